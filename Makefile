@@ -1,0 +1,36 @@
+# Two commands for a fresh machine: `make demo` and `make test`. Both set up first if needed.
+SHELL := /bin/bash
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.setup-complete
+PACKAGES := collision_engine force_renderer haptic_wand_driver haptic_bringup
+SETUP_INPUTS := requirements.txt constraints.txt tools/setup_venv.sh tools/fix_wheel_cmake_paths.py \
+	$(wildcard src/msgs/*.txt src/msgs/*.xml src/msgs/msg/*.msg) \
+	$(foreach p,$(PACKAGES),$(wildcard src/$(p)/setup.py src/$(p)/setup.cfg src/$(p)/package.xml \
+	  src/$(p)/config/* src/$(p)/launch/* src/$(p)/scenes/* src/$(p)/scenes/meshes/*))
+
+# Local DDS only, and a domain of our own, for everything make runs.
+export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
+export ROS_DOMAIN_ID ?= 42
+export ROS_LOG_DIR := $(CURDIR)/build/ros_log
+export ROS_HOME := $(CURDIR)/build/ros_home
+unexport _ROS_WHEELS_BOOTSTRAP_COMPLETE
+
+.PHONY: setup demo test bench lint clean
+setup: $(STAMP)
+
+$(STAMP): $(SETUP_INPUTS)
+	tools/setup_venv.sh $(VENV)
+	touch $@
+
+demo: $(STAMP)
+	$(VENV)/bin/demo
+
+test: $(STAMP)
+	$(PY) -m pytest -q tests
+
+bench: $(STAMP)
+	$(PY) bench/run_all.py
+
+clean:
+	rm -rf build $(VENV)
