@@ -1,0 +1,11 @@
+"""Shared test set-up: ``tests/`` itself is importable, so ``ground_truth`` is one module for all."""
+import os
+import pathlib
+import sys
+
+TESTS = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(TESTS))
+
+# Anything a test starts that speaks DDS stays on this machine, in a domain of its own.
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+os.environ.setdefault('ROS_DOMAIN_ID', '42')
