@@ -3,7 +3,7 @@ SHELL := /bin/bash
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.setup-complete
-PACKAGES := collision_engine force_renderer haptic_wand_driver haptic_bringup
+PACKAGES := haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup
 SETUP_INPUTS := requirements.txt constraints.txt tools/setup_venv.sh tools/fix_wheel_cmake_paths.py \
 	$(wildcard src/msgs/*.txt src/msgs/*.xml src/msgs/msg/*.msg) \
 	$(foreach p,$(PACKAGES),$(wildcard src/$(p)/setup.py src/$(p)/setup.cfg src/$(p)/package.xml \
@@ -14,6 +14,7 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_DOMAIN_ID ?= 42
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
 export ROS_HOME := $(CURDIR)/build/ros_home
+export AMENT_PREFIX_PATH := $(CURDIR)/$(VENV)
 unexport _ROS_WHEELS_BOOTSTRAP_COMPLETE
 
 .PHONY: setup demo test bench lint clean

@@ -40,7 +40,7 @@ cmake -S src/msgs -B build/haptic_msgs -DCMAKE_INSTALL_PREFIX="$venv" -DBUILD_TE
 make -C build/haptic_msgs -j2 install >build/haptic_msgs.make.log 2>&1 \
   || { tail -50 build/haptic_msgs.make.log; exit 1; }
 
-for pkg in collision_engine force_renderer haptic_wand_driver haptic_bringup; do
+for pkg in haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup; do
   step "installing $pkg"
   "${pip[@]}" install -q --no-deps --no-build-isolation --use-pep517 -e "src/$pkg" \
     2> >(grep -v 'is ignored: it is neither' >&2)
@@ -49,6 +49,6 @@ for pkg in collision_engine force_renderer haptic_wand_driver haptic_bringup; do
   (cd "src/$pkg" && "$venv/bin/python" -W ignore setup.py -q install_data -d "$venv" >/dev/null)
 done
 
-"$venv/bin/python" -c "import rclpy, haptic_msgs.msg, collision_engine, force_renderer, \
+"$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, collision_engine, force_renderer, \
 haptic_wand_driver, haptic_bringup" || { echo "[setup] import check failed"; exit 1; }
 step "done: $venv"

@@ -1,0 +1,1 @@
+"""Shared rclpy plumbing of the haptic nodes: QoS, executor and start-up, stamps."""
