@@ -42,7 +42,9 @@ make -C build/haptic_msgs -j2 install >build/haptic_msgs.make.log 2>&1 \
 
 for pkg in haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup; do
   step "installing $pkg"
+  # compat mode puts src/<pkg> on sys.path, so a tests/<pkg>/ folder can never shadow it.
   "${pip[@]}" install -q --no-deps --no-build-isolation --use-pep517 -e "src/$pkg" \
+    --config-settings editable_mode=compat \
     2> >(grep -v 'is ignored: it is neither' >&2)
   # PEP 660 editable installs skip data_files: install the ament index marker, package.xml,
   # config, launch and scene files into <venv>/share the way colcon would.

@@ -1,0 +1,190 @@
+"""A simulated 5-DOF wand: the device to use when there is no hardware, closing the loop.
+
+The wand is five decoupled joints q = (x, y, z, roll, yaw), each a mass (or inertia) with viscous
+damping, moved by the operator's hand and by the applied wrench. The workspace ends are perfectly
+inelastic stops: a joint reaching one is put back on it and loses its outward velocity, so the
+stops only ever remove energy.
+
+``read(now)`` advances in fixed substeps of ``step`` seconds with semi-implicit Euler (velocity
+first, the device's own damping implicit), so the trajectory depends only on the wrench applied
+before each substep, never on when ``read`` was called: a jittery timer that reads the same
+instants gets the same states, bit for bit. The held wrench applies from the next substep on.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from haptic_wand_driver._checks import checked_number, finite_vector
+from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState
+from haptic_wand_driver.operator import OperatorHand
+from haptic_wand_driver.orientation import roll_yaw_jacobian
+from haptic_wand_driver.wrench_input import saturate
+
+__all__ = ['SimulatedWand', 'SimulatedWandConfig']
+
+_STABLE_STEP = 0.2
+"""Largest step · sqrt(k / m) and step · c / m accepted for the hand's explicit spring-damper."""
+
+
+@dataclass(frozen=True, eq=False)
+class SimulatedWandConfig:
+    """Parameters of the simulated wand.
+
+    The defaults describe a desk-top pantograph wand as a point: they are plausible values chosen
+    for a well-behaved loop, not a datasheet.
+
+    Parameters
+    ----------
+    mass : (3,) float, kg
+        Apparent mass on x, y, z.
+    damping : (3,) float, N·s/m
+        Viscous damping on x, y, z.
+    roll_inertia, yaw_inertia : float, kg·m²
+    roll_damping, yaw_damping : float, N·m·s/rad
+    limits : DeviceLimits
+        Force and torque saturation and the workspace, whose ends are the stops.
+    step : float, s
+        Simulation substep.
+    initial_position : (3,) float, m
+    initial_roll, initial_yaw : float, rad
+    """
+
+    mass: np.ndarray = field(default_factory=lambda: np.full(3, 0.15))
+    damping: np.ndarray = field(default_factory=lambda: np.full(3, 0.3))
+    roll_inertia: float = 5e-4
+    yaw_inertia: float = 5e-4
+    roll_damping: float = 2e-3
+    yaw_damping: float = 2e-3
+    limits: DeviceLimits = field(
+        default_factory=lambda: DeviceLimits(force_limit=10.0, torque_limit=0.5))
+    step: float = 5e-4
+    initial_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    initial_roll: float = 0.0
+    initial_yaw: float = 0.0
+
+    def __post_init__(self):
+        for name in ('mass', 'damping', 'initial_position'):
+            object.__setattr__(self, name, finite_vector(getattr(self, name), 3,
+                                                         f'SimulatedWandConfig.{name}'))
+        for name, value in (('mass', self.mass.min()), ('roll_inertia', self.roll_inertia),
+                            ('yaw_inertia', self.yaw_inertia), ('step', self.step)):
+            checked_number(value, f'SimulatedWandConfig.{name}', minimum=0.0, strict=True)
+        for name, value in (('damping', self.damping.min()), ('roll_damping', self.roll_damping),
+                            ('yaw_damping', self.yaw_damping)):
+            checked_number(value, f'SimulatedWandConfig.{name}', minimum=0.0)
+        if not self.limits.workspace.contains(self.initial_coordinates):
+            raise ValueError(f'SimulatedWandConfig initial pose {self.initial_coordinates} lies '
+                             f'outside the workspace {self.limits.workspace}')
+
+    @property
+    def inertia(self) -> np.ndarray:
+        """(5,) float: mass [kg] on x, y, z, inertia [kg·m²] on roll, yaw."""
+        return np.concatenate([self.mass, [self.roll_inertia, self.yaw_inertia]])
+
+    @property
+    def joint_damping(self) -> np.ndarray:
+        """(5,) float: N·s/m on x, y, z, N·m·s/rad on roll, yaw."""
+        return np.concatenate([self.damping, [self.roll_damping, self.yaw_damping]])
+
+    @property
+    def initial_coordinates(self) -> np.ndarray:
+        """(5,) float: x, y, z [m], roll, yaw [rad]."""
+        return np.concatenate([self.initial_position, [self.initial_roll, self.initial_yaw]])
+
+
+class SimulatedWand(HapticDevice):
+    """A 5-DOF wand simulated in real time, moved by an operator's hand and the applied wrench.
+
+    Parameters
+    ----------
+    config : SimulatedWandConfig
+    operator : OperatorHand or None
+        The hand holding it; None leaves the wand free (only the applied wrench moves it).
+    """
+
+    def __init__(self, config: SimulatedWandConfig = SimulatedWandConfig(), *,
+                 operator: OperatorHand | None = None):
+        self._config = config
+        self._inverse_inertia = 1.0 / config.inertia
+        self._damping_decay = 1.0 / (1.0 + config.step * config.joint_damping
+                                     * self._inverse_inertia)
+        self._lower, self._upper = config.limits.workspace.coordinate_bounds
+        if operator is not None:
+            self._check_step_resolves(operator)
+        self._operator = operator
+        self._coordinates = config.initial_coordinates
+        self._rates = np.zeros(5)
+        self._force = np.zeros(3)
+        self._torque = np.zeros(3)
+        self._start: float | None = None
+        self._steps_done = 0
+
+    def _check_step_resolves(self, operator: OperatorHand) -> None:
+        step = self._config.step
+        stiffness_ratio = step * np.sqrt(operator.stiffness * self._inverse_inertia).max()
+        damping_ratio = step * (operator.damping * self._inverse_inertia).max()
+        if max(stiffness_ratio, damping_ratio) > _STABLE_STEP:
+            raise ValueError(
+                f'SimulatedWandConfig.step {step} s is too long for the operator hand on this '
+                f'mass: step·sqrt(k/m) = {stiffness_ratio:.3g} and step·c/m = '
+                f'{damping_ratio:.3g} must stay <= {_STABLE_STEP}')
+
+    @property
+    def limits(self) -> DeviceLimits:
+        """Force, torque and workspace limits from the configuration."""
+        return self._config.limits
+
+    @property
+    def config(self) -> SimulatedWandConfig:
+        """The configuration it was built with."""
+        return self._config
+
+    def read(self, now: float) -> WandState:
+        """Advance to the last substep at or before ``now`` (s) and return the state there.
+
+        The first call starts the clock (and the operator's script) at ``now``.
+        """
+        self._raise_if_closed()
+        now = checked_number(now, 'SimulatedWand.read now')
+        if self._start is None:
+            self._start = float(now)
+        elif now < self._time():
+            raise ValueError(f'SimulatedWand.read: now {now!r} s is before the last state '
+                             f'({self._time()!r} s); the clock must not go back')
+        target_steps = int(np.floor((now - self._start) / self._config.step + 1e-9))
+        while self._steps_done < target_steps:
+            self._substep()
+        return WandState.from_coordinates(self._time(), self._coordinates, self._rates)
+
+    def apply(self, force: np.ndarray, torque: np.ndarray) -> None:
+        """Hold this wrench (N, N·m, workspace frame), saturated to the limits, until the next."""
+        self._raise_if_closed()
+        force = finite_vector(force, 3, 'SimulatedWand.apply force')
+        torque = finite_vector(torque, 3, 'SimulatedWand.apply torque')
+        self._force = saturate(force, self.limits.force_limit)
+        self._torque = saturate(torque, self.limits.torque_limit)
+
+    def close(self) -> None:
+        """Drop the held wrench and stop."""
+        self._force = np.zeros(3)
+        self._torque = np.zeros(3)
+        super().close()
+
+    def _time(self) -> float:
+        return self._start + self._steps_done * self._config.step
+
+    def _substep(self) -> None:
+        step = self._config.step
+        coordinates, rates = self._coordinates, self._rates
+        joint_torques = roll_yaw_jacobian(coordinates[4]).T @ self._torque
+        effort = np.concatenate([self._force, joint_torques])
+        if self._operator is not None:
+            effort += self._operator.effort(self._time() - self._start, coordinates, rates)
+        rates = (rates + step * effort * self._inverse_inertia) * self._damping_decay
+        coordinates = coordinates + step * rates
+        below, above = coordinates < self._lower, coordinates > self._upper
+        coordinates = np.clip(coordinates, self._lower, self._upper)
+        rates = np.where((below & (rates < 0.0)) | (above & (rates > 0.0)), 0.0, rates)
+        self._coordinates, self._rates = coordinates, rates
+        self._steps_done += 1

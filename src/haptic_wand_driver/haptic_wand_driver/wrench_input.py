@@ -1,0 +1,124 @@
+"""The commanded wrench as the driver holds it: validated, fresh or zero, actuatable, saturated.
+
+The force renderer sends a wrench per pose; the driver applies one per tick. Between the two sits
+:class:`WrenchCommand`: it keeps the latest good wrench, lets it go to zero when it is older than
+``timeout`` (the renderer or the link died), ignores wrenches with NaN/Inf (and zeroes the force,
+rather than keep rendering one that may be wrong), drops the pitch torque a 5-DOF wand cannot
+render, and saturates force and torque to the device limits without turning their direction.
+
+It is pure: it reads no clock, ``now`` is passed in (seconds, the clock that stamps the wrenches).
+"""
+
+import numpy as np
+
+from haptic_wand_driver._checks import checked_number, finite_vector
+from haptic_wand_driver.orientation import roll_yaw_jacobian
+
+__all__ = ['WrenchCommand', 'saturate']
+
+
+def saturate(vector: np.ndarray, limit: float) -> np.ndarray:
+    """Scale ``vector`` down to norm ``limit`` if it is longer, keeping its direction.
+
+    Parameters
+    ----------
+    vector : (3,) float
+    limit : float, same unit as vector, >= 0
+
+    Returns
+    -------
+    saturated : (3,) float
+        A new array.
+    """
+    vector = np.array(vector, dtype=np.float64)
+    norm = float(np.linalg.norm(vector))
+    return vector if norm <= limit else vector * (limit / norm)
+
+
+class WrenchCommand:
+    """The latest rendered wrench, as the device should apply it now.
+
+    Parameters
+    ----------
+    force_limit : float, N
+        Force norm the device renders at most (``HapticDevice.limits.force_limit``).
+    torque_limit : float, N·m
+        Norm of the actuated torque the device renders at most.
+    timeout : float, s
+        A wrench whose stamp is more than this older than ``now`` is stale and gives zero.
+    """
+
+    def __init__(self, *, force_limit: float, torque_limit: float, timeout: float = 0.010):
+        self._force_limit = checked_number(force_limit, 'WrenchCommand force_limit', minimum=0.0)
+        self._torque_limit = checked_number(torque_limit, 'WrenchCommand torque_limit',
+                                            minimum=0.0)
+        self._timeout = checked_number(timeout, 'WrenchCommand timeout', minimum=0.0)
+        self._force = np.zeros(3)
+        self._torque = np.zeros(3)
+        self._stamp: float | None = None
+
+    def update(self, force, torque, stamp: float, now: float) -> str | None:
+        """Take a received wrench; return None if it is held, else why it was ignored.
+
+        A wrench with NaN/Inf or the wrong shape also clears the held wrench, so the force goes
+        to zero until a good one arrives. A wrench older than the held one (out of order) or
+        stamped more than ``timeout`` in the future (clocks disagree) is ignored and the held one
+        stays.
+
+        Parameters
+        ----------
+        force : (3,) float, N, workspace frame
+        torque : (3,) float, N·m, workspace frame, about the tip
+        stamp : float, s
+            The wrench's stamp (the stamp of the pose it was rendered for).
+        now : float, s
+            Receive time on the same clock.
+
+        Returns
+        -------
+        reason : str or None
+            A sentence for a (throttled) warning, or None when the wrench was accepted.
+        """
+        try:
+            force_vector = finite_vector(force, 3, 'force')
+            torque_vector = finite_vector(torque, 3, 'torque')
+        except ValueError as error:
+            self._stamp = None
+            return f'wrench ignored and force zeroed: {error}'
+        if not (np.isfinite(stamp) and np.isfinite(now)):
+            self._stamp = None
+            return f'wrench ignored and force zeroed: stamp {stamp!r} or now {now!r} is not finite'
+        if self._stamp is not None and stamp < self._stamp:
+            return (f'wrench ignored: stamp {stamp:.6f} s is older than the held wrench '
+                    f'({self._stamp:.6f} s)')
+        if stamp > now + self._timeout:
+            return (f'wrench ignored: stamp {stamp:.6f} s is {stamp - now:.6f} s ahead of now; '
+                    f'the clocks disagree')
+        self._force, self._torque, self._stamp = force_vector, torque_vector, float(stamp)
+        return None
+
+    def is_fresh(self, now: float) -> bool:
+        """Whether a wrench is held and at most ``timeout`` old at ``now`` (s)."""
+        return self._stamp is not None and now - self._stamp <= self._timeout
+
+    def current(self, now: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+        """Return the wrench to apply at ``now``: zero unless fresh; actuatable; saturated.
+
+        Parameters
+        ----------
+        now : float, s
+        yaw : float, rad
+            The wand's current yaw, which sets its roll axis.
+
+        Returns
+        -------
+        force : (3,) float, N, workspace frame
+        torque : (3,) float, N·m, workspace frame
+            Only its components about the roll axis and z remain (no pitch torque).
+        """
+        if not self.is_fresh(now):
+            return np.zeros(3), np.zeros(3)
+        jacobian = roll_yaw_jacobian(yaw)
+        actuated_torque = jacobian @ (jacobian.T @ self._torque)
+        return (saturate(self._force, self._force_limit),
+                saturate(actuated_torque, self._torque_limit))
