@@ -18,7 +18,7 @@ setup(
     zip_safe=False,
     maintainer='Haptic toolkit maintainers',
     maintainer_email='maintainers@haptic-telesono.invalid',
-    description='Launch files, a local launcher, the composed loop, the bag recorder and the demo.',
+    description='Launch file, local launcher, composed loop, bag recorder and the demo.',
     license='Apache-2.0',
     entry_points={
         'console_scripts': [

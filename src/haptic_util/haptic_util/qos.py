@@ -6,7 +6,7 @@ pose is already stale). The depth of 5 lets a subscriber catch up after a schedu
 instead of dropping a sample. Latched descriptions (the scene) are reliable and transient-local so
 that a late subscriber, such as a recorder or RViz, still receives them.
 """
-from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, qos_profile_sensor_data,
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 
 __all__ = ['HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'RECORDER_QOS', 'MARKER_QOS']

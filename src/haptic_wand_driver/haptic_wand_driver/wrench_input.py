@@ -83,10 +83,10 @@ class WrenchCommand:
             force_vector = finite_vector(force, 3, 'force')
             torque_vector = finite_vector(torque, 3, 'torque')
         except ValueError as error:
-            self._stamp = None
+            self.clear()
             return f'wrench ignored and force zeroed: {error}'
         if not (np.isfinite(stamp) and np.isfinite(now)):
-            self._stamp = None
+            self.clear()
             return f'wrench ignored and force zeroed: stamp {stamp!r} or now {now!r} is not finite'
         if self._stamp is not None and stamp < self._stamp:
             return (f'wrench ignored: stamp {stamp:.6f} s is older than the held wrench '
@@ -96,6 +96,10 @@ class WrenchCommand:
                     f'the clocks disagree')
         self._force, self._torque, self._stamp = force_vector, torque_vector, float(stamp)
         return None
+
+    def clear(self) -> None:
+        """Drop the held wrench: zero force until a good one arrives."""
+        self._stamp = None
 
     def is_fresh(self, now: float) -> bool:
         """Whether a wrench is held and at most ``timeout`` old at ``now`` (s)."""

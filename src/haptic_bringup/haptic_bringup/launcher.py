@@ -1,0 +1,251 @@
+"""The local launcher: the haptic loop without ros2cli or launch (PyPI installs).
+
+    haptic_loop [--composed] [--scene SCENE] [--experiment NAME] [--duration S] [--record DIR]
+
+starts the wand driver, the collision engine and the force renderer as three processes (or, with
+``--composed``, as one process on one executor), with local-only DDS discovery, a domain id, and
+ROS logs under ``build/``. It waits for the loop's topics to be discovered, runs until the
+driver's experiment ends, ``--duration`` passes or Ctrl-C, then stops every process (the
+recorder last) and removes stale shared memory. On a full ROS 2 install,
+``ros2 launch haptic_bringup haptic_loop.launch.py`` does the same.
+"""
+import argparse
+import dataclasses
+import os
+import pathlib
+import signal
+import sys
+import time
+from typing import Optional
+
+from ament_index_python.packages import get_package_share_directory
+import yaml
+
+from haptic_bringup.discovery import GraphWatcher
+from haptic_bringup.processes import (clean_stale_shm, start_child, stop_children,
+                                      wait_any_exit)
+
+__all__ = ['LoopConfig', 'Loop', 'main', 'loop_environment', 'NODES']
+
+# node name → (package, module with main(), Node class); the order is the stop order.
+NODES = {
+    'wand_driver': ('haptic_wand_driver', 'haptic_wand_driver.node', 'WandDriverNode'),
+    'collision_engine': ('collision_engine', 'collision_engine.node', 'CollisionNode'),
+    'force_renderer': ('force_renderer', 'force_renderer.node', 'ForceNode'),
+}
+COMPOSED_MODULE = 'haptic_bringup.composed'
+RECORDER_MODULE = 'haptic_bringup.recorder'
+DEFAULT_DOMAIN_ID = 42
+DISCOVERY_TIMEOUT = 20.0  # [s] includes importing and warming up the collision kernels
+RECORDER_DRAIN = 0.3  # [s] for in-flight messages to reach the recorder before it stops
+DURATION_GRACE = 3.0  # [s] past --duration before the launcher stops a driver that did not
+
+
+@dataclasses.dataclass
+class LoopConfig:
+    """What to run. ``nodes`` may leave some out (a test may stand in for the driver)."""
+
+    nodes: tuple = tuple(NODES)
+    composed: bool = False
+    scene: Optional[str] = None
+    experiment: Optional[str] = None
+    duration: float = 0.0
+    record: Optional[str] = None
+    domain_id: int = DEFAULT_DOMAIN_ID
+    params_file: Optional[str] = None
+    overrides: dict = dataclasses.field(default_factory=dict)
+    run_dir: pathlib.Path = pathlib.Path('build/launch')
+    python: str = sys.executable
+
+
+def loop_environment(domain_id: int, log_dir: pathlib.Path) -> dict:
+    """The children's environment: local-only discovery, our domain, logs under the build dir."""
+    env = dict(os.environ)
+    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    env['ROS_DOMAIN_ID'] = str(domain_id)
+    env['ROS_LOG_DIR'] = str(log_dir)
+    env.setdefault('ROS_HOME', str(log_dir.parent / 'ros_home'))
+    prefixes = [p for p in env.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+    if sys.prefix not in prefixes:
+        prefixes.append(sys.prefix)
+    env['AMENT_PREFIX_PATH'] = os.pathsep.join(prefixes)
+    env['PYTHONUNBUFFERED'] = '1'
+    return env
+
+
+def node_parameters(config: LoopConfig) -> dict:
+    """Every node's parameters: package defaults, then the user's file, then the options."""
+    merged = {}
+    for package, _, _ in NODES.values():
+        share = pathlib.Path(get_package_share_directory(package))
+        merged.update(yaml.safe_load((share / 'config' / f'{package}.yaml').read_text()) or {})
+    if config.params_file:
+        user = yaml.safe_load(pathlib.Path(config.params_file).read_text()) or {}
+        for node, section in user.items():
+            merged.setdefault(node, {'ros__parameters': {}})
+            merged[node]['ros__parameters'].update(section.get('ros__parameters', {}))
+    options = {}
+    if config.scene:
+        for node in ('collision_engine', 'force_renderer', 'wand_driver'):
+            options.setdefault(node, {})['scene_file'] = str(config.scene)
+    if config.experiment:
+        options.setdefault('wand_driver', {})['experiment'] = config.experiment
+    if config.duration:
+        options.setdefault('wand_driver', {})['duration'] = float(config.duration)
+    if config.record:
+        options.setdefault('wand_driver', {})['min_subscribers'] = 2
+        options['recorder'] = {'output': str(pathlib.Path(config.record).resolve())}
+    for node, values in [*options.items(), *config.overrides.items()]:
+        merged.setdefault(node, {'ros__parameters': {}})
+        merged[node]['ros__parameters'].update(values)
+    return merged
+
+
+def expected_endpoints(config: LoopConfig) -> dict:
+    """Topic → (publishers, subscribers) that make the loop closed."""
+    recording = 1 if config.record else 0
+    running = set(config.nodes)
+    endpoints = {}
+    if 'wand_driver' in running:
+        endpoints['/wand/pose'] = (1, recording + ('collision_engine' in running))
+        endpoints['/wand/wrench'] = (('force_renderer' in running), 1)
+    if 'collision_engine' in running:
+        endpoints['/collision/state'] = (1, recording + ('force_renderer' in running))
+        endpoints.setdefault('/wand/pose', (0, 1))
+    if 'force_renderer' in running:
+        endpoints.setdefault('/wand/wrench', (1, 0))
+    return endpoints
+
+
+class Loop:
+    """Start the loop, wait until it is closed, and stop it cleanly (a context manager)."""
+
+    def __init__(self, config: LoopConfig) -> None:
+        self.config = config
+        stamp = time.strftime('%Y%m%d-%H%M%S')
+        self.run_dir = pathlib.Path(config.run_dir).resolve() / f'{stamp}-{os.getpid()}'
+        self.children = []
+        self.startup_time = None
+
+    def __enter__(self) -> 'Loop':
+        self.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def start(self) -> None:
+        config = self.config
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        params = self.run_dir / 'params.yaml'
+        params.write_text(yaml.safe_dump(node_parameters(config), sort_keys=False))
+        env = loop_environment(config.domain_id, self.run_dir / 'log')
+        ros_args = ['--ros-args', '--params-file', str(params)]
+        started = time.monotonic()
+        if config.record:
+            self.children.append(start_child(
+                'recorder', [config.python, '-m', RECORDER_MODULE, *ros_args], env))
+        if config.composed:
+            self.children.append(start_child(
+                'composed', [config.python, '-m', COMPOSED_MODULE, *config.nodes, *ros_args],
+                env))
+        else:
+            for name in config.nodes:
+                self.children.append(start_child(
+                    name, [config.python, '-m', NODES[name][1], *ros_args], env))
+        self._wait_for_discovery()
+        self.startup_time = time.monotonic() - started
+
+    def _wait_for_discovery(self) -> None:
+        watcher = GraphWatcher(self.config.domain_id)
+        try:
+            missing = watcher.wait(expected_endpoints(self.config), DISCOVERY_TIMEOUT,
+                                   abort=lambda: self.exited() is not None)
+        finally:
+            watcher.close()
+        dead = self.exited()
+        if dead is not None:
+            self.stop()
+            raise RuntimeError(f'{dead.name} exited with code {dead.returncode} at start-up '
+                               '(its error is printed above)')
+        if missing:
+            self.stop()
+            raise RuntimeError('the loop did not close within '
+                               f'{DISCOVERY_TIMEOUT:.0f} s; missing: {"; ".join(missing)}')
+
+    def exited(self):
+        """The first child that has exited, or None."""
+        return next((c for c in self.children if c.returncode is not None), None)
+
+    def pids(self) -> dict:
+        return {child.name: child.pid for child in self.children}
+
+    def wait(self, timeout: Optional[float] = None):
+        """Wait until a child exits (the driver at the end of its experiment) or ``timeout``."""
+        return wait_any_exit(self.children, float('inf') if timeout is None else timeout)
+
+    def stop(self) -> dict:
+        """Stop every child (the recorder last, after a drain) and clean shared memory."""
+        recorder = [c for c in self.children if c.name == 'recorder']
+        others = [c for c in self.children if c.name != 'recorder']
+        codes = stop_children(others)
+        if recorder:
+            time.sleep(RECORDER_DRAIN)
+            codes.update(stop_children(recorder))
+        self.children = []
+        clean_stale_shm()
+        return codes
+
+
+def parse_args(argv=None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        prog='haptic_loop', description=__doc__.split('\n\n')[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--composed', action='store_true',
+                        help='run the three nodes in one process on one executor')
+    parser.add_argument('--scene', help='scene YAML (path or package://pkg/path)')
+    parser.add_argument('--experiment', help='simulated operator script: cuboid, cylinder, '
+                        'hand, hold, or a waypoint file')
+    parser.add_argument('--duration', type=float, default=0.0,
+                        help='stop after this many seconds of closed loop (0: until Ctrl-C or '
+                        'the end of the experiment)')
+    parser.add_argument('--record', metavar='DIR', help='record a rosbag2 (mcap) to DIR')
+    parser.add_argument('--domain-id', type=int,
+                        default=int(os.environ.get('ROS_DOMAIN_ID', DEFAULT_DOMAIN_ID)))
+    parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
+    parser.add_argument('--run-dir', default='build/launch',
+                        help='where parameters and ROS logs of the run go')
+    return parser.parse_args(argv)
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    config = LoopConfig(composed=args.composed, scene=args.scene, experiment=args.experiment,
+                        duration=args.duration, record=args.record, domain_id=args.domain_id,
+                        params_file=args.params_file, run_dir=pathlib.Path(args.run_dir))
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    loop = Loop(config)
+    stop = []
+    signal.signal(signal.SIGINT, lambda *_: stop.append(True))
+    signal.signal(signal.SIGTERM, lambda *_: stop.append(True))
+    try:
+        loop.start()
+    except RuntimeError as error:
+        print(f'haptic_loop: {error}', file=sys.stderr)
+        return 1
+    layout = 'one process' if config.composed else f'{len(config.nodes)} processes'
+    print(f'haptic_loop: loop closed in {loop.startup_time:.2f} s ({layout}, '
+          f'domain {config.domain_id}); Ctrl-C stops', flush=True)
+    # The driver ends its experiment after ``duration`` and exits; this is only a backstop.
+    deadline = time.monotonic() + args.duration + DURATION_GRACE if args.duration \
+        else float('inf')
+    while not stop and time.monotonic() < deadline and loop.exited() is None:
+        time.sleep(0.05)
+    codes = loop.stop()
+    failed = {name: code for name, code in codes.items() if code not in (0, -signal.SIGINT)}
+    print(f'haptic_loop: stopped ({", ".join(f"{n}: {c}" for n, c in codes.items())})')
+    return 1 if failed else 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -1,0 +1,16 @@
+"""ROS parameters of the bring-up's own nodes (the recorder)."""
+from dataclasses import dataclass
+
+from haptic_util.parameters import parameter
+
+__all__ = ['RecorderParams', 'LOOP_TOPICS']
+
+# What a haptic session is: the loop's streams and the scene it ran against.
+LOOP_TOPICS = ('/wand/pose', '/wand/twist', '/collision/state', '/wand/wrench',
+               '/scene/description')
+
+
+@dataclass(frozen=True)
+class RecorderParams:
+    output: str = parameter('bags/haptic_session', 'new bag directory to write')
+    topics: tuple[str, ...] = parameter(LOOP_TOPICS, 'topics to record')

@@ -1,0 +1,103 @@
+"""Child processes of the local launcher: started in their own groups, stopped without orphans.
+
+Each node runs in its own session, so a Ctrl-C in the terminal reaches only the launcher, which
+then stops the nodes in a chosen order (the recorder last, so it loses nothing). A child also
+receives SIGTERM if the launcher itself dies (``PR_SET_PDEATHSIG``), so even a killed launcher
+leaves no orphans. Fast DDS leaves shared-memory segments behind a SIGKILLed process; those no
+live process holds are removed at the end, as ``fastdds shm clean`` does.
+"""
+import ctypes
+import fcntl
+import os
+import pathlib
+import signal
+import subprocess
+import time
+from typing import Optional
+
+__all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'wait_any_exit']
+
+PR_SET_PDEATHSIG = 1
+SHM_DIR = pathlib.Path('/dev/shm')
+
+
+class Child:
+    """A named child process in its own process group."""
+
+    def __init__(self, name: str, process: subprocess.Popen) -> None:
+        self.name = name
+        self.process = process
+
+    @property
+    def pid(self) -> int:
+        return self.process.pid
+
+    @property
+    def returncode(self) -> Optional[int]:
+        return self.process.poll()
+
+    def signal(self, signum: int) -> None:
+        try:
+            os.killpg(self.process.pid, signum)
+        except ProcessLookupError:
+            pass
+
+
+def _die_with_parent() -> None:
+    libc = ctypes.CDLL('libc.so.6', use_errno=True)
+    libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+def start_child(name: str, argv: list, env: dict) -> Child:
+    """Start ``argv`` as a new session whose processes die with the launcher."""
+    process = subprocess.Popen(argv, env=env, start_new_session=True,
+                               preexec_fn=_die_with_parent)
+    return Child(name, process)
+
+
+def stop_children(children: list, *, timeout: float = 5.0) -> dict:
+    """Stop children in order: SIGINT, then SIGTERM, then SIGKILL, each after ``timeout``.
+
+    Returns each child's exit code (negative: the signal that ended it).
+    """
+    codes = {}
+    for child in children:
+        for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
+            if child.returncode is not None:
+                break
+            child.signal(signum)
+            try:
+                child.process.wait(timeout)
+            except subprocess.TimeoutExpired:
+                continue
+        codes[child.name] = child.process.wait()
+    return codes
+
+
+def clean_stale_shm(directory: pathlib.Path = SHM_DIR) -> list:
+    """Remove Fast DDS segments whose lock no live process holds; return their names."""
+    removed = []
+    for lock in sorted(directory.glob('fastrtps_*_el')):
+        try:
+            with lock.open('rb') as handle:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            continue  # a live participant holds it
+        except FileNotFoundError:
+            continue
+        segment = lock.name[:-len('_el')]
+        for name in (segment, lock.name, f'sem.{segment}_mutex'):
+            (directory / name).unlink(missing_ok=True)
+        removed.append(segment)
+    return removed
+
+
+def wait_any_exit(children: list, timeout: float, poll: float = 0.05) -> Optional[Child]:
+    """Wait up to ``timeout`` s for any child to exit; return it, or None."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        for child in children:
+            if child.returncode is not None:
+                return child
+        time.sleep(poll)
+    return None

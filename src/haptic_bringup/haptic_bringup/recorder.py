@@ -1,0 +1,98 @@
+"""A rosbag2 recorder for machines without ``ros2 bag``: raw CDR in, mcap (Jazzy format) out.
+
+Subscriptions are raw, so no message is converted to Python; each one is written with its
+receive time, as ``ros2 bag record`` does. A topic's type is taken from the graph once a
+publisher appears; latched topics (the scene description) are subscribed transient-local.
+On SIGINT or SIGTERM the bag is closed and complete; after ``kill -9`` it is recoverable up to
+the last flush (see ``haptic_bringup.bag``).
+"""
+import importlib
+import pathlib
+
+from ament_index_python.packages import get_package_share_directory
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy
+
+from haptic_bringup.bag import BagWriter, typestore_with
+from haptic_bringup.params import RecorderParams
+from haptic_util.executor import run_nodes, StartupError
+from haptic_util.parameters import declare_parameters
+from haptic_util.qos import LATCHED_QOS, RECORDER_QOS
+
+__all__ = ['BagRecorder', 'main', 'custom_definitions']
+
+CUSTOM_PACKAGES = ('haptic_msgs',)
+GRAPH_POLL_PERIOD = 0.1  # [s]
+
+
+def custom_definitions(packages=CUSTOM_PACKAGES) -> list:
+    """(type name, .msg text) of the project's own interfaces, from their installed share."""
+    definitions = []
+    for package in packages:
+        share = pathlib.Path(get_package_share_directory(package)) / 'msg'
+        for path in sorted(share.glob('*.msg')):
+            definitions.append((f'{package}/msg/{path.stem}', path.read_text()))
+    return definitions
+
+
+def message_class(type_name: str):
+    """The Python class of ``pkg/msg/Name``."""
+    package, _, name = type_name.split('/')
+    return getattr(importlib.import_module(f'{package}.msg'), name)
+
+
+class BagRecorder(Node):
+    """Records the configured topics to ``output`` as soon as each one has a publisher."""
+
+    def __init__(self, **kwargs):
+        super().__init__('recorder', **kwargs)
+        self.params = declare_parameters(self, RecorderParams)
+        output = pathlib.Path(self.params.output).expanduser()
+        if output.exists():
+            raise StartupError(f'{self.get_name()}: output {output} exists already; '
+                               'give a new directory')
+        self.bag = BagWriter(output, typestore_with(custom_definitions()))
+        self._pending = [self.resolve_topic_name(t) for t in self.params.topics]
+        self._poll = self.create_timer(GRAPH_POLL_PERIOD, self.subscribe_new_topics)
+        self.get_logger().info(f'recording {", ".join(self._pending)} to {output}')
+
+    @property
+    def waiting_for(self) -> list:
+        """Topics not subscribed yet (no publisher seen)."""
+        return list(self._pending)
+
+    def subscribe_new_topics(self) -> None:
+        types = dict(self.get_topic_names_and_types())
+        for topic in [t for t in self._pending if t in types]:
+            type_name = types[topic][0]
+            publishers = self.get_publishers_info_by_topic(topic)
+            latched = any(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                          for p in publishers)
+            self.bag.add_topic(topic, type_name)
+            self.create_subscription(
+                message_class(type_name), topic, self._writer_for(topic),
+                LATCHED_QOS if latched else RECORDER_QOS, raw=True)
+            self._pending.remove(topic)
+        if not self._pending:
+            self._poll.cancel()
+
+    def _writer_for(self, topic: str):
+        clock = self.get_clock()
+
+        def write(data: bytes) -> None:
+            self.bag.write(topic, clock.now().nanoseconds, data)
+        return write
+
+    def destroy_node(self) -> bool:
+        self.bag.close()
+        counts = ', '.join(f'{t}: {n}' for t, n in self.bag.counts.items())
+        self.get_logger().info(f'closed {self.bag.path} ({counts})')
+        return super().destroy_node()
+
+
+def main(args=None) -> int:
+    return run_nodes([BagRecorder], args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

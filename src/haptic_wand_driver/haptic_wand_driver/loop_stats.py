@@ -1,0 +1,73 @@
+"""Round-trip book-keeping of the haptic loop, as the driver sees it.
+
+Every wrench carries the stamp of the pose it answers, so the driver, which stamped that pose,
+knows the loop's round trip exactly, on one clock, without any extra traffic. Counted from the
+first pose after ``start()``: poses sent, poses answered (a wrench with that pose's stamp), and
+each answer's latency.
+"""
+import numpy as np
+
+__all__ = ['LoopStats']
+
+
+class LoopStats:
+    """Poses sent and answered, and round-trip latencies [s]."""
+
+    def __init__(self) -> None:
+        self._sent: set = set()
+        self._answered: set = set()
+        self._latency_ns: list = []
+        self._first_ns = None
+        self._last_ns = None
+
+    def sent(self, stamp_ns: int) -> None:
+        self._sent.add(stamp_ns)
+        if self._first_ns is None:
+            self._first_ns = stamp_ns
+        self._last_ns = stamp_ns
+
+    def answered(self, stamp_ns: int, received_ns: int) -> None:
+        """Record a wrench for the pose stamped ``stamp_ns``; others are not loop answers."""
+        if stamp_ns in self._sent and stamp_ns not in self._answered:
+            self._answered.add(stamp_ns)
+            self._latency_ns.append(received_ns - stamp_ns)
+
+    @property
+    def poses(self) -> int:
+        return len(self._sent)
+
+    @property
+    def answers(self) -> int:
+        return len(self._answered)
+
+    @property
+    def latencies(self) -> np.ndarray:
+        """(n,) float, s: round trip of each answered pose, in arrival order."""
+        return np.asarray(self._latency_ns, dtype=np.float64) * 1e-9
+
+    @property
+    def rate(self) -> float:
+        """Achieved pose rate [Hz] over the poses sent so far."""
+        if self.poses < 2:
+            return 0.0
+        return (self.poses - 1) / ((self._last_ns - self._first_ns) * 1e-9)
+
+    def summary(self) -> dict:
+        """Rate, share answered, and latency percentiles (s), for logs and benchmarks."""
+        latency = self.latencies
+        percentiles = (np.percentile(latency, [50, 90, 99]) if latency.size
+                       else np.full(3, np.nan))
+        return {
+            'poses': self.poses,
+            'answers': self.answers,
+            'answered_percent': 100.0 * self.answers / self.poses if self.poses else 0.0,
+            'rate_hz': self.rate,
+            'latency_p50_s': float(percentiles[0]),
+            'latency_p90_s': float(percentiles[1]),
+            'latency_p99_s': float(percentiles[2]),
+            'latency_max_s': float(latency.max()) if latency.size else float('nan'),
+        }
+
+    def save(self, path) -> None:
+        """Write the raw latencies and the summary to an .npz file."""
+        np.savez(path, latencies=self.latencies, **self.summary())

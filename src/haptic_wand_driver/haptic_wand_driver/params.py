@@ -1,0 +1,38 @@
+"""The wand driver's ROS parameters, in one place (see config/haptic_wand_driver.yaml)."""
+from dataclasses import dataclass
+
+from haptic_util.parameters import parameter
+
+__all__ = ['WandDriverParams']
+
+
+@dataclass(frozen=True)
+class WandDriverParams:
+    device: str = parameter('simulated', 'device backend: simulated, replay, or one registered '
+                            'with haptic_wand_driver.register_device')
+    rate: float = parameter(1000.0, 'pose publishing rate', unit='Hz', low=1.0, high=10000.0)
+    frame_id: str = parameter('world', 'frame of the published pose, twist and expected wrench')
+    experiment: str = parameter('cuboid', 'simulated operator script: cuboid, cylinder, hand, '
+                                'hold, or a waypoint file (.yaml/.csv)')
+    scene_file: str = parameter('package://collision_engine/scenes/cuboid.yaml',
+                                'scene the scripted operator taps (simulated device only)')
+    replay_file: str = parameter('', 'recording to replay (device: replay): a bag or a CSV')
+    replay_loop: bool = parameter(False, 'start the replay over at its end')
+    duration: float = parameter(0.0, 'run the experiment this long, then exit (0: forever)',
+                                unit='s', low=0.0)
+    wrench_timeout: float = parameter(0.010, 'a wrench older than this is stale: zero force',
+                                      unit='s', low=0.0005, high=1.0)
+    force_limit: float = parameter(10.0, 'device force limit (saturation)', unit='N', low=0.0)
+    torque_limit: float = parameter(0.5, 'device torque limit (saturation)', unit='N*m', low=0.0)
+    device_mass: float = parameter(0.15, 'simulated apparent mass per axis', unit='kg',
+                                   low=1e-4)
+    device_damping: float = parameter(2.0, 'simulated physical damping per axis',
+                                      unit='N*s/m', low=0.0)
+    hand_stiffness: float = parameter(50.0, 'simulated operator hand stiffness', unit='N/m',
+                                      low=0.0)
+    hand_damping: float = parameter(3.5, 'simulated operator hand damping', unit='N*s/m',
+                                    low=0.0)
+    min_subscribers: int = parameter(1, 'start only once wand/pose has this many matched '
+                                     'subscribers (2 when recording)', low=0)
+    wait_for_wrench: bool = parameter(True, 'start only once a wand/wrench publisher matched')
+    stats_file: str = parameter('', 'write round-trip latencies (.npz) here on exit')
