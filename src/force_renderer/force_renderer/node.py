@@ -1,0 +1,174 @@
+"""The force renderer node: collision state in, saturated and passive wrench out.
+
+Subscribes ``collision/state`` (CollisionState) and, when the materials have damping and
+``velocity_source`` is ``twist``, ``wand/twist`` (TwistStamped). Publishes one ``wand/wrench``
+(WrenchStamped) per state, with the state's header (the pose's stamp and frame), force at the tip,
+zero torque. When no fresh state arrives for ``watchdog_timeout``, it publishes zero wrenches.
+"""
+from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
+from rclpy.node import Node
+from std_msgs.msg import Header
+from visualization_msgs.msg import Marker
+
+from force_renderer.contact import Contact
+from force_renderer.materials import PerObjectLaw
+from force_renderer.params import ForceRendererParams
+from force_renderer.passivity import passivity_warning
+from force_renderer.pipeline import ForcePipeline, PipelineConfig
+from force_renderer.proxy import GodObjectProxy
+from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
+from force_renderer.watchdog import Reason
+from haptic_msgs.msg import CollisionState
+from haptic_util.executor import run_nodes, StartupError
+from haptic_util.parameters import declare_parameters
+from haptic_util.paths import resolve_path
+from haptic_util.qos import HAPTIC_STREAM_QOS, MARKER_QOS
+from haptic_util.stamps import to_nanoseconds
+
+__all__ = ['ForceNode', 'main']
+
+WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
+ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
+
+
+class ForceNode(Node):
+    """Turns each collision state into the wrench the wand applies."""
+
+    def __init__(self, **kwargs):
+        super().__init__('force_renderer', **kwargs)
+        self.params = params = declare_parameters(self, ForceRendererParams)
+        try:
+            law, gains = self._law(params)
+        except ValueError as error:
+            raise StartupError(f'{self.get_name()}: {error}') from None
+        self.pipeline = ForcePipeline(law, PipelineConfig(
+            force_limit=params.force_limit, passivity=params.passivity,
+            max_damping=params.max_damping, servo_period=params.servo_period,
+            timeout=params.watchdog_timeout))
+        for stiffness, damping in gains:
+            warning = passivity_warning(stiffness, params.device_damping, params.servo_period,
+                                        damping)
+            if warning:
+                self.get_logger().warn(warning)
+        self._contact = None
+        self._header = None
+        self._twist = None
+        self._published = 0
+        self._wrench = WrenchStamped()
+        self._wrench_pub = self.create_publisher(WrenchStamped, 'wand/wrench', HAPTIC_STREAM_QOS)
+        self.create_subscription(CollisionState, 'collision/state', self.on_state,
+                                 HAPTIC_STREAM_QOS)
+        uses_damping = any(max(damping) > 0.0 for _, damping in gains)
+        if uses_damping and params.velocity_source == 'twist':
+            self.create_subscription(TwistStamped, 'wand/twist', self.on_twist,
+                                     HAPTIC_STREAM_QOS)
+        self.create_timer(params.watchdog_timeout / 2, self.check_stale)
+        if params.marker_rate > 0:
+            self._marker_pub = self.create_publisher(Marker, 'wand/force_marker', MARKER_QOS)
+            self.create_timer(1.0 / params.marker_rate, self.publish_marker)
+        passivity = 'on' if params.passivity else 'off'
+        self.get_logger().info(f'{params.law} law, passivity {passivity}, '
+                               f'force limit {params.force_limit:g} N')
+
+    def _law(self, params: ForceRendererParams):
+        """The force law and every (stiffness, damping) it renders with."""
+        default = (params.stiffness, params.damping)
+        if not params.scene_file:
+            if params.law != 'normal':
+                raise ValueError(f'law {params.law!r} needs parameter scene_file')
+            return SpringDamper(*default), [default]
+        scene_path = resolve_path(params.scene_file, what='parameter scene_file')
+        from collision_engine import read_scene
+        spec = read_scene(scene_path)
+        materials = {o.name: (tuple(o.material.stiffness), tuple(o.material.damping))
+                     for o in spec.objects if o.material is not None}
+        gains = [default, *materials.values()]
+        if params.law == 'proxy':
+            from collision_engine import load_scene
+            scene = load_scene(scene_path)
+            scene.warm_up()
+
+            def signed_distance(point):
+                result = scene.query(point)
+                return result.distance, result.normal
+            return GodObjectProxy(*default, signed_distance), [default]
+        if params.law == 'centroid':
+            from force_renderer.centroids import vertex_centroids
+            centroids = vertex_centroids(spec)
+            laws = {name: CentroidSpringDamper(*materials.get(name, default), centroid)
+                    for name, centroid in centroids.items()}
+            return PerObjectLaw(laws, SpringDamper(*default)), gains
+        laws = {name: SpringDamper(*gain) for name, gain in materials.items()}
+        return PerObjectLaw(laws, SpringDamper(*default)), gains
+
+    def on_twist(self, msg: TwistStamped) -> None:
+        v = msg.twist.linear
+        self._twist = (to_nanoseconds(msg.header.stamp), (v.x, v.y, v.z))
+
+    def on_state(self, msg: CollisionState) -> None:
+        stamp_ns = to_nanoseconds(msg.header.stamp)
+        p, n, t = msg.closest_point, msg.normal, msg.tip
+        self._contact = Contact(msg.distance, (p.x, p.y, p.z), (n.x, n.y, n.z), (t.x, t.y, t.z),
+                                msg.object, stamp_ns * 1e-9)
+        self._header = msg.header
+        self.render(self._velocity(stamp_ns))
+
+    def _velocity(self, stamp_ns: int):
+        """The twist of the state's pose, or None (the pipeline then estimates it)."""
+        twist = self._twist
+        if twist is None or abs(twist[0] - stamp_ns) > self.params.watchdog_timeout * 1e9:
+            return None
+        return twist[1]
+
+    def render(self, velocity) -> None:
+        now = self.get_clock().now().nanoseconds * 1e-9
+        force = self.pipeline.step(self._contact, velocity, now)
+        reason = self.pipeline.last_reason
+        if reason is not Reason.OK:
+            self.get_logger().warn(f'force zeroed: {reason.value}',
+                                   throttle_duration_sec=WARN_PERIOD)
+        wrench = self._wrench
+        # A zero sent because the state is stale answers no pose: it is stamped now.
+        wrench.header = self._header if reason is not Reason.STALE else Header(
+            stamp=self.get_clock().now().to_msg(), frame_id=self._header.frame_id)
+        f = wrench.wrench.force
+        f.x, f.y, f.z = float(force[0]), float(force[1]), float(force[2])
+        self._wrench_pub.publish(wrench)
+        self._published += 1
+
+    def check_stale(self) -> None:
+        """Publish zero force while the collision state is stale (after the first one)."""
+        if self._contact is None:
+            return
+        now = self.get_clock().now().nanoseconds * 1e-9
+        if now - self._contact.stamp > self.params.watchdog_timeout:
+            self.render(None)
+
+    def publish_marker(self) -> None:
+        if self._contact is None:
+            return
+        marker = Marker(ns='force', id=0, type=Marker.ARROW, action=Marker.ADD)
+        marker.header = self._wrench.header
+        force = self._wrench.wrench.force
+        tip = self._contact.tip
+        start = (float(tip[0]), float(tip[1]), float(tip[2]))
+        end = (start[0] + ARROW_SCALE * force.x, start[1] + ARROW_SCALE * force.y,
+               start[2] + ARROW_SCALE * force.z)
+        marker.points = [Point(x=start[0], y=start[1], z=start[2]),
+                         Point(x=end[0], y=end[1], z=end[2])]
+        marker.scale.x, marker.scale.y, marker.scale.z = 0.002, 0.004, 0.004
+        marker.color.r, marker.color.g, marker.color.a = 0.1, 0.4, 1.0
+        marker.pose.orientation.w = 1.0
+        self._marker_pub.publish(marker)
+
+    def destroy_node(self) -> bool:
+        self.get_logger().info(f'published {self._published} wrenches')
+        return super().destroy_node()
+
+
+def main(args=None) -> int:
+    return run_nodes([ForceNode], args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
