@@ -1,0 +1,120 @@
+"""Penalty force laws: a spring-damper along the surface normal, and the paper's law.
+
+Both follow one small interface, `ForceLaw`: `force(contact, velocity) -> (3,)` in the contact's
+frame, zero out of contact. The renderer's law (`SpringDamper`) is unilateral: a surface can push
+the tip out but never pull it in. `CentroidSpringDamper` is the paper's law, kept only to compare
+against (it pushes away from the object's vertex centroid, up to 45 degrees off a cube face).
+"""
+
+import math
+from typing import Protocol
+
+import numpy as np
+
+from force_renderer._checks import floats3, per_axis, vector3
+from force_renderer.contact import Contact
+from force_renderer.errors import ForceRendererError
+
+__all__ = ['CentroidSpringDamper', 'ForceLaw', 'SpringDamper', 'unilateral_spring_damper']
+
+Vector3 = tuple[float, float, float]
+
+
+class ForceLaw(Protocol):
+    """A rendering law: the force on the tip for one collision state."""
+
+    def force(self, contact: Contact, velocity) -> np.ndarray:
+        """Force on the tip, (3,) float, N, in the contact's frame; zero out of contact.
+
+        `velocity` is the tip velocity, (3,) float, m/s, same frame.
+        """
+
+
+def unilateral_spring_damper(displacement: Vector3, normal: Vector3, velocity: Vector3,
+                             stiffness: Vector3, damping: Vector3) -> Vector3:
+    """K⊙x − C⊙v with its component along `normal` clipped at zero, as plain floats.
+
+    Why clip: on the way out of a surface the damper opposes the outward motion and can outweigh
+    the spring near the surface; the clip keeps it from pulling the tip back in (a sticky wall).
+
+    Parameters
+    ----------
+    displacement : (3,) float, m
+        Spring extension x, pointing out of the surface (towards where the tip should be).
+    normal : (3,) float
+        Unit outward normal that decides what "attractive" means.
+    velocity : (3,) float, m/s
+        Tip velocity.
+    stiffness, damping : (3,) float, N/m and N·s/m
+        Per-axis gains along the frame's axes.
+    """
+    fx = stiffness[0] * displacement[0] - damping[0] * velocity[0]
+    fy = stiffness[1] * displacement[1] - damping[1] * velocity[1]
+    fz = stiffness[2] * displacement[2] - damping[2] * velocity[2]
+    pushing = fx * normal[0] + fy * normal[1] + fz * normal[2]
+    if pushing < 0.0:
+        fx -= pushing * normal[0]
+        fy -= pushing * normal[1]
+        fz -= pushing * normal[2]
+    return fx, fy, fz
+
+
+class SpringDamper:
+    """F = K⊙x − C⊙v in contact (x = penetration vector), never attractive; zero outside.
+
+    Parameters
+    ----------
+    stiffness : float or (3,) float, N/m
+        K per world axis (the object's material); one number means the same on every axis.
+    damping : float or (3,) float, N·s/m
+        C per world axis; it acts only in contact.
+    """
+
+    def __init__(self, stiffness, damping) -> None:
+        self.stiffness = per_axis(stiffness, 'stiffness')
+        self.damping = per_axis(damping, 'damping')
+        self._stiffness = tuple(self.stiffness.tolist())
+        self._damping = tuple(self.damping.tolist())
+
+    def force(self, contact: Contact, velocity) -> np.ndarray:
+        """Force on the tip, (3,) float, N; see `ForceLaw.force`."""
+        if not contact.in_contact:
+            return np.zeros(3)
+        px, py, pz = contact.point.tolist()
+        tx, ty, tz = contact.tip.tolist()
+        return np.array(unilateral_spring_damper(
+            (px - tx, py - ty, pz - tz), contact.normal.tolist(), floats3(velocity),
+            self._stiffness, self._damping))
+
+
+class CentroidSpringDamper:
+    """The paper's law: F = (r/|r|)⊙k·|d| − kd⊙v with r = tip − centroid, in contact only.
+
+    For comparison only: the direction ignores the surface, and the damper may pull. At r = 0 the
+    direction is undefined and the spring term is dropped.
+
+    Parameters
+    ----------
+    stiffness : float or (3,) float, N/m
+        k per axis (paper: 160 N/m; its Simulink model: 80 N/m).
+    damping : float or (3,) float, N·s/m
+        kd per axis (0.8 N·s/m in both).
+    centroid : (3,) float, m
+        Plain mean of the object's mesh vertices, in the contact's frame.
+    """
+
+    def __init__(self, stiffness, damping, centroid) -> None:
+        self.stiffness = per_axis(stiffness, 'stiffness')
+        self.damping = per_axis(damping, 'damping')
+        self.centroid = vector3(centroid, 'centroid')
+        if not np.all(np.isfinite(self.centroid)):
+            raise ForceRendererError(f'centroid must be finite, got {self.centroid.tolist()}')
+
+    def force(self, contact: Contact, velocity) -> np.ndarray:
+        """Force on the tip, (3,) float, N; see `ForceLaw.force`."""
+        if not contact.in_contact:
+            return np.zeros(3)
+        radial = contact.tip - self.centroid
+        length = math.sqrt(float(radial @ radial))
+        spring = radial * (-contact.distance / length) if length > 0.0 else np.zeros(3)
+        return self.stiffness * spring - self.damping * np.asarray(velocity, dtype=np.float64)
