@@ -58,17 +58,24 @@ class LoopConfig:
     python: str = sys.executable
 
 
+def add_venv_prefix() -> None:
+    """Make this interpreter's prefix an ament prefix, as the PyPI set-up installs into it.
+
+    On a sourced ROS 2 install the prefix is already on AMENT_PREFIX_PATH, or irrelevant.
+    """
+    prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+    if sys.prefix not in prefixes:
+        os.environ['AMENT_PREFIX_PATH'] = os.pathsep.join([*prefixes, sys.prefix])
+
+
 def loop_environment(domain_id: int, log_dir: pathlib.Path) -> dict:
     """The children's environment: local-only discovery, our domain, logs under the build dir."""
+    add_venv_prefix()
     env = dict(os.environ)
     env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     env['ROS_DOMAIN_ID'] = str(domain_id)
     env['ROS_LOG_DIR'] = str(log_dir)
     env.setdefault('ROS_HOME', str(log_dir.parent / 'ros_home'))
-    prefixes = [p for p in env.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
-    if sys.prefix not in prefixes:
-        prefixes.append(sys.prefix)
-    env['AMENT_PREFIX_PATH'] = os.pathsep.join(prefixes)
     env['PYTHONUNBUFFERED'] = '1'
     return env
 
@@ -137,9 +144,9 @@ class Loop:
     def start(self) -> None:
         config = self.config
         self.run_dir.mkdir(parents=True, exist_ok=True)
+        env = loop_environment(config.domain_id, self.run_dir / 'log')
         params = self.run_dir / 'params.yaml'
         params.write_text(yaml.safe_dump(node_parameters(config), sort_keys=False))
-        env = loop_environment(config.domain_id, self.run_dir / 'log')
         ros_args = ['--ros-args', '--params-file', str(params)]
         started = time.monotonic()
         if config.record:

@@ -1,19 +1,20 @@
 """The QoS profiles every haptic node must agree on.
 
-The 1 kHz streams (pose, twist, collision state, wrench) are sensor data: the newest sample is the
-only one worth having, so they are best effort with a short keep-last history (a retransmitted
-pose is already stale). The depth of 5 lets a subscriber catch up after a scheduling hiccup
-instead of dropping a sample. Latched descriptions (the scene) are reliable and transient-local so
-that a late subscriber, such as a recorder or RViz, still receives them.
+The 1 kHz streams (pose, twist, collision state, wrench) are sensor data: best effort, keep last
+(a retransmitted pose is already stale, and a reliable queue under load only adds latency). The
+depth of 10 lets a subscriber that was descheduled for a few milliseconds catch up and still
+answer every pose instead of dropping samples. Latched descriptions (the scene) are reliable and
+transient-local, so that a late subscriber, such as a recorder or RViz, still receives them.
 """
-from rclpy.qos import (DurabilityPolicy, HistoryPolicy, qos_profile_sensor_data, QoSProfile,
-                       ReliabilityPolicy)
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 __all__ = ['HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'RECORDER_QOS', 'MARKER_QOS']
 
+STREAM_DEPTH = 10
+
 HAPTIC_STREAM_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
-    depth=qos_profile_sensor_data.depth,
+    depth=STREAM_DEPTH,
     reliability=ReliabilityPolicy.BEST_EFFORT,
     durability=DurabilityPolicy.VOLATILE,
 )

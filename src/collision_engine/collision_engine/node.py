@@ -1,0 +1,137 @@
+"""The collision node: tip pose in, signed distance to the nearest scene object out.
+
+Subscribes ``wand/pose`` (PoseStamped) and publishes, per pose, ``collision/state``
+(CollisionState) with the pose's header, so that latency can be measured end to end. Optionally
+``collision/nearby`` (every object within ``report_radius``), ``collision/markers`` for RViz,
+``scene/description`` (the scene YAML, latched, for recorders) and ``/diagnostics``.
+"""
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import PoseStamped
+from rclpy.node import Node
+from std_msgs.msg import Header, String
+from visualization_msgs.msg import MarkerArray
+
+from collision_engine import load_scene, read_scene
+from collision_engine.conversions import (fill_invalid_state, fill_state, InvalidPose,
+                                          tip_position)
+from collision_engine.markers import contact_markers, scene_markers
+from collision_engine.params import CollisionNodeParams
+from haptic_msgs.msg import CollisionState, CollisionStateArray
+from haptic_util.executor import run_nodes, StartupError
+from haptic_util.parameters import declare_parameters
+from haptic_util.paths import resolve_path
+from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS, MARKER_QOS
+
+__all__ = ['CollisionNode', 'main']
+
+ERROR_LOG_PERIOD = 1.0  # [s] throttle of repeated input errors
+
+
+class CollisionNode(Node):
+    """Answers every tip pose with the signed distance to the nearest scene object."""
+
+    def __init__(self, **kwargs):
+        super().__init__('collision_engine', **kwargs)
+        self.params = declare_parameters(self, CollisionNodeParams)
+        scene_path = resolve_path(self.params.scene_file, what='parameter scene_file')
+        try:
+            self.scene = load_scene(scene_path)
+        except ValueError as error:
+            raise StartupError(f'{self.get_name()}: {error}') from None
+        self.scene.warm_up()
+        self.get_logger().info(
+            f'scene {scene_path}: {len(self.scene.objects)} object(s) in frame '
+            f'{self.scene.frame_id!r}')
+
+        self._state = CollisionState()
+        self._answered = 0
+        self._invalid_poses = 0
+        self._last_result = None
+        self._state_pub = self.create_publisher(CollisionState, 'collision/state',
+                                                HAPTIC_STREAM_QOS)
+        self._nearby_pub = (self.create_publisher(CollisionStateArray, 'collision/nearby',
+                                                  HAPTIC_STREAM_QOS)
+                            if self.params.report_radius > 0 else None)
+        self.create_subscription(PoseStamped, 'wand/pose', self.on_pose, HAPTIC_STREAM_QOS)
+
+        description = self.create_publisher(String, 'scene/description', LATCHED_QOS)
+        description.publish(String(data=scene_path.read_text()))
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.create_timer(self.params.diagnostics_period, self.publish_diagnostics)
+        if self.params.marker_rate > 0:
+            self._marker_pub = self.create_publisher(MarkerArray, 'collision/markers', MARKER_QOS)
+            self._scene_markers = scene_markers(read_scene(scene_path))
+            self.create_timer(1.0 / self.params.marker_rate, self.publish_markers)
+
+    def on_pose(self, msg: PoseStamped) -> None:
+        try:
+            tip = tip_position(msg, self.scene.frame_id)
+        except InvalidPose as error:
+            self._invalid_poses += 1
+            self.get_logger().error(f'ignoring pose: {error}',
+                                    throttle_duration_sec=ERROR_LOG_PERIOD)
+            self._state_pub.publish(fill_invalid_state(self._state, msg.header,
+                                                       self._disagreements()))
+            return
+        start = time.perf_counter()
+        result = self.scene.query(tip)
+        elapsed = time.perf_counter() - start
+        self._last_result = result
+        self._state_pub.publish(fill_state(self._state, msg.header, result, elapsed,
+                                           self._disagreements()))
+        self._answered += 1
+        if self._nearby_pub is not None:
+            self.publish_nearby(msg.header, tip)
+
+    def _disagreements(self) -> int:
+        stats = self.scene.cross_validation_stats
+        return 0 if stats is None else stats.disagreements
+
+    def publish_nearby(self, header, tip) -> None:
+        disagreements = self._disagreements()
+        nearby = CollisionStateArray(header=header, radius=self.params.report_radius)
+        nearby.states = [fill_state(CollisionState(), header, result, 0.0, disagreements)
+                         for result in self.scene.query_within(tip, self.params.report_radius)]
+        self._nearby_pub.publish(nearby)
+
+    def publish_markers(self) -> None:
+        stamp = self.get_clock().now().to_msg()
+        markers = MarkerArray(markers=self._scene_markers + contact_markers(
+            self._last_result, self.scene.frame_id))
+        for marker in markers.markers:
+            marker.header.stamp = stamp
+        self._marker_pub.publish(markers)
+
+    def publish_diagnostics(self) -> None:
+        stats = self.scene.cross_validation_stats
+        values = {'objects': len(self.scene.objects), 'invalid_poses': self._invalid_poses}
+        if stats is None:
+            level, message = DiagnosticStatus.OK, 'FCL cross-validation off'
+        else:
+            level = DiagnosticStatus.WARN if stats.disagreements else DiagnosticStatus.OK
+            message = f'{stats.disagreements} FCL disagreement(s) in {stats.checks} check(s)'
+            values.update(fcl_checks=stats.checks, fcl_disagreements=stats.disagreements,
+                          fcl_max_discrepancy_m=stats.max_discrepancy, fcl_errors=stats.errors)
+        status = DiagnosticStatus(
+            level=level, name=f'{self.get_name()}: collision', hardware_id='scene',
+            message=message, values=[KeyValue(key=k, value=str(v)) for k, v in values.items()])
+        self._diagnostics_pub.publish(DiagnosticArray(
+            header=self._diagnostics_header(), status=[status]))
+
+    def destroy_node(self) -> bool:
+        self.get_logger().info(f'published {self._answered} states, refused '
+                               f'{self._invalid_poses} poses')
+        return super().destroy_node()
+
+    def _diagnostics_header(self) -> Header:
+        return Header(stamp=self.get_clock().now().to_msg(), frame_id=self.scene.frame_id)
+
+
+def main(args=None) -> int:
+    return run_nodes([CollisionNode], args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

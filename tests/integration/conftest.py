@@ -1,0 +1,28 @@
+"""Integration fixtures: the loop's nodes as real processes, in a DDS domain of the test's own."""
+import os
+
+from loop_client import LoopClient
+import pytest
+
+from haptic_bringup.launcher import Loop, LoopConfig
+
+
+def session_domain_id() -> int:
+    """A domain per test session, so parallel runs on one machine do not hear each other."""
+    return 1 + os.getpid() % 100
+
+
+@pytest.fixture(scope='module')
+def collision_and_force(tmp_path_factory):
+    """The collision and force nodes, started as processes; the test stands in for the wand."""
+    config = LoopConfig(nodes=('collision_engine', 'force_renderer'),
+                        domain_id=session_domain_id(), run_dir=tmp_path_factory.mktemp('launch'))
+    with Loop(config) as loop:
+        yield loop
+
+
+@pytest.fixture
+def client():
+    wand = LoopClient(session_domain_id())
+    yield wand
+    wand.close()
