@@ -100,7 +100,7 @@ def node_parameters(config: LoopConfig) -> dict:
     if config.duration:
         options.setdefault('wand_driver', {})['duration'] = float(config.duration)
     if config.record:
-        options.setdefault('wand_driver', {})['min_subscribers'] = 2
+        options.setdefault('wand_driver', {})['wait_for_recorder'] = True
         options['recorder'] = {'output': str(pathlib.Path(config.record).resolve())}
     for node, values in [*options.items(), *config.overrides.items()]:
         merged.setdefault(node, {'ros__parameters': {}})

@@ -3,8 +3,10 @@
 Subscriptions are raw, so no message is converted to Python; each one is written with its
 receive time, as ``ros2 bag record`` does. A topic's type is taken from the graph once a
 publisher appears; latched topics (the scene description) are subscribed transient-local.
-On SIGINT or SIGTERM the bag is closed and complete; after ``kill -9`` it is recoverable up to
-the last flush (see ``haptic_bringup.bag``).
+Once every topic has a matched publisher it says so on ``recorder/ready`` (latched), so that a
+driver can hold its session until nothing it publishes can be missed. On SIGINT or SIGTERM the
+bag is closed and complete; after ``kill -9`` it is recoverable up to the last flush (see
+``haptic_bringup.bag``).
 """
 import importlib
 import pathlib
@@ -12,6 +14,7 @@ import pathlib
 from ament_index_python.packages import get_package_share_directory
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
+from std_msgs.msg import Bool
 
 from haptic_bringup.bag import BagWriter, typestore_with
 from haptic_bringup.params import RecorderParams
@@ -22,7 +25,7 @@ from haptic_util.qos import LATCHED_QOS, RECORDER_QOS
 __all__ = ['BagRecorder', 'main', 'custom_definitions']
 
 CUSTOM_PACKAGES = ('haptic_msgs',)
-GRAPH_POLL_PERIOD = 0.1  # [s]
+GRAPH_POLL_PERIOD = 0.02  # [s]
 
 
 def custom_definitions(packages=CUSTOM_PACKAGES) -> list:
@@ -53,6 +56,9 @@ class BagRecorder(Node):
                                'give a new directory')
         self.bag = BagWriter(output, typestore_with(custom_definitions()))
         self._pending = [self.resolve_topic_name(t) for t in self.params.topics]
+        self._stream_subscriptions = []
+        self._ready_pub = self.create_publisher(Bool, 'recorder/ready', LATCHED_QOS)
+        self._ready_pub.publish(Bool(data=False))
         self._poll = self.create_timer(GRAPH_POLL_PERIOD, self.subscribe_new_topics)
         self.get_logger().info(f'recording {", ".join(self._pending)} to {output}')
 
@@ -69,12 +75,14 @@ class BagRecorder(Node):
             latched = any(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
                           for p in publishers)
             self.bag.add_topic(topic, type_name)
-            self.create_subscription(
+            self._stream_subscriptions.append(self.create_subscription(
                 message_class(type_name), topic, self._writer_for(topic),
-                LATCHED_QOS if latched else RECORDER_QOS, raw=True)
+                LATCHED_QOS if latched else RECORDER_QOS, raw=True))
             self._pending.remove(topic)
-        if not self._pending:
+        if not self._pending and all(s.get_publisher_count() for s in self._stream_subscriptions):
             self._poll.cancel()
+            self._ready_pub.publish(Bool(data=True))
+            self.get_logger().info('every topic has a matched publisher: ready')
 
     def _writer_for(self, topic: str):
         clock = self.get_clock()

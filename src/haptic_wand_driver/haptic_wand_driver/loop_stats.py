@@ -68,6 +68,6 @@ class LoopStats:
             'latency_max_s': float(latency.max()) if latency.size else float('nan'),
         }
 
-    def save(self, path) -> None:
-        """Write the raw latencies and the summary to an .npz file."""
-        np.savez(path, latencies=self.latencies, **self.summary())
+    def save(self, path, **extra) -> None:
+        """Write the raw latencies, the summary and ``extra`` figures to an .npz file."""
+        np.savez(path, latencies=self.latencies, **self.summary(), **extra)

@@ -5,13 +5,16 @@ each ``wand/wrench`` (WrenchStamped) to the device when it arrives. A wrench old
 ``wrench_timeout``, or one with NaN, gives zero force. The wrench's stamp is the stamp of the pose
 it answers, so the driver measures the loop's round trip (``stats_file``).
 """
+import enum
+
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from rclpy.node import Node
+from std_msgs.msg import Bool
 
-from haptic_util.executor import run_nodes, StartupError
+from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
 from haptic_util.stamps import to_nanoseconds
 from haptic_wand_driver.device import make_device
 from haptic_wand_driver.experiments import make_script, needs_scene
@@ -24,6 +27,15 @@ from haptic_wand_driver.wrench_input import WrenchCommand
 __all__ = ['WandDriverNode', 'main']
 
 WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
+
+
+class Phase(enum.Enum):
+    """A session: wait for the consumers, probe the loop at rest, run, done."""
+
+    WAITING = 'waiting'
+    PROBING = 'probing'
+    RUNNING = 'running'
+    DONE = 'done'
 
 
 class WandDriverNode(Node):
@@ -41,8 +53,12 @@ class WandDriverNode(Node):
                                     torque_limit=limits.torque_limit,
                                     timeout=params.wrench_timeout)
         self.stats = LoopStats()
+        self._phase = Phase.WAITING
         self._state = None
-        self._start_ns = None
+        self._probe_start = self._device_offset = 0.0
+        self._last_probe_ns = -1
+        self._published = 0
+        self._recorder_ready = False
         self._pose = PoseStamped()
         self._twist = TwistStamped()
         self._pose.header.frame_id = self._twist.header.frame_id = params.frame_id
@@ -50,6 +66,8 @@ class WandDriverNode(Node):
         self._twist_pub = self.create_publisher(TwistStamped, 'wand/twist', HAPTIC_STREAM_QOS)
         self._wrench_sub = self.create_subscription(WrenchStamped, 'wand/wrench', self.on_wrench,
                                                     HAPTIC_STREAM_QOS)
+        if params.wait_for_recorder:
+            self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
         self.create_timer(1.0 / params.rate, self.tick)
         self.get_logger().info(f'{params.device} wand at {params.rate:g} Hz in frame '
                                f'{params.frame_id!r}; waiting for the loop to connect')
@@ -70,27 +88,43 @@ class WandDriverNode(Node):
                             stiffness=params.hand_stiffness, damping=params.hand_damping)
         return make_device('simulated', config=config, operator=hand)
 
-    def connected(self) -> bool:
-        """Whether the loop is connected, so no pose of the experiment is lost to discovery."""
-        return (self._pose_pub.get_subscription_count() >= self.params.min_subscribers
-                and (not self.params.wait_for_wrench
-                     or self._wrench_sub.get_publisher_count() >= 1))
+    def ready(self) -> bool:
+        """Whether every consumer is connected, so no pose of the session is lost to discovery."""
+        params = self.params
+        return (self._pose_pub.get_subscription_count() >= params.min_subscribers
+                and (not params.wait_for_wrench or self._wrench_sub.get_publisher_count() >= 1)
+                and (not params.wait_for_recorder or self._recorder_ready))
 
     def tick(self) -> None:
         now_ns = self.get_clock().now().nanoseconds
-        if self._start_ns is None:
-            if not self.connected():
-                return
-            self._start_ns = now_ns
-            self.get_logger().info('loop connected: experiment started')
         now = now_ns * 1e-9
-        state = self._state = self.device.read(now)
-        self.device.apply(*self.wrench.current(now, state.yaw))
-        self._publish(state, now_ns)
-        duration = self.params.duration
-        if duration and now_ns - self._start_ns >= duration * 1e9:
-            self.get_logger().info(f'experiment done after {duration:g} s: {self.stats.summary()}')
-            self.context.try_shutdown()
+        if self._phase is Phase.WAITING:
+            if not self.ready():
+                return
+            self._state = self.device.read(now)
+            self._probe_start = now
+            self._phase = Phase.PROBING if self.params.wait_for_wrench else Phase.RUNNING
+            self._start(now)
+        if self._phase is Phase.PROBING:
+            self._publish(self._state, now_ns)  # the device at rest where it starts
+        elif self._phase is Phase.RUNNING:
+            device_now = now - self._device_offset
+            state = self._state = self.device.read(device_now)
+            self.device.apply(*self.wrench.current(now, state.yaw))
+            self._publish(state, now_ns)
+            self.stats.sent(now_ns)
+            if self.params.duration and device_now - self._probe_start >= self.params.duration:
+                self._phase = Phase.DONE
+                self.get_logger().info(f'experiment done after {self.params.duration:g} s')
+                request_stop()
+
+    def _start(self, now: float) -> None:
+        """Start the session once a wrench answered a probe (or at once, open loop)."""
+        if self._phase is Phase.PROBING:
+            self.get_logger().info('loop connected: probing it end to end')
+            return
+        self._device_offset = now - self._probe_start  # the device's clock skips the probing
+        self.get_logger().info('loop closed: experiment started')
 
     def _publish(self, state, now_ns: int) -> None:
         sec, nanosec = divmod(now_ns, 1_000_000_000)
@@ -105,16 +139,22 @@ class WandDriverNode(Node):
         angular.x, angular.y, angular.z = (float(v) for v in state.angular_velocity)
         self._pose_pub.publish(pose)
         self._twist_pub.publish(twist)
-        self.stats.sent(now_ns)
+        self._published += 1
+        self._last_probe_ns = now_ns
 
     def on_wrench(self, msg: WrenchStamped) -> None:
         now_ns = self.get_clock().now().nanoseconds
-        stamp_ns = to_nanoseconds(msg.header.stamp)
-        self.stats.answered(stamp_ns, now_ns)
-        if self._start_ns is None:
-            return
         now = now_ns * 1e-9
-        state = self._state = self.device.read(now)  # the new wrench acts from its arrival on
+        stamp_ns = to_nanoseconds(msg.header.stamp)
+        if self._phase is Phase.PROBING:
+            if stamp_ns <= self._last_probe_ns:  # it answers a probe: the loop is closed
+                self._phase = Phase.RUNNING
+                self._start(now)
+            return
+        if self._phase is not Phase.RUNNING:
+            return
+        self.stats.answered(stamp_ns, now_ns)
+        state = self._state = self.device.read(now - self._device_offset)  # acts from now on
         reason = self._take(msg, stamp_ns * 1e-9, now)
         if reason is not None:
             self.get_logger().warn(reason, throttle_duration_sec=WARN_PERIOD)
@@ -129,11 +169,15 @@ class WandDriverNode(Node):
         f, t = msg.wrench.force, msg.wrench.torque
         return self.wrench.update((f.x, f.y, f.z), (t.x, t.y, t.z), stamp, now)
 
+    def on_recorder_ready(self, msg: Bool) -> None:
+        self._recorder_ready = msg.data
+
     def destroy_node(self) -> bool:
         self.device.close()
         if self.params.stats_file:
-            self.stats.save(self.params.stats_file)
-        self.get_logger().info(f'published {self.stats.poses} poses; loop: {self.stats.summary()}')
+            self.stats.save(self.params.stats_file, published=self._published)
+        self.get_logger().info(f'published {self._published} poses; experiment loop: '
+                               f'{self.stats.summary()}')
         return super().destroy_node()
 
 

@@ -33,6 +33,9 @@ class WandDriverParams:
     hand_damping: float = parameter(3.5, 'simulated operator hand damping', unit='N*s/m',
                                     low=0.0)
     min_subscribers: int = parameter(1, 'start only once wand/pose has this many matched '
-                                     'subscribers (2 when recording)', low=0)
-    wait_for_wrench: bool = parameter(True, 'start only once a wand/wrench publisher matched')
+                                     'subscribers', low=0)
+    wait_for_wrench: bool = parameter(True, 'start only once a wrench answered a pose (the loop '
+                                      'is closed end to end); false: open loop (replay)')
+    wait_for_recorder: bool = parameter(False, 'start only once recorder/ready says every '
+                                        'stream is being recorded')
     stats_file: str = parameter('', 'write round-trip latencies (.npz) here on exit')

@@ -1,0 +1,97 @@
+"""The main job: the simulated wand taps the paper's objects over ROS 2, recorded and summarised.
+
+    demo [--experiments cuboid cylinder hand] [--composed] [--out build/demo]
+
+For each experiment it launches the loop (driver, collision engine, force renderer and a
+recorder), lets the scripted operator tap for 10 s, stops, reads the bag back and prints one
+line per contact: depth, mean force per axis, and how far the force pointed from the normal.
+"""
+import argparse
+import os
+import pathlib
+import shutil
+import sys
+import time
+
+import numpy as np
+
+from haptic_bringup.bag import typestore_with
+from haptic_bringup.contacts import contact_intervals, format_contacts
+from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.recorder import custom_definitions
+from haptic_bringup.session import read_session, topic_counts
+
+__all__ = ['main', 'EXPERIMENTS', 'run_experiment']
+
+EXPERIMENTS = {
+    'cuboid': 'package://collision_engine/scenes/cuboid.yaml',
+    'cylinder': 'package://collision_engine/scenes/cylinder.yaml',
+    'hand': 'package://collision_engine/scenes/hand.yaml',
+}
+DURATION = 10.0  # [s] as the paper's experiments
+
+
+def run_experiment(name: str, out: pathlib.Path, *, composed: bool = False,
+                   duration: float = DURATION, domain_id: int = 42) -> dict:
+    """Run one experiment over ROS 2 and return where its bag and loop statistics are."""
+    run = out / name
+    shutil.rmtree(run, ignore_errors=True)
+    run.mkdir(parents=True)
+    stats = run / 'loop_stats.npz'
+    config = LoopConfig(composed=composed, scene=EXPERIMENTS[name], experiment=name,
+                        duration=duration, record=str(run / 'bag'), domain_id=domain_id,
+                        run_dir=run / 'launch',
+                        overrides={'wand_driver': {'stats_file': str(stats)}})
+    with Loop(config) as loop:
+        ended = loop.wait(duration + 10.0)
+        if ended is None or ended.name not in ('wand_driver', 'composed'):
+            raise RuntimeError(f'{name}: the driver did not end its experiment '
+                               f'({ended.name if ended else "timeout"})')
+    return {'bag': run / 'bag', 'stats': stats}
+
+
+def summarise(name: str, files: dict) -> str:
+    """The per-contact table and the loop's figures of one experiment, as text."""
+    session = read_session(files['bag'], typestore_with(custom_definitions()))
+    contacts = contact_intervals(session)
+    loop = np.load(files['stats'])
+    counts = topic_counts(files['bag'])
+    lines = [
+        f'== {name}: {len(contacts)} contacts in {session.time[-1]:.1f} s ==',
+        format_contacts(contacts),
+        f'loop: {float(loop["rate_hz"]):.0f} Hz, {float(loop["answered_percent"]):.1f} % of '
+        f'{int(loop["poses"])} poses answered, round trip p50 '
+        f'{1e3 * float(loop["latency_p50_s"]):.2f} ms, p99 '
+        f'{1e3 * float(loop["latency_p99_s"]):.2f} ms',
+        'recorded: ' + ', '.join(f'{topic} {n}' for topic, n in sorted(counts.items()))
+        + f' (driver published {int(loop["published"])} poses)',
+    ]
+    return '\n'.join(lines)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog='demo', description=__doc__.split('\n\n')[0])
+    parser.add_argument('--experiments', nargs='+', choices=list(EXPERIMENTS),
+                        default=['cuboid'])
+    parser.add_argument('--composed', action='store_true', help='one process for the loop')
+    parser.add_argument('--out', default='build/demo', type=pathlib.Path)
+    parser.add_argument('--domain-id', type=int,
+                        default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    args = parser.parse_args(argv)
+    add_venv_prefix()
+    started = time.monotonic()
+    for name in args.experiments:
+        print(f'[demo] {name}: tapping for {DURATION:g} s over ROS 2 ...', flush=True)
+        try:
+            files = run_experiment(name, args.out, composed=args.composed,
+                                   domain_id=args.domain_id)
+        except RuntimeError as error:
+            print(f'[demo] {error}', file=sys.stderr)
+            return 1
+        print(summarise(name, files), flush=True)
+    print(f'[demo] done in {time.monotonic() - started:.0f} s; bags in {args.out}')
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -1,0 +1,91 @@
+"""A recorded haptic session as arrays: what the wand did, what the engine said, what was felt.
+
+Read from a rosbag2 bag with rosbags (no ROS needed), and joined on the pose stamp that every
+state and wrench carries, so each row is one pose with its answer.
+"""
+import dataclasses
+import pathlib
+
+import numpy as np
+from rosbags.highlevel import AnyReader
+
+__all__ = ['Session', 'read_session', 'topic_counts']
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Session:
+    """One row per answered pose, in stamp order (all arrays share the first dimension).
+
+    Attributes
+    ----------
+    time : (n,) float, s since the first pose
+    tip : (n, 3) float, m
+    distance : (n,) float, m, signed, negative inside
+    point, normal : (n, 3) float: closest surface point (m) and unit outward normal
+    force : (n, 3) float, N, the wrench answering the pose (NaN when none came)
+    objects : (n,) str
+    status : (n,) int, CollisionState status
+    compute_time : (n,) float, s
+    fcl_distance, fcl_discrepancy : (n,) float, m (NaN when not cross-validated)
+    scene : str, the scene YAML the session ran against ('' when not recorded)
+    """
+
+    time: np.ndarray
+    tip: np.ndarray
+    distance: np.ndarray
+    point: np.ndarray
+    normal: np.ndarray
+    force: np.ndarray
+    objects: np.ndarray
+    status: np.ndarray
+    compute_time: np.ndarray
+    fcl_distance: np.ndarray
+    fcl_discrepancy: np.ndarray
+    scene: str
+
+
+def topic_counts(path: pathlib.Path) -> dict:
+    """Messages per topic in a bag, from its metadata."""
+    with AnyReader([pathlib.Path(path)]) as reader:
+        return {c.topic: c.msgcount for c in reader.connections}
+
+
+def read_session(path: pathlib.Path, typestore) -> Session:
+    """Join a bag's collision states and wrenches on their stamps."""
+    states, wrenches, scene = {}, {}, ''
+    with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
+        for connection, _, raw in reader.messages():
+            msg = reader.deserialize(raw, connection.msgtype)
+            if connection.topic == '/collision/state':
+                states[_stamp(msg)] = msg
+            elif connection.topic == '/wand/wrench':
+                wrenches[_stamp(msg)] = msg
+            elif connection.topic == '/scene/description':
+                scene = msg.data
+    stamps = sorted(states)
+    if not stamps:
+        raise ValueError(f'{path}: no /collision/state messages')
+    rows = [states[s] for s in stamps]
+    nan3 = (np.nan, np.nan, np.nan)
+    forces = [_xyz(wrenches[s].wrench.force) if s in wrenches else nan3 for s in stamps]
+    return Session(
+        time=(np.array(stamps) - stamps[0]) * 1e-9,
+        tip=np.array([_xyz(m.tip) for m in rows]),
+        distance=np.array([m.distance for m in rows]),
+        point=np.array([_xyz(m.closest_point) for m in rows]),
+        normal=np.array([_xyz(m.normal) for m in rows]),
+        force=np.array(forces),
+        objects=np.array([m.object for m in rows]),
+        status=np.array([m.status for m in rows]),
+        compute_time=np.array([m.compute_time for m in rows]),
+        fcl_distance=np.array([m.fcl_distance for m in rows]),
+        fcl_discrepancy=np.array([m.fcl_discrepancy for m in rows]),
+        scene=scene)
+
+
+def _stamp(msg) -> int:
+    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+
+
+def _xyz(vector) -> tuple:
+    return (vector.x, vector.y, vector.z)

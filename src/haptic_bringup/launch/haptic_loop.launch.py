@@ -1,0 +1,70 @@
+"""The haptic loop on a full ROS 2 Jazzy install.
+
+    ros2 launch haptic_bringup haptic_loop.launch.py [scene:=...] [experiment:=...]
+
+Arguments: ``scene:=<path or package://...>``, ``experiment:=cuboid|cylinder|hand|hold|<file>``,
+``composed:=true`` (one process), ``record:=<bag dir>`` (rosbag2 mcap via ``ros2 bag record``),
+``params_file:=<yaml>`` (overrides on top of each package's config/). The local launcher
+(``haptic_loop``) does the same where launch and ros2cli are not installed.
+"""
+import os
+
+from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
+from launch.actions import (DeclareLaunchArgument, ExecuteProcess, OpaqueFunction,
+                            SetEnvironmentVariable)
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+NODES = (('haptic_wand_driver', 'wand_driver', 'wand_driver'),
+         ('collision_engine', 'collision_node', 'collision_engine'),
+         ('force_renderer', 'force_node', 'force_renderer'))
+LOOP_TOPICS = ['/wand/pose', '/wand/twist', '/collision/state', '/wand/wrench',
+               '/scene/description']
+
+
+def _config(package: str) -> str:
+    return os.path.join(get_package_share_directory(package), 'config', f'{package}.yaml')
+
+
+def _nodes(context):
+    scene = LaunchConfiguration('scene').perform(context)
+    experiment = LaunchConfiguration('experiment').perform(context)
+    user = LaunchConfiguration('params_file').perform(context)
+    record = LaunchConfiguration('record').perform(context)
+    overrides = {'scene_file': scene} if scene else {}
+    driver_overrides = dict(overrides, **({'experiment': experiment} if experiment else {}))
+    extra = [user] if user else []
+    actions = []
+    if LaunchConfiguration('composed').perform(context).lower() == 'true':
+        # No name: a name given here would rename all three nodes of the process.
+        actions.append(Node(
+            package='haptic_bringup', executable='composed', output='screen',
+            parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides]))
+    else:
+        for package, executable, name in NODES:
+            values = driver_overrides if name == 'wand_driver' else overrides
+            actions.append(Node(package=package, executable=executable, name=name,
+                                output='screen', parameters=[_config(package), *extra, values]))
+    if record:
+        actions.append(ExecuteProcess(
+            cmd=['ros2', 'bag', 'record', '-s', 'mcap', '-o', record, *LOOP_TOPICS],
+            output='screen'))
+    return actions
+
+
+def generate_launch_description() -> LaunchDescription:
+    return LaunchDescription([
+        SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST'),
+        DeclareLaunchArgument('scene', default_value='',
+                              description='scene YAML (default: each package config)'),
+        DeclareLaunchArgument('experiment', default_value='',
+                              description='cuboid | cylinder | hand | hold | waypoint file'),
+        DeclareLaunchArgument('composed', default_value='false',
+                              description='run the three nodes in one process'),
+        DeclareLaunchArgument('record', default_value='',
+                              description='record the loop to this rosbag2 directory'),
+        DeclareLaunchArgument('params_file', default_value='',
+                              description='extra parameters YAML'),
+        OpaqueFunction(function=_nodes),
+    ])
