@@ -1,4 +1,4 @@
-"""Shared test set-up: ``tests/`` itself is importable, so ``ground_truth`` is one module for all."""
+"""Shared test set-up: ``tests/`` is importable, so ``ground_truth`` is one module for all."""
 import os
 import pathlib
 import sys

@@ -44,7 +44,7 @@ def matrix_from_quaternion(quaternion) -> np.ndarray:
 
 
 def quaternion_from_matrix(matrix) -> np.ndarray:
-    """Unit quaternion (x, y, z, w) of a rotation matrix whose trace is above -1 (Shepperd)."""
+    """Return the unit quaternion (x, y, z, w) of a rotation whose trace is above -1."""
     w = 0.5 * np.sqrt(1.0 + np.trace(matrix))
     return np.array([matrix[2, 1] - matrix[1, 2], matrix[0, 2] - matrix[2, 0],
                      matrix[1, 0] - matrix[0, 1], 4.0 * w * w]) / (4.0 * w)

@@ -8,13 +8,13 @@ from haptic_bringup.launcher import Loop, LoopConfig
 
 
 def session_domain_id() -> int:
-    """A domain per test session, so parallel runs on one machine do not hear each other."""
+    """Pick a domain per test session, so parallel runs on one machine do not interfere."""
     return 1 + os.getpid() % 100
 
 
 @pytest.fixture(scope='module')
 def collision_and_force(tmp_path_factory):
-    """The collision and force nodes, started as processes; the test stands in for the wand."""
+    """Start the collision and force nodes as processes; the test stands in for the wand."""
     config = LoopConfig(nodes=('collision_engine', 'force_renderer'),
                         domain_id=session_domain_id(), run_dir=tmp_path_factory.mktemp('launch'))
     with Loop(config) as loop:

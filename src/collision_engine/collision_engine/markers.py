@@ -34,7 +34,7 @@ def scene_markers(spec: SceneSpec) -> list:
 
 
 def contact_markers(result, frame_id: str) -> list:
-    """The closest point (red in contact, green outside) and the tip-to-surface segment."""
+    """Mark the closest point (red in contact, green outside) and the tip-to-surface segment."""
     if result is None or not math.isfinite(result.distance):
         return []
     color = CONTACT_COLOR if result.in_collision else FREE_COLOR

@@ -71,7 +71,7 @@ class ForceNode(Node):
                                f'force limit {params.force_limit:g} N')
 
     def _law(self, params: ForceRendererParams):
-        """The force law and every (stiffness, damping) it renders with."""
+        """Build the force law; return it and every (stiffness, damping) it renders with."""
         default = (params.stiffness, params.damping)
         if not params.scene_file:
             if params.law != 'normal':
@@ -114,7 +114,7 @@ class ForceNode(Node):
         self.render(self._velocity(stamp_ns))
 
     def _velocity(self, stamp_ns: int):
-        """The twist of the state's pose, or None (the pipeline then estimates it)."""
+        """Return the twist of the state's pose, or None (the pipeline then estimates it)."""
         twist = self._twist
         if twist is None or abs(twist[0] - stamp_ns) > self.params.watchdog_timeout * 1e9:
             return None

@@ -1,1 +1,1 @@
-"""placeholder"""
+"""Bring-up of the haptic loop: launchers, the composed process, recording, the demo."""

@@ -44,7 +44,7 @@ class _FlushingWriter(Writer):
 
 
 def typestore_with(definitions: Iterable[tuple[str, str]]) -> Typestore:
-    """The Jazzy typestore plus custom types given as (``pkg/msg/Name``, .msg text) pairs."""
+    """Return the Jazzy typestore plus custom types, given as (``pkg/msg/Name``, .msg) pairs."""
     store = get_typestore(Stores.ROS2_JAZZY)
     types = {}
     for name, text in definitions:

@@ -3,7 +3,7 @@
 One process skips two inter-process hops (and their Python message conversions on both sides),
 which halves the loop's latency here. Usage, as for the separate nodes::
 
-    python -m haptic_bringup.composed [wand_driver] [collision_engine] [force_renderer] \\
+    python -m haptic_bringup.composed [wand_driver] [collision_engine] [force_renderer]
         --ros-args --params-file params.yaml
 """
 import importlib

@@ -32,7 +32,7 @@ class ContactInterval:
 
 
 def contact_intervals(session, *, min_samples: int = 3) -> list:
-    """The session's contacts, in time order; shorter runs than ``min_samples`` are grazes."""
+    """List the contacts in time order; runs shorter than ``min_samples`` are grazes."""
     inside = session.distance < 0.0
     edges = np.flatnonzero(np.diff(np.concatenate([[0], inside.astype(np.int8), [0]])))
     intervals = []
@@ -58,7 +58,7 @@ def contact_intervals(session, *, min_samples: int = 3) -> list:
 
 
 def format_contacts(intervals) -> str:
-    """A plain-text table of contact intervals, one line each."""
+    """Format contact intervals as a plain-text table, one line each."""
     header = (f'{"#":>3} {"object":<10} {"start s":>8} {"end s":>7} {"depth mm":>9} '
               f'{"Fx N":>7} {"Fy N":>7} {"Fz N":>7} {"peak N":>7} {"∠normal °":>9}')
     lines = [header]

@@ -51,7 +51,7 @@ def run_experiment(name: str, out: pathlib.Path, *, composed: bool = False,
 
 
 def summarise(name: str, files: dict) -> str:
-    """The per-contact table and the loop's figures of one experiment, as text."""
+    """Summarise one experiment: its contacts and the loop's figures, as text."""
     session = read_session(files['bag'], typestore_with(custom_definitions()))
     contacts = contact_intervals(session)
     loop = np.load(files['stats'])

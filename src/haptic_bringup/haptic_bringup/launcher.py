@@ -69,7 +69,7 @@ def add_venv_prefix() -> None:
 
 
 def loop_environment(domain_id: int, log_dir: pathlib.Path) -> dict:
-    """The children's environment: local-only discovery, our domain, logs under the build dir."""
+    """Return the children's environment: local discovery, our domain, logs in the build dir."""
     add_venv_prefix()
     env = dict(os.environ)
     env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -181,7 +181,7 @@ class Loop:
                                f'{DISCOVERY_TIMEOUT:.0f} s; missing: {"; ".join(missing)}')
 
     def exited(self):
-        """The first child that has exited, or None."""
+        """Return the first child that has exited, or None."""
         return next((c for c in self.children if c.returncode is not None), None)
 
     def pids(self) -> dict:

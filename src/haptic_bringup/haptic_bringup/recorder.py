@@ -39,7 +39,7 @@ def custom_definitions(packages=CUSTOM_PACKAGES) -> list:
 
 
 def message_class(type_name: str):
-    """The Python class of ``pkg/msg/Name``."""
+    """Import and return the Python class of ``pkg/msg/Name``."""
     package, _, name = type_name.split('/')
     return getattr(importlib.import_module(f'{package}.msg'), name)
 

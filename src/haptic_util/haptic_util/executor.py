@@ -3,24 +3,39 @@
 rclpy's EventsExecutor is the executor that holds a 1 kHz loop here (the SingleThreadedExecutor
 misses it, and the MultiThreadedExecutor collapses to ~100 Hz with several nodes). In the Jazzy
 wheel its ``spin()`` never returns and ignores SIGINT, as does ``spin_until_future_complete``
-without a timeout. Spinning in short slices hands control back to Python often enough for the
-signal handlers (SIGINT → KeyboardInterrupt, SIGTERM → ExternalShutdownException) to run, at no
-measurable cost to latency.
+without a timeout. Spinning in short slices hands control back to Python often enough to notice a
+stop request, at no measurable cost to latency.
+
+A stop (SIGINT, SIGTERM, or a node calling ``request_stop``) ends the spin while the context is
+still valid, so nodes are destroyed in order and can log and publish their last words (final
+counts, a zero wrench); only then is rclpy shut down. A second SIGINT exits at once.
 """
+import signal
 import sys
+import threading
 from typing import Callable, Iterable, Optional
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
-__all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'StartupError']
+__all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'request_stop', 'StartupError']
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
 
 EXECUTORS = {'events': EventsExecutor, 'single_threaded': SingleThreadedExecutor}
+
+_stop_requested = threading.Event()
+
+
+def request_stop(*_) -> None:
+    """Ask this process's loop to stop cleanly (also the SIGINT/SIGTERM handler)."""
+    if _stop_requested.is_set() and _ and _[0] == signal.SIGINT:
+        raise KeyboardInterrupt
+    _stop_requested.set()
 
 
 class StartupError(RuntimeError):
@@ -37,9 +52,10 @@ def make_executor(kind: str = 'events') -> Executor:
 
 
 def spin(executor: Executor, stop: Optional[Future] = None) -> None:
-    """Spin until ``stop`` completes or the context shuts down, in signal-friendly slices."""
+    """Spin until a stop is requested, ``stop`` completes or the context shuts down."""
     stop = stop or Future()
-    while rclpy.ok(context=executor.context) and not stop.done():
+    while (rclpy.ok(context=executor.context) and not stop.done()
+           and not _stop_requested.is_set()):
         executor.spin_until_future_complete(stop, timeout_sec=SPIN_SLICE)
 
 
@@ -50,7 +66,9 @@ def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
     A node whose configuration is wrong raises ``StartupError`` or ``ValueError`` from its
     constructor: this prints that one line and returns exit code 2, with nothing left running.
     """
-    rclpy.init(args=args)
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, request_stop)
     nodes = []
     try:
         try:

@@ -1,0 +1,268 @@
+"""The compiled entry points: one call answers one whole query, from one packed scene.
+
+A call from Python into numba costs about 0.3-1 us plus about 0.2 us per array argument, as
+much as a primitive's whole computation, so each query is one call taking the packed scene as
+one float64 and one int64 array, an output row, and the point as three floats.
+
+Packed scene layout
+-------------------
+``floats``: ``[tip radius, rel_tol, abs_tol, scratch offset]``, then per object a record of
+``OBJECT_FLOATS`` values: rotation (9, row-major, local to world), translation (3),
+bounding-sphere centre in the local frame (3) and in the world frame (3), bounding-sphere radius
+(1); then the shapes' float blocks; then scratch space (GJK simplex, weights, search stack).
+``ints``: ``[object count, GJK iteration cap, EPA iteration cap, scratch offset]``, then per
+object ``[kind, object float record offset, shape float offset, shape int offset, hint]``
+(``hint`` is the last nearest triangle of a mesh, rewritten by every query as a warm start),
+then the shapes' int blocks (layouts in ``support`` and ``bvh``), then the search stack.
+
+The scratch space lives in the packed arrays because allocating it costs as much as a
+primitive's query; so does the hint. Hence one packed scene must not serve two threads at once.
+
+Output row (``OUT_SIZE`` float64), world frame, m
+-------------------------------------------------
+distance (tip radius subtracted), closest point (3), outward normal (3), object index (-1 for
+none), iterations, status, tip (3), triangle index (-1 unless a mesh), lower bound on the
+distance (tip radius subtracted; equal to the distance to rounding when converged).
+"""
+
+import math
+
+import numpy as np
+
+from collision_engine import bvh
+from collision_engine._jit import jit
+from collision_engine.epa import epa
+from collision_engine.gjk import (gjk, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
+                                  STATUS_NOT_CONVERGED, STATUS_OK)
+from collision_engine.support import (CAPSULE, CONVEX_MESH, CYLINDER, interior, pack_convex,
+                                      TRIANGLE_MESH)
+
+__all__ = ['OUT_SIZE', 'OBJECT_FLOATS', 'pack_scene', 'place_object', 'query_point',
+           'query_points', 'query_each_object', 'query_shape']
+
+OUT_SIZE = 15
+OBJECT_FLOATS = 19
+_HEADER_FLOATS = 4
+_HEADER_INTS = 4
+_SCRATCH_FLOATS = 16 + bvh.STACK_SIZE
+_OBJECT_INTS = 5
+
+
+def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, abs_tol: float,
+               max_iterations: int, max_epa_iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pack shapes and their poses into the layout above.
+
+    Parameters
+    ----------
+    shapes : list of shapes (``shapes`` module)
+    poses : list of Pose, local to world
+    tip_radius : float, m
+
+    Returns
+    -------
+    floats : (k,) float64
+    ints : (j,) int64
+    """
+    n = len(shapes)
+    float_blocks, int_blocks, records, table = [], [], [], []
+    float_at = _HEADER_FLOATS + OBJECT_FLOATS * n
+    int_at = _HEADER_INTS + _OBJECT_INTS * n
+    for index, (shape, pose) in enumerate(zip(shapes, poses)):
+        kind, shape_floats, shape_ints = _pack_shape(shape)
+        records.append(_object_record(shape, pose))
+        table.append([kind, _HEADER_FLOATS + OBJECT_FLOATS * index, float_at, int_at, -1])
+        float_blocks.append(shape_floats)
+        int_blocks.append(shape_ints)
+        float_at += len(shape_floats)
+        int_at += len(shape_ints)
+    floats = np.concatenate([[tip_radius, rel_tol, abs_tol, float_at], *records, *float_blocks,
+                             np.zeros(_SCRATCH_FLOATS)])
+    ints = np.concatenate([[n, max_iterations, max_epa_iterations, int_at], *table, *int_blocks,
+                           np.zeros(bvh.STACK_SIZE)])
+    return floats.astype(np.float64), ints.astype(np.int64)
+
+
+def _object_record(shape, pose) -> np.ndarray:
+    centre, radius = shape.bounding_sphere()
+    return np.concatenate((pose.rotation.ravel(), pose.translation, centre,
+                           pose.to_world(centre), [radius]))
+
+
+def place_object(floats: np.ndarray, ints: np.ndarray, index: int, shape, pose) -> None:
+    """Move object ``index`` of a packed scene to ``pose`` (its shape stays packed)."""
+    r = ints[_HEADER_INTS + _OBJECT_INTS * index + 1]
+    floats[r:r + OBJECT_FLOATS] = _object_record(shape, pose)
+
+
+def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
+    if shape.kind == TRIANGLE_MESH:
+        floats, ints = bvh.pack_triangle_mesh(shape.vertices, shape.faces)
+        return TRIANGLE_MESH, floats, ints
+    return pack_convex(shape)
+
+
+@jit(inline=True)
+def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy, gz,
+                     rel_tol, abs_tol, max_iter, max_epa_iter, W, lam):
+    """Signed distance to a convex shape: GJK outside, exact interior or EPA inside.
+
+    (cx, cy, cz) is the shape's centre, (gx, gy, gz) a first search direction (zero: from the
+    shape's core toward q). Returns (status, distance, lower bound, x, y, z, nx, ny, nz,
+    iterations), local frame.
+    """
+    s, x, y, z, nx, ny, nz = 0.0, qx, qy, qz, 1.0, 0.0, 0.0
+    if kind != CONVEX_MESH:
+        s, x, y, z, nx, ny, nz = interior(kind, floats, fo, qx, qy, qz)
+        if s <= 0.0:
+            return STATUS_OK, s, s, x, y, z, nx, ny, nz, 0
+    if gx == 0.0 and gy == 0.0 and gz == 0.0:
+        gx, gy, gz = qx - cx, qy - cy, qz - cz
+        if kind == CYLINDER or kind == CAPSULE:
+            gz = qz - min(max(qz, -floats[fo + 1]), floats[fo + 1])
+    status, contact, count, vx, vy, vz, lower, iterations = gjk(
+        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, rel_tol, abs_tol, max_iter, W, lam)
+    if not contact:
+        distance = math.sqrt(vx * vx + vy * vy + vz * vz)
+        return (status, distance, lower, qx + vx, qy + vy, qz + vz,
+                -vx / distance, -vy / distance, -vz / distance, iterations)
+    if kind != CONVEX_MESH:
+        # Within rounding of a primitive's surface: its exact interior formula holds there.
+        return STATUS_OK, s, s, x, y, z, nx, ny, nz, iterations
+    status, depth, bound, x, y, z, nx, ny, nz, more = epa(
+        kind, floats, fo, ints, io, (qx, qy, qz), W, count, rel_tol, abs_tol, max_epa_iter)
+    return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
+
+
+@jit(inline=True)
+def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, lam, stack, stack_d2):
+    """Signed distance from the world point p to object k, in the world frame.
+
+    Returns (status, distance, lower bound, x, y, z, nx, ny, nz, iterations, triangle).
+    """
+    entry = _HEADER_INTS + _OBJECT_INTS * k
+    kind, r, fo, io = ints[entry], ints[entry + 1], ints[entry + 2], ints[entry + 3]
+    dx, dy, dz = px - floats[r + 9], py - floats[r + 10], pz - floats[r + 11]
+    qx = floats[r] * dx + floats[r + 3] * dy + floats[r + 6] * dz
+    qy = floats[r + 1] * dx + floats[r + 4] * dy + floats[r + 7] * dz
+    qz = floats[r + 2] * dx + floats[r + 5] * dy + floats[r + 8] * dz
+    triangle = -1
+    if kind == TRIANGLE_MESH:
+        distance, x, y, z, nx, ny, nz, leaf_t, triangle, iterations = bvh.mesh_distance(
+            floats, fo, ints, io, qx, qy, qz, ints[entry + 4], stack, stack_d2)
+        ints[entry + 4] = leaf_t
+        status, lower = STATUS_OK, distance
+    else:
+        lx = floats[r] * gx + floats[r + 3] * gy + floats[r + 6] * gz
+        ly = floats[r + 1] * gx + floats[r + 4] * gy + floats[r + 7] * gz
+        lz = floats[r + 2] * gx + floats[r + 5] * gy + floats[r + 8] * gz
+        status, distance, lower, x, y, z, nx, ny, nz, iterations = _convex_distance(
+            kind, floats, fo, ints, io, qx, qy, qz,
+            floats[r + 12], floats[r + 13], floats[r + 14], lx, ly, lz,
+            floats[1], floats[2], ints[1], ints[2], W, lam)
+    wx = floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9]
+    wy = floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10]
+    wz = floats[r + 6] * x + floats[r + 7] * y + floats[r + 8] * z + floats[r + 11]
+    mx = floats[r] * nx + floats[r + 1] * ny + floats[r + 2] * nz
+    my = floats[r + 3] * nx + floats[r + 4] * ny + floats[r + 5] * nz
+    mz = floats[r + 6] * nx + floats[r + 7] * ny + floats[r + 8] * nz
+    return status, distance, lower, wx, wy, wz, mx, my, mz, iterations, triangle
+
+
+@jit(inline=True)
+def _write(out, row, distance, x, y, z, nx, ny, nz, index, iterations, status, px, py, pz,
+           triangle, lower):
+    out[row, 0] = distance
+    out[row, 1], out[row, 2], out[row, 3] = x, y, z
+    out[row, 4], out[row, 5], out[row, 6] = nx, ny, nz
+    out[row, 7] = index
+    out[row, 8] = iterations
+    out[row, 9] = status
+    out[row, 10], out[row, 11], out[row, 12] = px, py, pz
+    out[row, 13] = triangle
+    out[row, 14] = lower
+
+
+@jit(inline=True)
+def _invalid(out, row, px, py, pz):
+    """Write an INVALID_INPUT row and return true when p is not finite."""
+    if math.isfinite(px) and math.isfinite(py) and math.isfinite(pz):
+        return False
+    _write(out, row, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, -1, 0,
+           STATUS_INVALID_INPUT, px, py, pz, -1, np.nan)
+    return True
+
+
+@jit
+def _nearest(floats, ints, out, row, px, py, pz, W, lam, stack, stack_d2):
+    """Nearest object to p (signed), written to out[row]."""
+    if _invalid(out, row, px, py, pz):
+        return
+    best = best_lower = np.inf
+    best_status, best_k, best_t, total = STATUS_NO_OBJECT, -1, -1, 0
+    x = y = z = nx = ny = nz = np.nan
+    unsure = np.inf
+    for k in range(ints[0]):
+        r = ints[_HEADER_INTS + _OBJECT_INTS * k + 1]
+        cx, cy, cz = px - floats[r + 15], py - floats[r + 16], pz - floats[r + 17]
+        if math.sqrt(cx * cx + cy * cy + cz * cz) - floats[r + 18] >= best:
+            continue
+        status, d, lower, ox, oy, oz, mx, my, mz, iterations, t = _object_distance(
+            floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, lam, stack, stack_d2)
+        total += iterations
+        if status != STATUS_OK:
+            unsure = min(unsure, lower)
+        if d < best:
+            best, best_lower, best_status, best_k, best_t = d, lower, status, k, t
+            x, y, z, nx, ny, nz = ox, oy, oz, mx, my, mz
+    if best_k >= 0:
+        best_status = STATUS_NOT_CONVERGED if unsure < best else STATUS_OK
+    _write(out, row, best - floats[0], x, y, z, nx, ny, nz, best_k, total, best_status,
+           px, py, pz, best_t, min(best_lower, unsure) - floats[0])
+
+
+@jit(inline=True)
+def _scratch(floats, ints):
+    """View the scratch space: simplex (4, 3), weights (4,), search stack and its bounds."""
+    f = int(floats[3])
+    i = ints[3]
+    return (floats[f:f + 12].reshape((4, 3)), floats[f + 12:f + 16], ints[i:i + bvh.STACK_SIZE],
+            floats[f + 16:f + 16 + bvh.STACK_SIZE])
+
+
+@jit
+def query_point(floats, ints, out, px, py, pz):
+    """Nearest object to the world point p, written to ``out`` (1, OUT_SIZE)."""
+    W, lam, stack, stack_d2 = _scratch(floats, ints)
+    _nearest(floats, ints, out, 0, px, py, pz, W, lam, stack, stack_d2)
+
+
+@jit
+def query_points(floats, ints, points, out):
+    """Nearest object to each world point, points (n, 3) to out (n, OUT_SIZE)."""
+    W, lam, stack, stack_d2 = _scratch(floats, ints)
+    for row in range(points.shape[0]):
+        _nearest(floats, ints, out, row, points[row, 0], points[row, 1], points[row, 2],
+                 W, lam, stack, stack_d2)
+
+
+@jit
+def query_each_object(floats, ints, out, px, py, pz):
+    """Signed distance from p to every object, out (objects, OUT_SIZE)."""
+    W, lam, stack, stack_d2 = _scratch(floats, ints)
+    for k in range(ints[0]):
+        status, d, lower, x, y, z, nx, ny, nz, iterations, t = _object_distance(
+            floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, lam, stack, stack_d2)
+        _write(out, k, d - floats[0], x, y, z, nx, ny, nz, k, iterations, status,
+               px, py, pz, t, lower - floats[0])
+
+
+@jit
+def query_shape(floats, ints, out, px, py, pz, gx, gy, gz):
+    """Object 0 alone with a first search direction (world frame): the single-shape API."""
+    if _invalid(out, 0, px, py, pz):
+        return
+    W, lam, stack, stack_d2 = _scratch(floats, ints)
+    status, d, lower, x, y, z, nx, ny, nz, iterations, t = _object_distance(
+        floats, ints, 0, px, py, pz, gx, gy, gz, W, lam, stack, stack_d2)
+    _write(out, 0, d - floats[0], x, y, z, nx, ny, nz, 0, iterations, status, px, py, pz,
+           t, lower - floats[0])

@@ -1,0 +1,203 @@
+"""Exact signed distance to a closed triangle mesh: an AABB tree over its triangles.
+
+The tree is built once in numpy (median split of the triangle centroids along the longest axis,
+at most ``LEAF_SIZE`` triangles a leaf) and searched in the compiled kernel depth-first, nearer
+child first, skipping every box farther than the best distance found so far; the previous
+answer's triangle is tried first, which tightens the bound from the start on a trajectory. Each
+candidate triangle is a convex piece handed to GJK (``gjk.nearest_on_triangle``), which also says
+which feature the nearest point lies on; the sign comes from that feature's angle-weighted
+pseudonormal (``pseudonormals``). Vertices must be welded and the surface closed and consistently
+wound (``shapes.TriangleMesh`` checks).
+
+Packed layout (one object's blocks; ``t`` triangles, ``e`` edges, ``n`` vertices, ``b`` nodes),
+triangles in tree-leaf order:
+
+* floats: scale (bounding radius, m); corners (t, 9); face normals (t, 3); edge normals (e, 3);
+  vertex normals (n, 3); node boxes (b, 6) as min xyz, max xyz.
+* ints: t, e, n, b; faces (t, 3); face edges (t, 3); original face index (t,); nodes (b, 3) as
+  first child (-1 for a leaf), first triangle, triangle count.
+"""
+
+import math
+
+import numpy as np
+
+from collision_engine._jit import jit
+from collision_engine.gjk import nearest_on_triangle
+from collision_engine.pseudonormals import pseudonormals
+
+__all__ = ['LEAF_SIZE', 'STACK_SIZE', 'build_tree', 'pack_triangle_mesh', 'mesh_distance']
+
+LEAF_SIZE = 4
+STACK_SIZE = 128
+
+
+def build_tree(corners: np.ndarray, leaf_size: int = LEAF_SIZE):
+    """Median-split AABB tree over triangles.
+
+    Parameters
+    ----------
+    corners : (t, 3, 3) float, m
+        The triangles' corners.
+
+    Returns
+    -------
+    order : (t,) int64
+        Triangle indices in leaf order: leaf triangles are contiguous.
+    boxes : (b, 6) float64, m
+        Each node's box (min x, y, z, max x, y, z).
+    nodes : (b, 3) int64
+        First child (its sibling follows it; -1 for a leaf), first triangle, triangle count.
+    """
+    centroids = corners.mean(axis=1)
+    lows, highs = corners.min(axis=1), corners.max(axis=1)
+    order = np.arange(len(corners))
+    boxes, nodes = [], []
+    pending = [(0, len(corners), 0)]
+    boxes.append(None)
+    nodes.append(None)
+    while pending:
+        start, stop, node = pending.pop()
+        members = order[start:stop]
+        boxes[node] = np.concatenate((lows[members].min(axis=0), highs[members].max(axis=0)))
+        if stop - start <= leaf_size:
+            nodes[node] = (-1, start, stop - start)
+            continue
+        spread = centroids[members].max(axis=0) - centroids[members].min(axis=0)
+        axis = int(np.argmax(spread))
+        middle = (stop - start) // 2
+        ranked = np.argpartition(centroids[members, axis], middle)
+        order[start:stop] = members[ranked]
+        child = len(nodes)
+        boxes.extend((None, None))
+        nodes.extend((None, None))
+        nodes[node] = (child, start, stop - start)
+        pending.append((start + middle, stop, child + 1))
+        pending.append((start, start + middle, child))
+    return order, np.array(boxes), np.array(nodes, dtype=np.int64)
+
+
+def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Build the tree and pseudonormals of a mesh and pack them in the layout above.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float, m, local frame
+    faces : (t, 3) int, closed and consistently wound
+
+    Returns
+    -------
+    floats : (k,) float64
+    ints : (j,) int64
+    """
+    normals = pseudonormals(vertices, faces)
+    order, boxes, nodes = build_tree(vertices[faces])
+    faces_sorted = faces[order]
+    centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+    scale = float(np.linalg.norm(vertices - centre, axis=1).max())
+    floats = np.concatenate((
+        [scale], vertices[faces_sorted].ravel(), normals.face[order].ravel(),
+        normals.edge.ravel(), normals.vertex.ravel(), boxes.ravel()))
+    ints = np.concatenate((
+        [len(faces), len(normals.edge), len(vertices), len(nodes)], faces_sorted.ravel(),
+        normals.face_edges[order].ravel(), order, nodes.ravel()))
+    return floats.astype(np.float64), ints.astype(np.int64)
+
+
+@jit(inline=True)
+def _box_distance2(floats, b, qx, qy, qz):
+    """Squared distance from q to the box at floats[b:b + 6] (0 inside)."""
+    dx = max(floats[b] - qx, 0.0, qx - floats[b + 3])
+    dy = max(floats[b + 1] - qy, 0.0, qy - floats[b + 4])
+    dz = max(floats[b + 2] - qz, 0.0, qz - floats[b + 5])
+    return dx * dx + dy * dy + dz * dz
+
+
+@jit(inline=True)
+def _triangle_distance2(floats, corners, t, qx, qy, qz):
+    c = corners + 9 * t
+    return nearest_on_triangle(
+        floats[c] - qx, floats[c + 1] - qy, floats[c + 2] - qz,
+        floats[c + 3] - qx, floats[c + 4] - qy, floats[c + 5] - qz,
+        floats[c + 6] - qx, floats[c + 7] - qy, floats[c + 8] - qz)
+
+
+@jit
+def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
+    """Signed distance from q to a packed triangle mesh, local frame.
+
+    ``hint`` is a triangle (leaf order) to try first, or -1. ``stack`` and ``stack_d2``
+    (``STACK_SIZE``,) are scratch: a depth-first search holds at most one node per
+    level plus one, and a median-split tree over t triangles has ceil(log2(t)) levels, so 128
+    entries never fill.
+
+    Returns (distance, closest x, y, z, outward normal x, y, z, triangle in leaf order,
+    original triangle index, triangles tested), m; the distance is negative inside.
+    """
+    n_tri, n_edge, n_vert = ints[io], ints[io + 1], ints[io + 2]
+    scale = floats[fo]
+    corners = fo + 1
+    face_normals = corners + 9 * n_tri
+    edge_normals = face_normals + 3 * n_tri
+    vertex_normals = edge_normals + 3 * n_edge
+    boxes = vertex_normals + 3 * n_vert
+    faces = io + 4
+    face_edges = faces + 3 * n_tri
+    original = face_edges + 3 * n_tri
+    nodes = original + n_tri
+
+    best_d2 = np.inf
+    best_t, feature, which = -1, 0, 0
+    vx = vy = vz = 0.0
+    tested = 0
+    if 0 <= hint < n_tri:
+        best_d2, vx, vy, vz, feature, which = _triangle_distance2(
+            floats, corners, hint, qx, qy, qz)
+        best_t = hint
+        tested = 1
+    stack[0] = 0
+    stack_d2[0] = _box_distance2(floats, boxes, qx, qy, qz)
+    top = 1
+    while top > 0:
+        top -= 1
+        node = stack[top]
+        if stack_d2[top] >= best_d2:
+            continue
+        child = ints[nodes + 3 * node]
+        if child < 0:
+            first = ints[nodes + 3 * node + 1]
+            tested += ints[nodes + 3 * node + 2]
+            for t in range(first, first + ints[nodes + 3 * node + 2]):
+                d2, ux, uy, uz, f, w = _triangle_distance2(floats, corners, t, qx, qy, qz)
+                if d2 < best_d2:
+                    best_d2, vx, vy, vz, feature, which, best_t = d2, ux, uy, uz, f, w, t
+            continue
+        near_d2 = _box_distance2(floats, boxes + 6 * child, qx, qy, qz)
+        far_d2 = _box_distance2(floats, boxes + 6 * (child + 1), qx, qy, qz)
+        near, far = child, child + 1
+        if far_d2 < near_d2:
+            near, far, near_d2, far_d2 = far, near, far_d2, near_d2
+        if far_d2 < best_d2:
+            stack[top] = far
+            stack_d2[top] = far_d2
+            top += 1
+        if near_d2 < best_d2:
+            stack[top] = near
+            stack_d2[top] = near_d2
+            top += 1
+
+    if feature == 3:
+        p = face_normals + 3 * best_t
+    elif feature == 2:
+        p = edge_normals + 3 * ints[face_edges + 3 * best_t + which]
+    else:
+        p = vertex_normals + 3 * ints[faces + 3 * best_t + which]
+    px, py, pz = floats[p], floats[p + 1], floats[p + 2]
+    distance = math.sqrt(best_d2)
+    inside = vx * px + vy * py + vz * pz > 0.0
+    sign = -1.0 if inside else 1.0
+    nx, ny, nz = px, py, pz
+    if feature != 3 and distance > 1e-9 * scale:
+        nx, ny, nz = -sign * vx / distance, -sign * vy / distance, -sign * vz / distance
+    return (sign * distance, qx + vx, qy + vy, qz + vz, nx, ny, nz,
+            best_t, ints[original + best_t], tested)

@@ -1,0 +1,207 @@
+"""EPA: penetration depth of a point inside a convex shape, compiled.
+
+The expanding polytope algorithm (van den Bergen 2001) grows a polytope inside ``C = A - q``
+from GJK's final simplex, always pushing out its face nearest the origin along that face's
+normal, until the support point no longer moves the face: the face then lies on the shape's
+surface, its distance to the origin is the penetration depth and its normal the direction out.
+On a polytope (a convex mesh) the answer is exact up to rounding. Primitives do not come here:
+their own exact interior distance is cheaper (``support.interior``).
+
+The simplex GJK ends with when it detects contact can be a point, segment or triangle (the point
+is on the surface, or within rounding of it); it is first blown up to a tetrahedron with support
+points along directions that span the missing dimensions (as libccd and coal do).
+"""
+
+import math
+
+import numpy as np
+
+from collision_engine._jit import jit
+from collision_engine.gjk import STATUS_NOT_CONVERGED, STATUS_OK
+from collision_engine.support import support
+
+__all__ = ['epa']
+
+_EPS = float(np.finfo(np.float64).eps)
+_FLOOR = 16.0 * _EPS
+_UNIT_AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+@jit
+def _support_minus_q(kind, floats, fo, ints, io, q, dx, dy, dz):
+    sx, sy, sz, _ = support(kind, floats, fo, ints, io, dx, dy, dz, 0)
+    return sx - q[0], sy - q[1], sz - q[2]
+
+
+@jit
+def _off_affine_hull(V, count, x, y, z, tolerance):
+    """Whether the point is farther than ``tolerance`` from the affine hull of V[:count]."""
+    if count == 1:
+        dx, dy, dz = x - V[0, 0], y - V[0, 1], z - V[0, 2]
+        return dx * dx + dy * dy + dz * dz > tolerance * tolerance
+    ux, uy, uz = V[1, 0] - V[0, 0], V[1, 1] - V[0, 1], V[1, 2] - V[0, 2]
+    px, py, pz = x - V[0, 0], y - V[0, 1], z - V[0, 2]
+    if count == 2:
+        cx, cy, cz = uy * pz - uz * py, uz * px - ux * pz, ux * py - uy * px
+        return cx * cx + cy * cy + cz * cz > tolerance * tolerance * (ux * ux + uy * uy + uz * uz)
+    wx, wy, wz = V[2, 0] - V[0, 0], V[2, 1] - V[0, 1], V[2, 2] - V[0, 2]
+    nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+    height = nx * px + ny * py + nz * pz
+    return height * height > tolerance * tolerance * (nx * nx + ny * ny + nz * nz)
+
+
+@jit
+def _blow_up(kind, floats, fo, ints, io, q, V, count, tolerance):
+    """Grow the simplex V[:count] to a tetrahedron with support points; returns its size."""
+    while count < 4:
+        grown = False
+        for axis in range(3):
+            ax, ay, az = _UNIT_AXES[axis]
+            if count == 1:
+                dx, dy, dz = ax, ay, az
+            elif count == 2:
+                ux, uy, uz = V[1, 0] - V[0, 0], V[1, 1] - V[0, 1], V[1, 2] - V[0, 2]
+                dx, dy, dz = uy * az - uz * ay, uz * ax - ux * az, ux * ay - uy * ax
+            else:
+                ux, uy, uz = V[1, 0] - V[0, 0], V[1, 1] - V[0, 1], V[1, 2] - V[0, 2]
+                wx, wy, wz = V[2, 0] - V[0, 0], V[2, 1] - V[0, 1], V[2, 2] - V[0, 2]
+                dx, dy, dz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+            if dx == 0.0 and dy == 0.0 and dz == 0.0:
+                continue
+            for sign in (1.0, -1.0):
+                x, y, z = _support_minus_q(kind, floats, fo, ints, io, q,
+                                           sign * dx, sign * dy, sign * dz)
+                if _off_affine_hull(V, count, x, y, z, tolerance):
+                    V[count, 0], V[count, 1], V[count, 2] = x, y, z
+                    count += 1
+                    grown = True
+                    break
+            if grown:
+                break
+        if not grown:
+            return count
+    return count
+
+
+@jit
+def _set_face(V, F, N, D, f, a, b, c):
+    """Store face f = (a, b, c) with its unit normal and signed distance from the origin."""
+    F[f, 0], F[f, 1], F[f, 2] = a, b, c
+    ux, uy, uz = V[b, 0] - V[a, 0], V[b, 1] - V[a, 1], V[b, 2] - V[a, 2]
+    wx, wy, wz = V[c, 0] - V[a, 0], V[c, 1] - V[a, 1], V[c, 2] - V[a, 2]
+    nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+    norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if norm == 0.0:
+        return False
+    nx, ny, nz = nx / norm, ny / norm, nz / norm
+    N[f, 0], N[f, 1], N[f, 2] = nx, ny, nz
+    D[f] = nx * V[a, 0] + ny * V[a, 1] + nz * V[a, 2]
+    return True
+
+
+@jit
+def _tetrahedron(V, F, N, D):
+    """Set the four outward faces of the tetrahedron V[0..3]; false if it is flat."""
+    ux, uy, uz = V[1, 0] - V[0, 0], V[1, 1] - V[0, 1], V[1, 2] - V[0, 2]
+    wx, wy, wz = V[2, 0] - V[0, 0], V[2, 1] - V[0, 1], V[2, 2] - V[0, 2]
+    tx, ty, tz = V[3, 0] - V[0, 0], V[3, 1] - V[0, 1], V[3, 2] - V[0, 2]
+    volume = (ux * (wy * tz - wz * ty) - uy * (wx * tz - wz * tx) + uz * (wx * ty - wy * tx))
+    if volume > 0.0:
+        faces = ((0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3))
+    else:
+        faces = ((0, 1, 2), (0, 3, 1), (0, 2, 3), (1, 3, 2))
+    ok = True
+    for f in range(4):
+        a, b, c = faces[f]
+        ok = _set_face(V, F, N, D, f, a, b, c) and ok
+    return ok
+
+
+@jit
+def epa(kind, floats, fo, ints, io, q, W, count, rel_tol, abs_tol, max_iter):
+    """Penetration of the point q inside a convex shape, from GJK's contact simplex.
+
+    Parameters
+    ----------
+    q : (3,) float, m, local frame
+    W : (4, 3) float
+        GJK's final simplex of ``C = A - q`` (``count`` rows), which contains the origin.
+
+    Returns
+    -------
+    (status, depth, depth_bound, closest x, y, z, outward normal x, y, z, iterations), local
+    frame, m: the penetration depth lies in [depth, depth_bound] (equal to rounding when
+    converged), and the closest point is q moved by ``depth`` along the normal.
+    """
+    max_vertices = max_iter + 4
+    V = np.empty((max_vertices, 3))
+    F = np.empty((2 * max_vertices, 3), dtype=np.int64)
+    N = np.empty((2 * max_vertices, 3))
+    D = np.empty(2 * max_vertices)
+    alive = np.zeros(2 * max_vertices, dtype=np.bool_)
+    V[:count] = W[:count]
+    scale = 0.0
+    for k in range(count):
+        scale = max(scale, math.sqrt(V[k, 0] ** 2 + V[k, 1] ** 2 + V[k, 2] ** 2))
+    x0, y0, z0 = _support_minus_q(kind, floats, fo, ints, io, q, 1.0, 0.0, 0.0)
+    x1, y1, z1 = _support_minus_q(kind, floats, fo, ints, io, q, -1.0, 0.0, 0.0)
+    scale = max(scale, abs(x0 - x1))
+    count = _blow_up(kind, floats, fo, ints, io, q, V, count, 1e-9 * scale)
+    if count < 4 or not _tetrahedron(V, F, N, D):
+        return STATUS_NOT_CONVERGED, 0.0, np.inf, q[0], q[1], q[2], 1.0, 0.0, 0.0, 0
+    alive[:4] = True
+    n_vertices, n_faces = 4, 4
+    edge_a = np.empty(6 * max_vertices, dtype=np.int64)
+    edge_b = np.empty(6 * max_vertices, dtype=np.int64)
+    status = STATUS_NOT_CONVERGED
+    bound = np.inf
+    iteration = 0
+    while True:
+        best = -1
+        for f in range(n_faces):
+            if alive[f] and (best < 0 or D[f] < D[best]):
+                best = f
+        nx, ny, nz, depth = N[best, 0], N[best, 1], N[best, 2], D[best]
+        if iteration >= max_iter or n_vertices >= max_vertices:
+            break
+        iteration += 1
+        wx, wy, wz = _support_minus_q(kind, floats, fo, ints, io, q, nx, ny, nz)
+        bound = min(bound, nx * wx + ny * wy + nz * wz)
+        gap = nx * wx + ny * wy + nz * wz - depth
+        if gap <= max(rel_tol * abs(depth), abs_tol, _FLOOR * scale):
+            status = STATUS_OK
+            break
+        w = n_vertices
+        V[w, 0], V[w, 1], V[w, 2] = wx, wy, wz
+        n_vertices += 1
+        # Faces the new point sees go; the edges they do not share form the horizon.
+        n_edges = 0
+        for f in range(n_faces):
+            if not alive[f]:
+                continue
+            a = F[f, 0]
+            if (N[f, 0] * (wx - V[a, 0]) + N[f, 1] * (wy - V[a, 1])
+                    + N[f, 2] * (wz - V[a, 2])) > _FLOOR * scale:
+                alive[f] = False
+                for e in range(3):
+                    edge_a[n_edges] = F[f, e]
+                    edge_b[n_edges] = F[f, (e + 1) % 3]
+                    n_edges += 1
+        degenerate = False
+        for e in range(n_edges):
+            shared = False
+            for g in range(n_edges):
+                if edge_a[g] == edge_b[e] and edge_b[g] == edge_a[e]:
+                    shared = True
+                    break
+            if shared:
+                continue
+            if n_faces >= len(D) or not _set_face(V, F, N, D, n_faces, edge_a[e], edge_b[e], w):
+                degenerate = True
+                break
+            alive[n_faces] = True
+            n_faces += 1
+        if degenerate:
+            break
+    return (status, depth, max(bound, depth), q[0] + depth * nx, q[1] + depth * ny,
+            q[2] + depth * nz, nx, ny, nz, iteration)

@@ -1,0 +1,309 @@
+"""Our GJK: distance from a point to a convex shape given by its support function, compiled.
+
+GJK (Gilbert, Johnson, Keerthi 1988) searches the shape minus the point, ``C = A - q``, for its
+point ``v`` nearest the origin; ``q + v`` is then the closest point of ``A`` and ``|v|`` the
+distance. The sub-algorithm that finds the nearest point of the current simplex is the
+signed-volumes method of Montanari, Petrinic and Barbieri (2017, ACM TOG 36(3) 32): barycentric
+coordinates as ratios of signed volumes (tetrahedron), areas (triangle, in the coordinate plane
+where it is largest) and lengths (segment), which its authors show to be more accurate and robust
+than Johnson's dot-product recursion on near-degenerate simplices.
+
+The loop stops on whichever comes first:
+
+* a relative test, ``|v|^2 - v.w <= rel_tol |v|^2`` (the bound gap is a fraction of the
+  distance);
+* an absolute test, ``|v|^2 - v.w <= abs_tol |v|`` (the gap is below ``abs_tol`` metres);
+* the rounding floor, ``|v|^2 - v.w <= 1024 eps |v| max|w|``: the distance is then known to
+  about 2e-13 of the shape's size, what float64 sub-algorithm steps on it can resolve;
+* contact: the origin lies in the simplex (the point is inside or on the shape);
+* no progress: the new support point is already in the simplex, or the new simplex is not
+  nearer. In exact arithmetic that proves optimality; in float64 it is reported as converged
+  when the gap is at the rounding of v (``1024 eps max|w|^2``: v carries about eps max|w| of
+  rounding, so near the surface its direction, hence the lower bound, is loose while |v| is
+  exact to rounding), else as ``NOT_CONVERGED`` with the best bound;
+* the iteration cap, reported as ``NOT_CONVERGED`` with the best upper bound found.
+
+A relative test alone cycles near the surface of a many-vertex hull, hence all of them.
+Status codes are those of ``haptic_msgs/CollisionState``.
+"""
+
+import math
+
+import numpy as np
+
+from collision_engine._jit import jit
+from collision_engine.support import support
+
+__all__ = ['STATUS_OK', 'STATUS_NOT_CONVERGED', 'STATUS_NO_OBJECT', 'STATUS_INVALID_INPUT',
+           'gjk', 'nearest_on_simplex', 'nearest_on_triangle']
+
+STATUS_OK = 0
+STATUS_NOT_CONVERGED = 1
+STATUS_NO_OBJECT = 2
+STATUS_INVALID_INPUT = 3
+
+_EPS = float(np.finfo(np.float64).eps)
+_ROUNDING = 1024.0 * _EPS
+_CONTACT = 16.0 * _EPS
+
+
+@jit(inline=True)
+def _same_sign(a, b):
+    return (a > 0.0 and b > 0.0) or (a < 0.0 and b < 0.0)
+
+
+@jit(inline=True)
+def _s1d(ax, ay, az, bx, by, bz):
+    """Nearest point to the origin on the segment a b.
+
+    Returns (count, first, second, lambda_first, vx, vy, vz): the support set as local indices
+    (0 for a, 1 for b; ``second`` is -1 when it is one vertex), the weight of ``first`` (the
+    other weight is 1 - lambda_first) and the nearest point.
+    """
+    tx, ty, tz = bx - ax, by - ay, bz - az
+    tt = tx * tx + ty * ty + tz * tz
+    if tt == 0.0:
+        return 1, 0, -1, 1.0, ax, ay, az
+    s = -(ax * tx + ay * ty + az * tz) / tt
+    px, py, pz = ax + s * tx, ay + s * ty, az + s * tz
+    # Signed lengths along the axis where the segment is longest.
+    if abs(tx) >= abs(ty) and abs(tx) >= abs(tz):
+        a_k, b_k, p_k = ax, bx, px
+    elif abs(ty) >= abs(tz):
+        a_k, b_k, p_k = ay, by, py
+    else:
+        a_k, b_k, p_k = az, bz, pz
+    mu = a_k - b_k
+    c_first = p_k - b_k
+    c_second = a_k - p_k
+    if _same_sign(mu, c_first) and _same_sign(mu, c_second):
+        la = c_first / mu
+        lb = 1.0 - la
+        return 2, 0, 1, la, la * ax + lb * bx, la * ay + lb * by, la * az + lb * bz
+    if _same_sign(mu, c_first):
+        return 1, 0, -1, 1.0, ax, ay, az
+    return 1, 1, -1, 1.0, bx, by, bz
+
+
+@jit(inline=True)
+def _cross_k(ux, uy, uz, wx, wy, wz, k):
+    """Component k of u x w: the signed area of (0, u, w) seen along axis k (doubled)."""
+    if k == 0:
+        return uy * wz - uz * wy
+    if k == 1:
+        return uz * wx - ux * wz
+    return ux * wy - uy * wx
+
+
+@jit(inline=True)
+def _s2d(ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Nearest point to the origin on the triangle a b c.
+
+    Returns (count, i0, i1, i2, l0, l1, l2, vx, vy, vz): the support set as local indices in
+    increasing order (0 a, 1 b, 2 c; unused slots -1), their weights and the nearest point.
+    """
+    ux, uy, uz = bx - ax, by - ay, bz - az
+    wx, wy, wz = cx - ax, cy - ay, cz - az
+    nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+    nn = nx * nx + ny * ny + nz * nz
+    c0 = c1 = c2 = mu = 0.0
+    if nn > 0.0:
+        scale = (ax * nx + ay * ny + az * nz) / nn
+        px, py, pz = scale * nx, scale * ny, scale * nz
+        # Signed areas in the coordinate plane where the triangle's projection is largest.
+        k, mu = 0, nx
+        if abs(ny) > abs(mu):
+            k, mu = 1, ny
+        if abs(nz) > abs(mu):
+            k, mu = 2, nz
+        c0 = _cross_k(bx - px, by - py, bz - pz, cx - px, cy - py, cz - pz, k)
+        c1 = _cross_k(cx - px, cy - py, cz - pz, ax - px, ay - py, az - pz, k)
+        c2 = _cross_k(ax - px, ay - py, az - pz, bx - px, by - py, bz - pz, k)
+        if _same_sign(mu, c0) and _same_sign(mu, c1) and _same_sign(mu, c2):
+            total = c0 + c1 + c2
+            l0, l1, l2 = c0 / total, c1 / total, c2 / total
+            return (3, 0, 1, 2, l0, l1, l2, l0 * ax + l1 * bx + l2 * cx,
+                    l0 * ay + l1 * by + l2 * cy, l0 * az + l1 * bz + l2 * cz)
+    # The projection is outside (or the triangle is degenerate): the nearest point is on an
+    # edge facing the origin, one opposite a vertex whose signed area has the wrong sign.
+    best = np.inf
+    result = (1, 0, -1, -1, 1.0, 0.0, 0.0, ax, ay, az)
+    if not _same_sign(mu, c0):
+        n, f, s, lf, vx, vy, vz = _s1d(bx, by, bz, cx, cy, cz)
+        best = vx * vx + vy * vy + vz * vz
+        result = (n, f + 1, s + 1 if s >= 0 else -1, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
+    if not _same_sign(mu, c1):
+        n, f, s, lf, vx, vy, vz = _s1d(ax, ay, az, cx, cy, cz)
+        dist = vx * vx + vy * vy + vz * vz
+        if dist < best:
+            best = dist
+            result = (n, 2 * f, 2 if s >= 0 else -1, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
+    if not _same_sign(mu, c2):
+        n, f, s, lf, vx, vy, vz = _s1d(ax, ay, az, bx, by, bz)
+        dist = vx * vx + vy * vy + vz * vz
+        if dist < best:
+            result = (n, f, s, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
+    return result
+
+
+@jit(inline=True)
+def _det3(W, i, j, k):
+    return (W[i, 0] * (W[j, 1] * W[k, 2] - W[j, 2] * W[k, 1])
+            - W[i, 1] * (W[j, 0] * W[k, 2] - W[j, 2] * W[k, 0])
+            + W[i, 2] * (W[j, 0] * W[k, 1] - W[j, 1] * W[k, 0]))
+
+
+@jit(inline=True)
+def _face_s2d(W, i, j, k):
+    """``_s2d`` on the rows i < j < k of W, with the support set as rows of W."""
+    n, a, b, c, la, lb, lc, vx, vy, vz = _s2d(W[i, 0], W[i, 1], W[i, 2], W[j, 0], W[j, 1],
+                                              W[j, 2], W[k, 0], W[k, 1], W[k, 2])
+    rows = (i, j, k)
+    return (n, rows[a], rows[b] if b >= 0 else -1, rows[c] if c >= 0 else -1,
+            la, lb, lc, vx, vy, vz)
+
+
+@jit(inline=True)
+def _s3d(W):
+    """Nearest point to the origin on the tetrahedron W[0..3].
+
+    Returns (count, v0, v1, v2, v3, l0, l1, l2, l3, vx, vy, vz) with the support set as rows
+    of W; count 4 means the origin is inside and v = 0.
+    """
+    c0 = _det3(W, 1, 2, 3)
+    c1 = -_det3(W, 0, 2, 3)
+    c2 = _det3(W, 0, 1, 3)
+    c3 = -_det3(W, 0, 1, 2)
+    det = c0 + c1 + c2 + c3
+    if (_same_sign(det, c0) and _same_sign(det, c1) and _same_sign(det, c2)
+            and _same_sign(det, c3)):
+        return 4, 0, 1, 2, 3, c0 / det, c1 / det, c2 / det, c3 / det, 0.0, 0.0, 0.0
+    best = np.inf
+    result = (1, 0, -1, -1, -1, 1.0, 0.0, 0.0, 0.0, W[0, 0], W[0, 1], W[0, 2])
+    for slot in range(4):
+        c = c0 if slot == 0 else (c1 if slot == 1 else (c2 if slot == 2 else c3))
+        if _same_sign(det, c):
+            continue
+        # The face opposite the vertex in this slot, its rows in increasing order.
+        n, a, b, c_, la, lb, lc, vx, vy, vz = _face_s2d(
+            W, 1 if slot == 0 else 0, 1 if slot >= 2 else 2, 2 if slot == 3 else 3)
+        dist = vx * vx + vy * vy + vz * vz
+        if dist < best:
+            best = dist
+            result = (n, a, b, c_, -1, la, lb, lc, 0.0, vx, vy, vz)
+    return result
+
+
+@jit(inline=True)
+def nearest_on_simplex(W, count, lam):
+    """Reduce the simplex W[:count] to the support set of its point nearest the origin.
+
+    Rewrites W[:new_count] and lam[:new_count] (the barycentric weights) in place. Returns
+    (new_count, vx, vy, vz).
+    """
+    if count == 1:
+        lam[0] = 1.0
+        return 1, W[0, 0], W[0, 1], W[0, 2]
+    if count == 2:
+        n, a, b, la, vx, vy, vz = _s1d(W[0, 0], W[0, 1], W[0, 2], W[1, 0], W[1, 1], W[1, 2])
+        _keep(W, lam, a, b, -1, -1, la, 1.0 - la, 0.0, 0.0)
+        return n, vx, vy, vz
+    if count == 3:
+        n, a, b, c, la, lb, lc, vx, vy, vz = _face_s2d(W, 0, 1, 2)
+        _keep(W, lam, a, b, c, -1, la, lb, lc, 0.0)
+        return n, vx, vy, vz
+    n, a, b, c, d, la, lb, lc, ld, vx, vy, vz = _s3d(W)
+    _keep(W, lam, a, b, c, d, la, lb, lc, ld)
+    return n, vx, vy, vz
+
+
+@jit(inline=True)
+def _keep(W, lam, a, b, c, d, la, lb, lc, ld):
+    """Move rows a, b, c, d (-1 = absent, present ones in increasing order) of W to the front."""
+    slot = 0
+    for index, weight in ((a, la), (b, lb), (c, lc), (d, ld)):
+        if index < 0:
+            continue
+        if index != slot:
+            W[slot, 0], W[slot, 1], W[slot, 2] = W[index, 0], W[index, 1], W[index, 2]
+        lam[slot] = weight
+        slot += 1
+
+
+@jit(inline=True)
+def nearest_on_triangle(ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Nearest point to the origin on one triangle, with the feature it lies on.
+
+    This is GJK started from the whole triangle as its simplex: the signed-volumes step gives
+    the nearest point v, and the next support point (the triangle vertex farthest along -v)
+    cannot pass below v's bound, so GJK's termination test ends it after that one step.
+
+    Returns (squared distance, vx, vy, vz, feature, which) where feature is 3 (face), 2 (edge:
+    ``which`` is the vertex opposite it) or 1 (vertex: ``which`` is the vertex).
+    """
+    n, i, j, k, li, lj, lk, vx, vy, vz = _s2d(ax, ay, az, bx, by, bz, cx, cy, cz)
+    which = i
+    if n == 2:
+        which = 3 - i - j
+    return vx * vx + vy * vy + vz * vz, vx, vy, vz, n, which
+
+
+@jit
+def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, rel_tol, abs_tol, max_iter, W, lam):
+    """Distance from the point q to a convex shape (packed as in ``support``), local frame.
+
+    (dx, dy, dz) is the first search direction, from the shape toward the point (a warm start
+    when it is near the answer). ``W`` (4, 3) and ``lam`` (4,) are scratch; on contact they
+    hold the final simplex of ``C = A - q`` for EPA.
+
+    Returns (status, contact, count, vx, vy, vz, lower, iterations): ``q + v`` is the nearest
+    point found, ``|v|`` the upper bound on the distance and ``lower`` the best lower bound.
+    ``contact`` is true when the point is inside or on the shape (then v ~ 0).
+    """
+    sx, sy, sz, vertex = support(kind, floats, fo, ints, io, dx, dy, dz, 0)
+    vx, vy, vz = sx - qx, sy - qy, sz - qz
+    W[0, 0], W[0, 1], W[0, 2] = vx, vy, vz
+    lam[0] = 1.0
+    count = 1
+    vv = vx * vx + vy * vy + vz * vz
+    w_max2 = vv
+    lower = 0.0
+    status = STATUS_NOT_CONVERGED
+    iteration = 0
+    while iteration < max_iter:
+        iteration += 1
+        if vv == 0.0:
+            return STATUS_OK, True, count, 0.0, 0.0, 0.0, 0.0, iteration
+        sx, sy, sz, vertex = support(kind, floats, fo, ints, io, -vx, -vy, -vz, vertex)
+        wx, wy, wz = sx - qx, sy - qy, sz - qz
+        w_max2 = max(w_max2, wx * wx + wy * wy + wz * wz)
+        norm_v = math.sqrt(vv)
+        vw = vx * wx + vy * wy + vz * wz
+        if vw > 0.0:
+            lower = max(lower, vw / norm_v)
+        gap = vv - vw
+        tolerance = max(rel_tol * vv, abs_tol * norm_v, _ROUNDING * norm_v * math.sqrt(w_max2))
+        if gap <= tolerance:
+            status = STATUS_OK
+            break
+        # A stall (the support point is already in the simplex, or the new simplex is not
+        # nearer) proves optimality in exact arithmetic; in float64 it is convergence when the
+        # gap is at the rounding of v, whose error is about eps max|w| in each coordinate.
+        stalled_ok = STATUS_OK if gap <= _ROUNDING * w_max2 else STATUS_NOT_CONVERGED
+        duplicate = False
+        for m in range(count):
+            if W[m, 0] == wx and W[m, 1] == wy and W[m, 2] == wz:
+                duplicate = True
+        if duplicate:
+            status = stalled_ok
+            break
+        W[count, 0], W[count, 1], W[count, 2] = wx, wy, wz
+        count, nx, ny, nz = nearest_on_simplex(W, count + 1, lam)
+        nn = nx * nx + ny * ny + nz * nz
+        if count == 4 or nn <= (_CONTACT * _CONTACT) * w_max2:
+            return STATUS_OK, True, count, nx, ny, nz, 0.0, iteration
+        if nn >= vv:
+            status = stalled_ok
+            break
+        vx, vy, vz, vv = nx, ny, nz, nn
+    return status, False, count, vx, vy, vz, lower, iteration

@@ -1,0 +1,158 @@
+"""What a scene query returns: one ``QueryResult`` per point, or a ``BatchResult`` of arrays.
+
+Sign rule, once for the package: the distance is positive outside, zero on the surface and
+negative inside; the normal is the unit outward surface normal at the closest point. Every
+vector is in the scene's frame, in metres. The wand tip is a sphere of the scene's
+``tip_radius`` (0: a point): ``distance`` is that of the sphere's surface, while ``point`` stays
+the closest point on the object's surface to the tip centre.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ['QueryResult', 'BatchResult']
+
+_NAN = float('nan')
+
+
+class QueryResult:
+    """The nearest object to one tip position.
+
+    Built from one packed output row (see ``_kernels``); the vectors are made on first access,
+    so that a haptic loop reading a few fields pays only for those.
+
+    Attributes
+    ----------
+    cross_validated : bool
+        True when FCL checked this query.
+    fcl_distance : float, m
+        FCL's distance to the same object (unsigned for a non-convex mesh); NaN when not run.
+    fcl_discrepancy : float, m
+        ``|distance - fcl_distance|`` (of magnitudes for a non-convex mesh); NaN when not run.
+    """
+
+    __slots__ = ('_row', '_names', 'cross_validated', 'fcl_distance', 'fcl_discrepancy')
+
+    def __init__(self, row: list, names: tuple, cross_validated: bool = False,
+                 fcl_distance: float = _NAN, fcl_discrepancy: float = _NAN) -> None:
+        self._row = row
+        self._names = names
+        self.cross_validated = cross_validated
+        self.fcl_distance = fcl_distance
+        self.fcl_discrepancy = fcl_discrepancy
+
+    @property
+    def distance(self) -> float:
+        """Signed distance from the tip to the nearest object, m (``inf`` when none)."""
+        return self._row[0]
+
+    @property
+    def point(self) -> np.ndarray:
+        """(3,) closest point on that object's surface, m."""
+        return np.array(self._row[1:4])
+
+    @property
+    def normal(self) -> np.ndarray:
+        """(3,) unit outward surface normal at ``point``."""
+        return np.array(self._row[4:7])
+
+    @property
+    def object_index(self) -> int:
+        """Index of the nearest object in ``Scene.objects`` (-1 for none)."""
+        return int(self._row[7])
+
+    @property
+    def object(self) -> str | None:
+        """Name of the nearest object, as in the scene file (None for none)."""
+        index = int(self._row[7])
+        return self._names[index] if index >= 0 else None
+
+    @property
+    def iterations(self) -> int:
+        """GJK and EPA iterations spent (for a mesh: triangles tested, one GJK step each)."""
+        return int(self._row[8])
+
+    @property
+    def status(self) -> int:
+        """0 OK, 1 NOT_CONVERGED (distance is the best upper bound), 2 NO_OBJECT."""
+        return int(self._row[9])
+
+    @property
+    def tip(self) -> np.ndarray:
+        """(3,) the tip position queried, m."""
+        return np.array(self._row[10:13])
+
+    @property
+    def triangle(self) -> int:
+        """The nearest triangle of a mesh (-1 for other shapes)."""
+        return int(self._row[13])
+
+    @property
+    def lower_bound(self) -> float:
+        """Lower bound on the distance from GJK, m (see ``DistanceResult.lower_bound``)."""
+        return self._row[14]
+
+    @property
+    def in_collision(self) -> bool:
+        """``distance <= 0``."""
+        return self._row[0] <= 0.0
+
+    @property
+    def penetration(self) -> np.ndarray:
+        """(3,) ``point - tip`` when in collision, else zero, m."""
+        if self._row[0] <= 0.0:
+            return np.array(self._row[1:4]) - np.array(self._row[10:13])
+        return np.zeros(3)
+
+    def __repr__(self) -> str:
+        return (f'QueryResult(object={self.object!r}, distance={self.distance!r}, '
+                f'point={self._row[1:4]}, normal={self._row[4:7]}, status={self.status})')
+
+
+@dataclass(frozen=True, eq=False)
+class BatchResult:
+    """The nearest object to each of n tip positions, as arrays (see ``QueryResult``).
+
+    Attributes
+    ----------
+    distance : (n,) float64, m
+    point : (n, 3) float64, m
+    normal : (n, 3) float64
+    object_index : (n,) int64, -1 for none
+    iterations : (n,) int64
+    status : (n,) int64
+    triangle : (n,) int64
+    lower_bound : (n,) float64, m
+    names : tuple of str
+        The scene's object names, indexed by ``object_index``.
+    """
+
+    distance: np.ndarray
+    point: np.ndarray
+    normal: np.ndarray
+    object_index: np.ndarray
+    iterations: np.ndarray
+    status: np.ndarray
+    triangle: np.ndarray
+    lower_bound: np.ndarray
+    names: tuple
+
+    @classmethod
+    def from_rows(cls, rows: np.ndarray, names: tuple) -> 'BatchResult':
+        """Split packed output rows (n, OUT_SIZE) into named arrays."""
+        return cls(
+            distance=rows[:, 0].copy(), point=rows[:, 1:4].copy(), normal=rows[:, 4:7].copy(),
+            object_index=rows[:, 7].astype(np.int64), iterations=rows[:, 8].astype(np.int64),
+            status=rows[:, 9].astype(np.int64), triangle=rows[:, 13].astype(np.int64),
+            lower_bound=rows[:, 14].copy(), names=names)
+
+    @property
+    def object(self) -> list:
+        """Nearest object's name per point (None for none)."""
+        return [self.names[i] if i >= 0 else None for i in self.object_index]
+
+    @property
+    def in_collision(self) -> np.ndarray:
+        """(n,) bool: ``distance <= 0``."""
+        return self.distance <= 0.0

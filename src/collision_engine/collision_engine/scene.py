@@ -1,0 +1,266 @@
+"""A scene of posed shapes and its signed-distance queries.
+
+``load_scene`` builds only what the file declares: a scene of primitives imports neither trimesh
+nor fcl and builds no tree; a convex mesh is queried by GJK on its hull, without a tree; fcl is
+imported only when the file turns cross-validation on. Every query is one compiled call.
+"""
+
+from dataclasses import dataclass
+import math
+from pathlib import Path
+import sys
+
+import numpy as np
+
+from collision_engine import _kernels
+from collision_engine.distance import DistanceRequest
+from collision_engine.gjk import STATUS_INVALID_INPUT
+from collision_engine.results import BatchResult, QueryResult
+from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CrossValidationSpec,
+                                         CylinderSpec, MaterialSpec, read_scene, SphereSpec)
+from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, TriangleMesh
+from collision_engine.transforms import Pose
+
+__all__ = ['Scene', 'SceneObject', 'load_scene']
+
+
+@dataclass(frozen=True, eq=False)
+class SceneObject:
+    """A shape placed in the scene.
+
+    ``pose`` maps the shape's local frame to the scene frame; ``material`` is None for the
+    renderer's defaults.
+    """
+
+    name: str
+    shape: object
+    pose: Pose
+    material: MaterialSpec | None = None
+
+
+def _point(point) -> tuple[float, float, float]:
+    if type(point) is np.ndarray:
+        point = point.tolist()
+    try:
+        x, y, z = point
+        return float(x), float(y), float(z)
+    except (TypeError, ValueError):
+        raise ValueError(f'point must be 3 numbers (m), got {point!r}') from None
+
+
+def _invalid(point) -> ValueError:
+    return ValueError(f'point must be finite, got {list(point)}')
+
+
+class Scene:
+    """Posed shapes, queried for the signed distance to the nearest one.
+
+    Not thread-safe: each query reuses scratch space and a warm-start hint kept in the scene.
+
+    Parameters
+    ----------
+    objects : sequence of SceneObject
+    frame_id : str
+        The frame every pose, point and result is in (REP-103).
+    tip_radius : float, m
+        The tip is a sphere of this radius; 0 for a point.
+    request : DistanceRequest, optional
+        Tolerances and iteration caps (its ``guess`` is not used by scene queries).
+    cross_validation : CrossValidationSpec, optional
+        With ``fcl`` true, every ``every``-th ``query`` is checked against FCL.
+    """
+
+    def __init__(self, objects, *, frame_id: str = 'world', tip_radius: float = 0.0,
+                 request: DistanceRequest | None = None,
+                 cross_validation: CrossValidationSpec | None = None) -> None:
+        self.objects = tuple(objects)
+        self.frame_id = frame_id
+        if not (tip_radius >= 0.0 and math.isfinite(tip_radius)):
+            raise ValueError(f'tip_radius must be a finite number >= 0 (m), got {tip_radius!r}')
+        self.tip_radius = float(tip_radius)
+        self.request = request or DistanceRequest()
+        self._names = tuple(o.name for o in self.objects)
+        shapes = [o.shape for o in self.objects]
+        poses = [o.pose for o in self.objects]
+        self._floats, self._ints = _kernels.pack_scene(
+            shapes, poses, tip_radius=self.tip_radius, rel_tol=self.request.rel_tol,
+            abs_tol=self.request.abs_tol, max_iterations=self.request.max_iterations,
+            max_epa_iterations=self.request.max_epa_iterations)
+        self._row = np.empty((1, _kernels.OUT_SIZE))
+        self._validator = None
+        if cross_validation is not None and cross_validation.fcl and self.objects:
+            from collision_engine.cross_validation import FclCrossValidator
+
+            self._validator = FclCrossValidator(
+                shapes, poses, every=cross_validation.every,
+                tolerance=cross_validation.tolerance, tip_radius=self.tip_radius)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The objects' names, in order."""
+        return self._names
+
+    @property
+    def cross_validation_stats(self):
+        """Running FCL cross-check totals (``CrossValidationStats``), or None when off."""
+        return None if self._validator is None else self._validator.stats
+
+    def warm_up(self) -> None:
+        """Compile (or load from cache) every kernel, so that the first real query is fast.
+
+        The first call in a process takes seconds without numba's cache and about half a
+        second with it; call this before a real-time loop starts (``load_scene`` does).
+        """
+        self.query_many(np.zeros((1, 3)))
+        _kernels.query_point(self._floats, self._ints, self._row, 0.0, 0.0, 0.0)
+        self.query_within((0.0, 0.0, 0.0), 0.0)
+
+    def query(self, point) -> QueryResult:
+        """Signed distance from one tip position to the nearest object.
+
+        Parameters
+        ----------
+        point : (3,) float, m, scene frame
+
+        Returns
+        -------
+        QueryResult
+
+        Raises
+        ------
+        ValueError
+            If ``point`` is not 3 finite numbers.
+        """
+        x, y, z = _point(point)
+        row = self._row
+        _kernels.query_point(self._floats, self._ints, row, x, y, z)
+        values = row[0].tolist()
+        if values[9] == STATUS_INVALID_INPUT:
+            raise _invalid((x, y, z))
+        validator = self._validator
+        if validator is None or values[7] < 0 or not validator.due():
+            return QueryResult(values, self._names)
+        fcl_distance, discrepancy = validator.check(
+            int(values[7]), values[10:13], values[0], values[1:4])
+        return QueryResult(values, self._names, not math.isnan(fcl_distance), fcl_distance,
+                           discrepancy)
+
+    def query_many(self, points) -> BatchResult:
+        """Signed distance from each of n tip positions to the nearest object (no FCL check).
+
+        Parameters
+        ----------
+        points : (n, 3) float, m, scene frame
+
+        Returns
+        -------
+        BatchResult
+        """
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3:
+            raise ValueError(f'points must have shape (n, 3), got {points.shape}')
+        if not np.all(np.isfinite(points)):
+            bad = int(np.argmin(np.all(np.isfinite(points), axis=1)))
+            raise ValueError(f'points[{bad}] is not finite: {points[bad].tolist()}')
+        rows = np.empty((len(points), _kernels.OUT_SIZE))
+        _kernels.query_points(self._floats, self._ints, points, rows)
+        return BatchResult.from_rows(rows, self._names)
+
+    def query_within(self, point, radius: float) -> list[QueryResult]:
+        """Every object whose signed distance from the tip is at most ``radius``, nearest first.
+
+        Parameters
+        ----------
+        point : (3,) float, m, scene frame
+        radius : float, m
+
+        Returns
+        -------
+        list of QueryResult
+        """
+        x, y, z = _point(point)
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            raise _invalid((x, y, z))
+        if math.isnan(radius):
+            raise ValueError('radius must not be NaN')
+        rows = np.empty((len(self.objects), _kernels.OUT_SIZE))
+        _kernels.query_each_object(self._floats, self._ints, rows, x, y, z)
+        rows = rows[rows[:, 0] <= radius]
+        rows = rows[np.argsort(rows[:, 0], kind='stable')]
+        return [QueryResult(row, self._names) for row in rows.tolist()]
+
+    def __repr__(self) -> str:
+        return f'Scene(frame_id={self.frame_id!r}, objects={list(self._names)})'
+
+
+def load_scene(path, *, request: DistanceRequest | None = None,
+               check_self_intersection: bool | None = None) -> Scene:
+    """Read a scene file and build its scene, warmed up.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The YAML scene (format in ``scene_file``).
+    request : DistanceRequest, optional
+        Tolerances and iteration caps.
+    check_self_intersection : bool, optional
+        Reject self-intersecting meshes (``mesh_io.load_mesh``; needs fcl). By default only
+        when the scene enables FCL cross-validation, so that fcl stays unimported otherwise.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        For a bad scene file (see ``read_scene``).
+    MeshError
+        For a mesh file that cannot carry a signed distance.
+    """
+    spec = read_scene(path)
+    if check_self_intersection is None:
+        check_self_intersection = spec.cross_validation.fcl
+    objects = [SceneObject(o.name, _build_shape(o.shape, check_self_intersection), o.pose,
+                           o.material) for o in spec.objects]
+    scene = Scene(objects, frame_id=spec.frame_id, tip_radius=spec.tip_radius,
+                  request=request, cross_validation=spec.cross_validation)
+    scene.warm_up()
+    return scene
+
+
+def _build_shape(spec, check_self_intersection: bool):
+    if isinstance(spec, BoxSpec):
+        return Box(spec.size)
+    if isinstance(spec, SphereSpec):
+        return Sphere(spec.radius)
+    if isinstance(spec, CylinderSpec):
+        return Cylinder(spec.radius, spec.height)
+    if isinstance(spec, CapsuleSpec):
+        return Capsule(spec.radius, spec.length)
+    from collision_engine.mesh_io import load_mesh
+
+    _import_trimesh_without_fcl()
+    mesh = load_mesh(Path(spec.file), scale=spec.scale,
+                     check_self_intersection=check_self_intersection)
+    convex = mesh.is_convex if spec.convex is None else spec.convex
+    if convex:
+        return ConvexMesh(mesh.vertices)
+    return TriangleMesh(mesh.vertices, mesh.faces, name=str(spec.file))
+
+
+def _import_trimesh_without_fcl() -> None:
+    """Import trimesh with fcl hidden, unless either is loaded already.
+
+    ``import trimesh`` imports fcl when it is installed (for trimesh's collision manager, which
+    nothing here uses), which would load fcl for every mesh scene. Hidden, trimesh keeps a
+    stand-in that raises on use, and a later ``import fcl`` (cross-validation, the mesh
+    self-intersection check) loads the real one.
+    """
+    if 'trimesh' in sys.modules or 'fcl' in sys.modules:
+        return
+    sys.modules['fcl'] = None
+    try:
+        import trimesh  # noqa: F401
+    finally:
+        del sys.modules['fcl']

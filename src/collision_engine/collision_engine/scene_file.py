@@ -1,0 +1,306 @@
+"""The scene file: parse and validate a YAML scene without building any geometry.
+
+Reading a scene imports neither trimesh nor fcl and loads no mesh, so a tool (or the node's
+parameter check) can reject a bad file in milliseconds. Every mistake raises a ``SceneError``
+with one line naming the file and the key path, e.g.
+``cuboid.yaml: objects[0].material.stiffness: must be 3 finite numbers >= 0, got [160, nan]``.
+
+Format (SI units, REP-103 frames; paths relative to the scene file)::
+
+    frame_id: world                 # optional, default world
+    tip_radius: 0.0                 # optional, m: the wand tip is a sphere of this radius
+    cross_validation: {fcl: true, every: 10, tolerance: 1.0e-6}   # optional, default off
+    objects:
+      - name: cuboid                # unique
+        shape: {box: {size: [0.1, 0.1, 0.2]}}
+        pose: {position: [0.0, 0.0, -0.075], rpy: [0.0, 0.0, 0.0]}   # or quaternion: [x, y, z, w]
+        material: {stiffness: [160, 160, 160], damping: [0.8, 0.8, 0.8]}   # optional
+
+Shapes: ``box: {size}``, ``sphere: {radius}``, ``cylinder: {radius, height}`` (axis z),
+``capsule: {radius, length}`` (axis z, ``length`` of the segment), ``mesh: {file, scale,
+convex}`` (``scale`` from file units to m, default 1; ``convex`` true queries the mesh's convex
+hull by GJK, false the exact non-convex surface; omitted, it is detected on load).
+"""
+
+from dataclasses import dataclass
+import difflib
+import math
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from collision_engine.errors import SceneError
+from collision_engine.transforms import Pose
+
+__all__ = ['BoxSpec', 'CapsuleSpec', 'CrossValidationSpec', 'CylinderSpec', 'MaterialSpec',
+           'MeshSpec', 'ObjectSpec', 'SceneSpec', 'SphereSpec', 'read_scene']
+
+
+@dataclass(frozen=True)
+class BoxSpec:
+    """``size``: full edge lengths (3,), m."""
+
+    size: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class SphereSpec:
+    """``radius``, m."""
+
+    radius: float
+
+
+@dataclass(frozen=True)
+class CylinderSpec:
+    """``radius`` and full ``height``, m; axis z."""
+
+    radius: float
+    height: float
+
+
+@dataclass(frozen=True)
+class CapsuleSpec:
+    """``radius`` and segment ``length``, m; axis z."""
+
+    radius: float
+    length: float
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """A mesh file (absolute path), its unit ``scale`` to m, and ``convex`` (None: detect)."""
+
+    file: Path
+    scale: float
+    convex: bool | None
+
+
+@dataclass(frozen=True, eq=False)
+class MaterialSpec:
+    """Per-axis spring-damper gains: ``stiffness`` (3,) N/m, ``damping`` (3,) N s/m."""
+
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+
+@dataclass(frozen=True)
+class CrossValidationSpec:
+    """FCL cross-check of every ``every``-th query, ``tolerance`` m beyond FCL's own error."""
+
+    fcl: bool = False
+    every: int = 1
+    tolerance: float = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class ObjectSpec:
+    """One scene object: ``name``, ``shape`` (a *Spec), ``pose`` (Pose), ``material``."""
+
+    name: str
+    shape: BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec
+    pose: Pose
+    material: MaterialSpec | None
+
+
+@dataclass(frozen=True, eq=False)
+class SceneSpec:
+    """A validated scene file: ``path``, ``frame_id``, ``tip_radius`` m, objects."""
+
+    path: Path
+    frame_id: str
+    tip_radius: float
+    cross_validation: CrossValidationSpec
+    objects: tuple[ObjectSpec, ...]
+
+
+_SHAPE_KEYS = {
+    'box': (('size',), ()),
+    'sphere': (('radius',), ()),
+    'cylinder': (('radius', 'height'), ()),
+    'capsule': (('radius', 'length'), ()),
+    'mesh': (('file',), ('scale', 'convex')),
+}
+
+
+class _Reader:
+    """Typed access to the parsed YAML, failing with the file name and the key path."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def fail(self, where: str, message: str):
+        raise SceneError(f'{self.path.name}: {where}: {message}')
+
+    def mapping(self, value, where: str, required=(), optional=()) -> dict:
+        if not isinstance(value, dict):
+            self.fail(where, f'must be a mapping, got {type(value).__name__} {value!r}')
+        allowed = (*required, *optional)
+        for key in value:
+            if key not in allowed:
+                close = difflib.get_close_matches(str(key), allowed, n=1)
+                hint = f' (did you mean {close[0]!r}?)' if close else ''
+                self.fail(_join(where, key), f'unknown key{hint}; allowed: {", ".join(allowed)}')
+        for key in required:
+            if key not in value:
+                self.fail(_join(where, key), 'missing')
+        return value
+
+    def number(self, value, where: str, *, minimum: float = -math.inf,
+               strict: bool = False) -> float:
+        relation = '>' if strict else '>='
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(where, f'must be a number, got {type(value).__name__} {value!r}')
+        number = float(value)
+        if not math.isfinite(number) or number < minimum or (strict and number == minimum):
+            bound = '' if minimum == -math.inf else f' {relation} {minimum:g}'
+            self.fail(where, f'must be a finite number{bound}, got {value!r}')
+        return number
+
+    def vector(self, value, where: str, length: int, *, minimum: float = -math.inf,
+               strict: bool = False) -> np.ndarray:
+        if not isinstance(value, list) or len(value) != length:
+            self.fail(where, f'must be a list of {length} numbers, got {value!r}')
+        try:
+            numbers = [self.number(v, where, minimum=minimum, strict=strict) for v in value]
+        except SceneError:
+            relation = '>' if strict else '>='
+            bound = '' if minimum == -math.inf else f' {relation} {minimum:g}'
+            self.fail(where, f'must be {length} finite numbers{bound}, got {value!r}')
+        return np.array(numbers)
+
+    def boolean(self, value, where: str) -> bool:
+        if not isinstance(value, bool):
+            self.fail(where, f'must be true or false, got {value!r}')
+        return value
+
+    def text(self, value, where: str) -> str:
+        if not isinstance(value, str) or not value:
+            self.fail(where, f'must be a non-empty string, got {value!r}')
+        return value
+
+
+def _join(where: str, key) -> str:
+    return f'{where}.{key}' if where else str(key)
+
+
+def read_scene(path) -> SceneSpec:
+    """Parse and validate a scene file; build no geometry and load no mesh.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The YAML scene. Mesh files are resolved relative to its folder and must exist.
+
+    Returns
+    -------
+    SceneSpec
+
+    Raises
+    ------
+    SceneError
+        On a missing or unparsable file, an unknown or missing key, a wrong type, a NaN,
+        negative or zero value where a positive one is needed, an unknown shape, a duplicate
+        object name or a missing mesh file; the message names the file and the key path.
+    """
+    path = Path(path)
+    reader = _Reader(path)
+    try:
+        document = yaml.safe_load(path.read_text(encoding='utf-8'))
+    except OSError as error:
+        raise SceneError(f'{path}: cannot read the scene file: {error.strerror}') from None
+    except yaml.YAMLError as error:
+        mark = getattr(error, 'problem_mark', None)
+        at = f'line {mark.line + 1}' if mark is not None else 'document'
+        raise SceneError(f'{path.name}: {at}: not valid YAML: '
+                         f'{getattr(error, "problem", error)}') from None
+    top = reader.mapping(document, '', ('objects',),
+                         ('frame_id', 'tip_radius', 'cross_validation'))
+    frame_id = reader.text(top.get('frame_id', 'world'), 'frame_id')
+    tip_radius = reader.number(top.get('tip_radius', 0.0), 'tip_radius', minimum=0.0)
+    cross_validation = _cross_validation(reader, top.get('cross_validation', {}))
+    if not isinstance(top['objects'], list):
+        reader.fail('objects', f'must be a list, got {top["objects"]!r}')
+    objects = tuple(_object(reader, item, f'objects[{i}]')
+                    for i, item in enumerate(top['objects']))
+    names = [o.name for o in objects]
+    for i, name in enumerate(names):
+        if name in names[:i]:
+            reader.fail(f'objects[{i}].name', f'duplicate name {name!r}')
+    return SceneSpec(path, frame_id, tip_radius, cross_validation, objects)
+
+
+def _cross_validation(reader: _Reader, value) -> CrossValidationSpec:
+    where = 'cross_validation'
+    fields = reader.mapping(value, where, (), ('fcl', 'every', 'tolerance'))
+    every = fields.get('every', 1)
+    if isinstance(every, bool) or not isinstance(every, int) or every < 1:
+        reader.fail(f'{where}.every', f'must be an integer >= 1, got {every!r}')
+    return CrossValidationSpec(
+        fcl=reader.boolean(fields.get('fcl', False), f'{where}.fcl'),
+        every=every,
+        tolerance=reader.number(fields.get('tolerance', 1e-6), f'{where}.tolerance',
+                                minimum=0.0, strict=True))
+
+
+def _object(reader: _Reader, value, where: str) -> ObjectSpec:
+    fields = reader.mapping(value, where, ('name', 'shape'), ('pose', 'material'))
+    name = reader.text(fields['name'], f'{where}.name')
+    shape = _shape(reader, fields['shape'], f'{where}.shape')
+    pose = _pose(reader, fields.get('pose', {}), f'{where}.pose')
+    material = None
+    if fields.get('material') is not None:
+        material = _material(reader, fields['material'], f'{where}.material')
+    return ObjectSpec(name, shape, pose, material)
+
+
+def _shape(reader: _Reader, value, where: str):
+    fields = reader.mapping(value, where, (), tuple(_SHAPE_KEYS))
+    if len(fields) != 1:
+        reader.fail(where, f'must name exactly one shape of {", ".join(_SHAPE_KEYS)}, '
+                    f'got {list(fields) or "none"}')
+    (kind, params), = fields.items()
+    where = f'{where}.{kind}'
+    params = reader.mapping(params, where, *_SHAPE_KEYS[kind])
+
+    def length(key):
+        return reader.number(params[key], f'{where}.{key}', minimum=0.0, strict=True)
+
+    if kind == 'box':
+        size = reader.vector(params['size'], f'{where}.size', 3, minimum=0.0, strict=True)
+        return BoxSpec(tuple(size.tolist()))
+    if kind == 'sphere':
+        return SphereSpec(length('radius'))
+    if kind == 'cylinder':
+        return CylinderSpec(length('radius'), length('height'))
+    if kind == 'capsule':
+        return CapsuleSpec(length('radius'), length('length'))
+    file = reader.path.parent / reader.text(params['file'], f'{where}.file')
+    if not file.is_file():
+        reader.fail(f'{where}.file', f'no such file: {file}')
+    scale = reader.number(params.get('scale', 1.0), f'{where}.scale', minimum=0.0, strict=True)
+    convex = params.get('convex')
+    if convex is not None:
+        convex = reader.boolean(convex, f'{where}.convex')
+    return MeshSpec(file.resolve(), scale, convex)
+
+
+def _pose(reader: _Reader, value, where: str) -> Pose:
+    fields = reader.mapping(value, where, (), ('position', 'rpy', 'quaternion'))
+    if 'rpy' in fields and 'quaternion' in fields:
+        reader.fail(where, 'give rpy or quaternion, not both')
+    position = reader.vector(fields.get('position', [0.0, 0.0, 0.0]), f'{where}.position', 3)
+    if 'quaternion' in fields:
+        quaternion = reader.vector(fields['quaternion'], f'{where}.quaternion', 4)
+        if np.linalg.norm(quaternion) < 1e-9:
+            reader.fail(f'{where}.quaternion', f'must be non-zero, got {fields["quaternion"]}')
+        return Pose.from_quaternion(position, quaternion)
+    rpy = reader.vector(fields.get('rpy', [0.0, 0.0, 0.0]), f'{where}.rpy', 3)
+    return Pose.from_rpy(position, rpy)
+
+
+def _material(reader: _Reader, value, where: str) -> MaterialSpec:
+    fields = reader.mapping(value, where, ('stiffness', 'damping'))
+    return MaterialSpec(
+        stiffness=reader.vector(fields['stiffness'], f'{where}.stiffness', 3, minimum=0.0),
+        damping=reader.vector(fields['damping'], f'{where}.damping', 3, minimum=0.0))
