@@ -116,3 +116,27 @@ def recover(path: pathlib.Path, typestore: Typestore) -> pathlib.Path:
     finally:
         writer.close()
     return target
+
+
+def main(argv=None) -> int:
+    """``haptic_bag info|recover DIR``: bag tools for machines without ``ros2 bag``."""
+    import argparse
+    import sys
+
+    from haptic_bringup.recorder import custom_definitions
+    from haptic_bringup.session import topic_counts
+
+    parser = argparse.ArgumentParser(prog='haptic_bag', description=main.__doc__)
+    parser.add_argument('command', choices=['info', 'recover'])
+    parser.add_argument('bag', type=pathlib.Path)
+    args = parser.parse_args(argv)
+    try:
+        if args.command == 'recover':
+            args.bag = recover(args.bag, typestore_with(custom_definitions()))
+            print(f'recovered into {args.bag}')
+        for topic, count in sorted(topic_counts(args.bag).items()):
+            print(f'{topic}: {count} messages')
+    except (ValueError, OSError) as error:
+        print(f'haptic_bag: {args.bag}: {error}', file=sys.stderr)
+        return 1
+    return 0
