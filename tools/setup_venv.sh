@@ -53,4 +53,11 @@ done
 
 "$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, collision_engine, force_renderer, \
 haptic_wand_driver, haptic_bringup" || { echo "[setup] import check failed"; exit 1; }
+step "compiling the collision kernels once (numba caches them for every later start)"
+"$venv/bin/python" -c "
+import pathlib
+from collision_engine import load_scene
+for scene in sorted(pathlib.Path('src/collision_engine/scenes').glob('*.yaml')):
+    load_scene(scene)
+"
 step "done: $venv"

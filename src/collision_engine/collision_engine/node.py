@@ -7,10 +7,9 @@ Subscribes ``wand/pose`` (PoseStamped) and publishes, per pose, ``collision/stat
 """
 import time
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.node import Node
-from std_msgs.msg import Header, String
+from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from collision_engine import load_scene, read_scene
@@ -19,6 +18,7 @@ from collision_engine.conversions import (fill_invalid_state, fill_state, Invali
 from collision_engine.markers import contact_markers, scene_markers
 from collision_engine.params import CollisionNodeParams
 from haptic_msgs.msg import CollisionState, CollisionStateArray
+from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
@@ -58,8 +58,7 @@ class CollisionNode(Node):
 
         description = self.create_publisher(String, 'scene/description', LATCHED_QOS)
         description.publish(String(data=scene_path.read_text()))
-        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        self.create_timer(self.params.diagnostics_period, self.publish_diagnostics)
+        self.diagnostics = Diagnostics(self, self.report, self.params.diagnostics_period)
         if self.params.marker_rate > 0:
             self._marker_pub = self.create_publisher(MarkerArray, 'collision/markers', MARKER_QOS)
             self._scene_markers = scene_markers(read_scene(scene_path))
@@ -104,29 +103,25 @@ class CollisionNode(Node):
             marker.header.stamp = stamp
         self._marker_pub.publish(markers)
 
-    def publish_diagnostics(self) -> None:
+    def report(self) -> Report:
+        """Counts and the FCL cross-validation totals, for /diagnostics."""
         stats = self.scene.cross_validation_stats
-        values = {'objects': len(self.scene.objects), 'invalid_poses': self._invalid_poses}
+        values = {'objects': len(self.scene.objects),
+                  'published': self._answered + self._invalid_poses,
+                  'invalid_poses': self._invalid_poses}
         if stats is None:
-            level, message = DiagnosticStatus.OK, 'FCL cross-validation off'
-        else:
-            level = DiagnosticStatus.WARN if stats.disagreements else DiagnosticStatus.OK
-            message = f'{stats.disagreements} FCL disagreement(s) in {stats.checks} check(s)'
-            values.update(fcl_checks=stats.checks, fcl_disagreements=stats.disagreements,
-                          fcl_max_discrepancy_m=stats.max_discrepancy, fcl_errors=stats.errors)
-        status = DiagnosticStatus(
-            level=level, name=f'{self.get_name()}: collision', hardware_id='scene',
-            message=message, values=[KeyValue(key=k, value=str(v)) for k, v in values.items()])
-        self._diagnostics_pub.publish(DiagnosticArray(
-            header=self._diagnostics_header(), status=[status]))
+            return Report(OK, 'FCL cross-validation off', values)
+        values.update(fcl_checks=stats.checks, fcl_disagreements=stats.disagreements,
+                      fcl_max_discrepancy_m=stats.max_discrepancy, fcl_errors=stats.errors)
+        return Report(WARN if stats.disagreements else OK,
+                      f'{stats.disagreements} FCL disagreement(s) in {stats.checks} check(s)',
+                      values)
 
     def destroy_node(self) -> bool:
-        self.get_logger().info(f'published {self._answered} states, refused '
-                               f'{self._invalid_poses} poses')
+        self.diagnostics.final()
+        self.get_logger().info(f'answered {self._answered} poses, refused '
+                               f'{self._invalid_poses}')
         return super().destroy_node()
-
-    def _diagnostics_header(self) -> Header:
-        return Header(stamp=self.get_clock().now().to_msg(), frame_id=self.scene.frame_id)
 
 
 def main(args=None) -> int:

@@ -19,6 +19,7 @@ from force_renderer.proxy import GodObjectProxy
 from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
 from haptic_msgs.msg import CollisionState
+from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
@@ -29,6 +30,7 @@ __all__ = ['ForceNode', 'main']
 
 WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
+DIAGNOSTICS_PERIOD = 1.0  # [s]
 
 
 class ForceNode(Node):
@@ -54,6 +56,7 @@ class ForceNode(Node):
         self._header = None
         self._twist = None
         self._published = 0
+        self._zeroed = 0
         self._wrench = WrenchStamped()
         self._wrench_pub = self.create_publisher(WrenchStamped, 'wand/wrench', HAPTIC_STREAM_QOS)
         self.create_subscription(CollisionState, 'collision/state', self.on_state,
@@ -63,6 +66,7 @@ class ForceNode(Node):
             self.create_subscription(TwistStamped, 'wand/twist', self.on_twist,
                                      HAPTIC_STREAM_QOS)
         self.create_timer(params.watchdog_timeout / 2, self.check_stale)
+        self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
         if params.marker_rate > 0:
             self._marker_pub = self.create_publisher(Marker, 'wand/force_marker', MARKER_QOS)
             self.create_timer(1.0 / params.marker_rate, self.publish_marker)
@@ -125,6 +129,7 @@ class ForceNode(Node):
         force = self.pipeline.step(self._contact, velocity, now)
         reason = self.pipeline.last_reason
         if reason is not Reason.OK:
+            self._zeroed += 1
             self.get_logger().warn(f'force zeroed: {reason.value}',
                                    throttle_duration_sec=WARN_PERIOD)
         wrench = self._wrench
@@ -161,7 +166,18 @@ class ForceNode(Node):
         marker.pose.orientation.w = 1.0
         self._marker_pub.publish(marker)
 
+    def report(self) -> Report:
+        """Counts, the watchdog's last word and the passivity energy, for /diagnostics."""
+        reason = self.pipeline.last_reason
+        values = {'law': self.params.law, 'published': self._published,
+                  'zeroed': self._zeroed, 'last_reason': reason.value}
+        if self.pipeline.passivity is not None:
+            values['passivity_energy_j'] = self.pipeline.passivity.energy
+        level = OK if reason in (Reason.OK, Reason.NO_STATE) else WARN
+        return Report(level, f'force {reason.value}', values)
+
     def destroy_node(self) -> bool:
+        self.diagnostics.final()
         self.get_logger().info(f'published {self._published} wrenches')
         return super().destroy_node()
 

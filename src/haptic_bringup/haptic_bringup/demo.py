@@ -19,7 +19,8 @@ from haptic_bringup.bag import typestore_with
 from haptic_bringup.contacts import contact_intervals, format_contacts
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import read_session, topic_counts
+from haptic_bringup.session import (published_counts, PUBLISHERS, read_session,
+                                    topic_counts)
 
 __all__ = ['main', 'EXPERIMENTS', 'run_experiment']
 
@@ -52,10 +53,12 @@ def run_experiment(name: str, out: pathlib.Path, *, composed: bool = False,
 
 def summarise(name: str, files: dict) -> str:
     """Summarise one experiment: its contacts and the loop's figures, as text."""
-    session = read_session(files['bag'], typestore_with(custom_definitions()))
+    typestore = typestore_with(custom_definitions())
+    session = read_session(files['bag'], typestore)
     contacts = contact_intervals(session)
     loop = np.load(files['stats'])
-    counts = topic_counts(files['bag'])
+    recorded = topic_counts(files['bag'])
+    published = published_counts(files['bag'], typestore)
     lines = [
         f'== {name}: {len(contacts)} contacts in {session.time[-1]:.1f} s ==',
         format_contacts(contacts),
@@ -63,8 +66,9 @@ def summarise(name: str, files: dict) -> str:
         f'{int(loop["poses"])} poses answered, round trip p50 '
         f'{1e3 * float(loop["latency_p50_s"]):.2f} ms, p99 '
         f'{1e3 * float(loop["latency_p99_s"]):.2f} ms',
-        'recorded: ' + ', '.join(f'{topic} {n}' for topic, n in sorted(counts.items()))
-        + f' (driver published {int(loop["published"])} poses)',
+        'published / recorded: ' + ', '.join(
+            f'{topic} {published.get(topic, "?")}/{recorded.get(topic, 0)}'
+            for topic in sorted(published.keys() | (recorded.keys() & PUBLISHERS.keys()))),
     ]
     return '\n'.join(lines)
 

@@ -36,7 +36,7 @@ NODES = {
 COMPOSED_MODULE = 'haptic_bringup.composed'
 RECORDER_MODULE = 'haptic_bringup.recorder'
 DEFAULT_DOMAIN_ID = 42
-DISCOVERY_TIMEOUT = 20.0  # [s] includes importing and warming up the collision kernels
+DISCOVERY_TIMEOUT = 120.0  # [s] includes imports and, on a cold cache, compiling the kernels
 RECORDER_DRAIN = 0.3  # [s] for in-flight messages to reach the recorder before it stops
 DURATION_GRACE = 3.0  # [s] past --duration before the launcher stops a driver that did not
 

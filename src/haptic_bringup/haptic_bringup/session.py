@@ -9,7 +9,11 @@ import pathlib
 import numpy as np
 from rosbags.highlevel import AnyReader
 
-__all__ = ['Session', 'read_session', 'topic_counts']
+__all__ = ['Session', 'read_session', 'topic_counts', 'published_counts', 'PUBLISHERS']
+
+# Which node publishes each stream, by its name in /diagnostics reports.
+PUBLISHERS = {'/wand/pose': 'wand_driver', '/wand/twist': 'wand_driver',
+              '/collision/state': 'collision_engine', '/wand/wrench': 'force_renderer'}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -48,6 +52,22 @@ def topic_counts(path: pathlib.Path) -> dict:
     """Messages per topic in a bag, from its metadata."""
     with AnyReader([pathlib.Path(path)]) as reader:
         return {c.topic: c.msgcount for c in reader.connections}
+
+
+def published_counts(path: pathlib.Path, typestore) -> dict:
+    """Topic → how many messages its node says it published, from its last /diagnostics report.
+
+    Topics whose node left no report (it was killed, or not recorded) are missing.
+    """
+    said = {}
+    with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
+        connections = [c for c in reader.connections if c.topic == '/diagnostics']
+        for connection, _, raw in reader.messages(connections=connections):
+            for status in reader.deserialize(raw, connection.msgtype).status:
+                values = {v.key: v.value for v in status.values}
+                if 'published' in values:
+                    said[status.hardware_id] = int(values['published'])
+    return {topic: said[node] for topic, node in PUBLISHERS.items() if node in said}
 
 
 def read_session(path: pathlib.Path, typestore) -> Session:

@@ -11,6 +11,7 @@ from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
+from haptic_util.diagnostics import Diagnostics, OK, Report
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
@@ -27,6 +28,7 @@ from haptic_wand_driver.wrench_input import WrenchCommand
 __all__ = ['WandDriverNode', 'main']
 
 WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
+DIAGNOSTICS_PERIOD = 1.0  # [s]
 
 
 class Phase(enum.Enum):
@@ -69,6 +71,7 @@ class WandDriverNode(Node):
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
         self.create_timer(1.0 / params.rate, self.tick)
+        self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
         self.get_logger().info(f'{params.device} wand at {params.rate:g} Hz in frame '
                                f'{params.frame_id!r}; waiting for the loop to connect')
 
@@ -172,7 +175,16 @@ class WandDriverNode(Node):
     def on_recorder_ready(self, msg: Bool) -> None:
         self._recorder_ready = msg.data
 
+    def report(self) -> Report:
+        """The session's phase, counts and round trip so far, for /diagnostics."""
+        summary = self.stats.summary()
+        values = {'phase': self._phase.value, 'published': self._published, **summary}
+        return Report(OK, f'{self._phase.value}: {summary["answered_percent"]:.1f} % of '
+                      f'{summary["poses"]} poses answered, p99 '
+                      f'{1e3 * summary["latency_p99_s"]:.2f} ms', values)
+
     def destroy_node(self) -> bool:
+        self.diagnostics.final()
         self.device.close()
         if self.params.stats_file:
             self.stats.save(self.params.stats_file, published=self._published)
