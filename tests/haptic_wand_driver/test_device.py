@@ -162,3 +162,12 @@ def test_package_exports_the_public_api():
         'tests/haptic_wand_driver) is on sys.path before the editable install is consulted')
     for name in haptic_wand_driver.__all__:
         assert hasattr(haptic_wand_driver, name), name
+
+
+@pytest.mark.parametrize('coordinates, rates, name', [
+    ([0.0, 0.0, np.nan, 0.0, 0.0], np.zeros(5), 'WandState coordinates'),
+    (np.zeros(5), np.zeros(4), 'WandState rates'),
+    (np.zeros(6), np.zeros(5), 'WandState coordinates')])
+def test_wand_state_from_coordinates_refuses_naming_the_argument(coordinates, rates, name):
+    with pytest.raises(ValueError, match=name):
+        WandState.from_coordinates(0.0, coordinates, rates)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from haptic_wand_driver.operator import OperatorHand
-from haptic_wand_driver.scripts import WaypointScript
+from haptic_wand_driver.scripts import Target, WaypointScript
 
 LEG = np.array([0.04, -0.02, 0.0, 0.1, -0.2])
 
@@ -35,3 +35,35 @@ def test_no_effort_when_the_tip_follows_a_moving_target():
 def test_rejects_negative_gains_by_name(name):
     with pytest.raises(ValueError, match=name):
         hand(**{name: -1.0})
+
+
+def test_gains_are_read_only_arrays():
+    operator = hand(stiffness=40.0, rotational_stiffness=0.5, damping=2.0,
+                    rotational_damping=0.01)
+    np.testing.assert_array_equal(operator.stiffness, [40.0, 40.0, 40.0, 0.5, 0.5])
+    np.testing.assert_array_equal(operator.damping, [2.0, 2.0, 2.0, 0.01, 0.01])
+    with pytest.raises(ValueError):
+        operator.stiffness[0] = 1.0
+
+
+def test_target_components_are_the_script_target_as_floats():
+    operator = hand()
+    for t in (-1.0, 0.25, 0.5, 0.9, 2.0):
+        coordinates, rates = operator.target_components(t)
+        target = operator.script.target(t)
+        np.testing.assert_array_equal(coordinates, target.coordinates)
+        np.testing.assert_array_equal(rates, target.rates)
+
+
+class _Broken:
+    """A script that offers only ``target`` and answers with an infinite rate."""
+
+    duration = 1.0
+
+    def target(self, t):
+        return Target(np.zeros(5), np.array([0.0, np.inf, 0.0, 0.0, 0.0]))
+
+
+def test_a_script_with_only_target_is_checked_naming_it():
+    with pytest.raises(ValueError, match=r'_Broken\.target\(0\.5\)\.rates must be 5 finite'):
+        OperatorHand(_Broken()).target_components(0.5)

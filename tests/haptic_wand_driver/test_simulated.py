@@ -186,3 +186,147 @@ def test_config_rejects_bad_fields_by_name(kwargs, name):
 def test_step_too_long_for_the_hand_is_refused():
     with pytest.raises(ValueError, match='step'):
         SimulatedWand(SimulatedWandConfig(step=0.05), operator=pressing_hand())
+
+
+# A reference integration written from the module docstring with numpy, sharing no code with the
+# module: semi-implicit Euler, device damping implicit, inelastic stops, the hand a spring-damper
+# to a minimum-jerk target, the held wrench saturated and reaching the joints through the roll
+# axis and z.
+
+REFERENCE_WAYPOINTS = np.array([  # t, x, y, z, roll, yaw
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [0.6, 0.02, -0.01, -0.065, 0.1, -0.03],
+    [1.2, 0.02, -0.01, -0.065, 0.1, -0.03],
+    [2.0, -0.03, 0.02, 0.0, -0.25, 0.03],
+    [2.5, -0.03, 0.02, 0.0, -0.25, 0.03],
+])
+REFERENCE_HAND = dict(stiffness=60.0, damping=3.0, rotational_stiffness=0.25,
+                      rotational_damping=0.02)
+REFERENCE_FORCE_LIMIT = 1.0
+REFERENCE_TORQUE_LIMIT = 0.02
+
+
+def reference_target(t):
+    """Minimum-jerk target and its rate at ``t``, as 10 t^3 - 15 t^4 + 6 t^5 per leg."""
+    times, points = REFERENCE_WAYPOINTS[:, 0], REFERENCE_WAYPOINTS[:, 1:]
+    if t <= times[0]:
+        return points[0], np.zeros(5)
+    if t >= times[-1]:
+        return points[-1], np.zeros(5)
+    leg = np.flatnonzero(times <= t)[-1]
+    span = times[leg + 1] - times[leg]
+    tau = (t - times[leg]) / span
+    shape = 10 * tau ** 3 - 15 * tau ** 4 + 6 * tau ** 5
+    slope = (30 * tau ** 2 - 60 * tau ** 3 + 30 * tau ** 4) / span
+    change = points[leg + 1] - points[leg]
+    return points[leg] + shape * change, slope * change
+
+
+def reference_wrench(position, velocity, yaw, t):
+    """A wall below, a push up into the top stop for a while, and a torque with a pitch part."""
+    wall = HalfSpace([0.0, 0.0, SURFACE_HEIGHT], [0.0, 0.0, 1.0])
+    force = wall_force(wall, position, velocity) + ([0.0, 0.0, 3.0] if 1.9 < t < 2.2 else 0.0)
+    torque = rotation_z(yaw) @ [0.03 * np.sin(4.0 * t), 0.01, 0.015]
+    return force, torque
+
+
+def reference_run(config, times):
+    """States (coordinates, rates) at each of ``times``, the wrench applied after each read."""
+    stiffness = np.array([REFERENCE_HAND['stiffness']] * 3
+                         + [REFERENCE_HAND['rotational_stiffness']] * 2)
+    damping = np.array([REFERENCE_HAND['damping']] * 3
+                       + [REFERENCE_HAND['rotational_damping']] * 2)
+    mass = np.array([*config.mass, config.roll_inertia, config.yaw_inertia])
+    device_damping = np.array([*config.damping, config.roll_damping, config.yaw_damping])
+    workspace = config.limits.workspace
+    lower = np.array([*workspace.lower, -workspace.roll_limit, -workspace.yaw_limit])
+    upper = np.array([*workspace.upper, workspace.roll_limit, workspace.yaw_limit])
+    q, v = np.zeros(5), np.zeros(5)
+    force, torque = np.zeros(3), np.zeros(3)
+    substeps, states = 0, []
+    for now in times:
+        while (substeps + 1) * config.step <= now - times[0] + 1e-9:
+            t = substeps * config.step
+            goal, goal_rate = reference_target(t)
+            roll_axis = np.array([np.cos(q[4]), np.sin(q[4]), 0.0])
+            effort = (np.concatenate([force, [roll_axis @ torque, torque[2]]])
+                      + stiffness * (goal - q) + damping * (goal_rate - v))
+            v = (v + config.step * effort / mass) / (1.0 + config.step * device_damping / mass)
+            q = q + config.step * v
+            v[((q < lower) & (v < 0.0)) | ((q > upper) & (v > 0.0))] = 0.0
+            q = np.minimum(np.maximum(q, lower), upper)
+            substeps += 1
+        states.append((q.copy(), v.copy()))
+        force, torque = reference_wrench(q[:3], v[:3], q[4], substeps * config.step)
+        for name, limit in (('force', REFERENCE_FORCE_LIMIT), ('torque', REFERENCE_TORQUE_LIMIT)):
+            vector = force if name == 'force' else torque
+            length = np.sqrt(np.sum(vector ** 2))
+            scaled = vector * (limit / length) if length > limit else vector
+            force, torque = (scaled, torque) if name == 'force' else (force, scaled)
+    return states
+
+
+def test_simulation_matches_a_reference_integration():
+    workspace = Workspace(lower=[-0.15, -0.15, -0.15], upper=[0.15, 0.15, 0.01],
+                          roll_limit=0.25, yaw_limit=0.04)
+    config = SimulatedWandConfig(limits=DeviceLimits(REFERENCE_FORCE_LIMIT,
+                                                     REFERENCE_TORQUE_LIMIT, workspace))
+    script = WaypointScript(REFERENCE_WAYPOINTS[:, 0], REFERENCE_WAYPOINTS[:, 1:],
+                            workspace=workspace)
+    wand = SimulatedWand(config, operator=OperatorHand(script, **REFERENCE_HAND))
+    times = np.arange(0.0, 3.0, TICK) + np.random.default_rng(3).uniform(0.0, 0.3 * TICK, 3000)
+    times[0] = 0.0
+    states = run(wand, 0.0, lambda s: reference_wrench(s.position, s.linear_velocity, s.yaw,
+                                                       s.time), times=times)
+    expected = reference_run(config, times)
+    coordinates = np.array([s.coordinates for s in states])
+    rates = np.array([s.rates for s in states])
+    np.testing.assert_allclose(coordinates, [q for q, _ in expected], rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(rates, [v for _, v in expected], rtol=0.0, atol=1e-12)
+    # The run exercises what it claims to: the wall, and stops at both ends.
+    assert coordinates[:, 2].min() < SURFACE_HEIGHT
+    assert coordinates[:, 2].max() == workspace.upper[2]
+    assert coordinates[:, 3].min() == -workspace.roll_limit
+    assert coordinates[:, 4].max() == workspace.yaw_limit
+
+
+class _TargetOnly:
+    """A script that offers only ``target(t)``, as a third-party script may."""
+
+    def __init__(self, script, spoil_after=np.inf):
+        self._script, self._spoil_after = script, spoil_after
+        self.duration = script.duration
+
+    def target(self, t):
+        target = self._script.target(t)
+        if t > self._spoil_after:
+            return type(target)(target.coordinates * np.nan, target.rates)
+        return target
+
+
+def wall_contact(state):
+    wall = HalfSpace([0.0, 0.0, SURFACE_HEIGHT], [0.0, 0.0, 1.0])
+    return wall_force(wall, state.position, state.linear_velocity), np.zeros(3)
+
+
+def test_a_script_with_only_target_moves_the_hand_the_same_way():
+    waypoints = pressing_hand().script
+    expected = run(SimulatedWand(operator=OperatorHand(waypoints)), 1.0, wall_contact)
+    states = run(SimulatedWand(operator=OperatorHand(_TargetOnly(waypoints))), 1.0, wall_contact)
+    for a, b in zip(expected, states):
+        np.testing.assert_array_equal(a.coordinates, b.coordinates)
+        np.testing.assert_array_equal(a.rates, b.rates)
+
+
+def test_a_script_giving_nan_stops_the_wand_with_an_error_naming_it():
+    wand = SimulatedWand(operator=OperatorHand(_TargetOnly(pressing_hand().script, 0.2)))
+    wand.read(0.0)
+    with pytest.raises(ValueError, match=r'_TargetOnly\.target\(.*coordinates must be 5 finite'):
+        wand.read(0.5)
+
+
+def test_states_are_read_only():
+    state = SimulatedWand(operator=pressing_hand()).read(0.0)
+    for vector in (state.position, state.linear_velocity):
+        with pytest.raises(ValueError):
+            vector[0] = 1.0

@@ -1,12 +1,12 @@
 """WrenchCommand: staleness, NaN, order, saturation and the actuated-DOF projection."""
 
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
 from wand_ground_truth import rotation_z
 
-from haptic_wand_driver.wrench_input import saturate, WrenchCommand
+from haptic_wand_driver.wrench_input import saturate, saturate_components, WrenchCommand
 
 components = st.floats(-50.0, 50.0)
 vectors = st.tuples(components, components, components).map(np.array)
@@ -72,6 +72,7 @@ def test_wrench_from_the_future_is_ignored():
 
 @settings(max_examples=60, deadline=None)
 @given(vectors, st.floats(0.0, 20.0))
+@example(np.array([0.0, 0.0, 1.4487731358402805e-214]), 0.0)  # its square underflows to 0
 def test_saturate_keeps_direction_and_bounds_the_norm(vector, limit):
     result = saturate(vector, limit)
     norm = np.linalg.norm(vector)
@@ -112,3 +113,11 @@ def test_torque_saturates_after_projection():
 def test_rejects_bad_settings_by_name(name):
     with pytest.raises(ValueError, match=name):
         command(**{name: -1.0})
+
+
+@settings(max_examples=60, deadline=None)
+@given(vectors, st.floats(0.0, 20.0))
+def test_saturate_components_is_saturate_on_floats(vector, limit):
+    components = saturate_components(tuple(vector.tolist()), limit)
+    assert all(type(c) is float for c in components)
+    np.testing.assert_array_equal(components, saturate(vector, limit))

@@ -104,7 +104,7 @@ class CollisionNode(Node):
         self._marker_pub.publish(markers)
 
     def report(self) -> Report:
-        """Counts and the FCL cross-validation totals, for /diagnostics."""
+        """Report counts and the FCL cross-validation totals, for /diagnostics."""
         stats = self.scene.cross_validation_stats
         values = {'objects': len(self.scene.objects),
                   'published': self._answered + self._invalid_poses,

@@ -167,7 +167,7 @@ class ForceNode(Node):
         self._marker_pub.publish(marker)
 
     def report(self) -> Report:
-        """Counts, the watchdog's last word and the passivity energy, for /diagnostics."""
+        """Report counts, the watchdog's last word and the passivity energy."""
         reason = self.pipeline.last_reason
         values = {'law': self.params.law, 'published': self._published,
                   'zeroed': self._zeroed, 'last_reason': reason.value}

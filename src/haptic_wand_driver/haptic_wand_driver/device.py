@@ -30,12 +30,13 @@ Lifetime
 import abc
 from dataclasses import dataclass, field
 import importlib
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number, finite_vector
-from haptic_wand_driver.orientation import quaternion_from_roll_yaw, roll_yaw_jacobian
+from haptic_wand_driver._checks import (checked_number, finite_components, finite_vector,
+                                        read_only_vector)
+from haptic_wand_driver.orientation import quaternion_from_roll_yaw, roll_axis
 
 __all__ = [
     'DeviceClosedError',
@@ -165,18 +166,33 @@ class WandState:
     def from_coordinates(cls, time: float, coordinates: np.ndarray,
                          rates: np.ndarray) -> 'WandState':
         """Build from joint coordinates and rates, both (5,): (x, y, z, roll, yaw) and d/dt."""
-        return cls(time=time, position=coordinates[:3], roll=coordinates[3], yaw=coordinates[4],
-                   linear_velocity=rates[:3], roll_rate=rates[3], yaw_rate=rates[4])
+        return cls._from_checked(checked_number(time, 'WandState.time'),
+                                 finite_components(coordinates, 5, 'WandState coordinates'),
+                                 finite_components(rates, 5, 'WandState rates'))
+
+    @classmethod
+    def _from_checked(cls, time: float, coordinates: Sequence[float],
+                      rates: Sequence[float]) -> 'WandState':
+        """Build from floats the caller vouches are finite: a device's per-tick constructor.
+
+        It skips the dataclass checks, which cost more than a simulated substep.
+        """
+        vectors = read_only_vector((*coordinates[:3], *rates[:3]))
+        state = object.__new__(cls)
+        state.__dict__.update({'time': time, 'position': vectors[:3], 'roll': coordinates[3],
+                               'yaw': coordinates[4], 'linear_velocity': vectors[3:],
+                               'roll_rate': rates[3], 'yaw_rate': rates[4]})
+        return state
 
     @property
     def coordinates(self) -> np.ndarray:
         """(5,) float: x, y, z [m], roll, yaw [rad]."""
-        return np.concatenate([self.position, [self.roll, self.yaw]])
+        return np.array([*self.position.tolist(), self.roll, self.yaw])
 
     @property
     def rates(self) -> np.ndarray:
         """(5,) float: linear velocity [m/s], roll rate, yaw rate [rad/s]."""
-        return np.concatenate([self.linear_velocity, [self.roll_rate, self.yaw_rate]])
+        return np.array([*self.linear_velocity.tolist(), self.roll_rate, self.yaw_rate])
 
     @property
     def orientation(self) -> np.ndarray:
@@ -186,7 +202,9 @@ class WandState:
     @property
     def angular_velocity(self) -> np.ndarray:
         """(3,) float, rad/s, world frame: roll_rate about the roll axis plus yaw_rate about z."""
-        return roll_yaw_jacobian(self.yaw) @ np.array([self.roll_rate, self.yaw_rate])
+        x, y, z = roll_axis(self.yaw)
+        return np.array([self.roll_rate * x, self.roll_rate * y,
+                         self.roll_rate * z + self.yaw_rate])
 
 
 class HapticDevice(abc.ABC):

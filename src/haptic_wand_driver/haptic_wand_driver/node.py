@@ -176,7 +176,7 @@ class WandDriverNode(Node):
         self._recorder_ready = msg.data
 
     def report(self) -> Report:
-        """The session's phase, counts and round trip so far, for /diagnostics."""
+        """Report the session's phase, counts and round trip so far, for /diagnostics."""
         summary = self.stats.summary()
         values = {'phase': self._phase.value, 'published': self._published, **summary}
         return Report(OK, f'{self._phase.value}: {summary["answered_percent"]:.1f} % of '

@@ -7,12 +7,34 @@ surface, k_hand · 0.01 / (k_hand + k_wall), and the tip rests on the wall; with
 would follow the hand to the target.
 """
 
+from typing import Callable
+
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number
-from haptic_wand_driver.scripts import Script
+from haptic_wand_driver._checks import checked_number, finite_components, read_only_vector
+from haptic_wand_driver.scripts import Script, TargetComponents
 
-__all__ = ['OperatorHand']
+__all__ = ['OperatorHand', 'impedance']
+
+
+def impedance(stiffness, damping, target, target_rate, coordinate, rate):
+    """Return the spring-damper effort pulling a joint toward a moving target.
+
+    Plain arithmetic, so it takes floats (the simulated wand's substeps, one joint at a time)
+    and arrays (:meth:`OperatorHand.effort`, every joint at once) alike.
+
+    Parameters
+    ----------
+    stiffness : float or (5,) float, N/m or N·m/rad
+    damping : float or (5,) float, N·s/m or N·m·s/rad
+    target, coordinate : float or (5,) float, m or rad
+    target_rate, rate : float or (5,) float, m/s or rad/s
+
+    Returns
+    -------
+    effort : float or (5,) float, N or N·m
+    """
+    return stiffness * (target - coordinate) + damping * (target_rate - rate)
 
 
 class OperatorHand:
@@ -34,15 +56,30 @@ class OperatorHand:
 
     def __init__(self, script: Script, *, stiffness: float = 50.0, damping: float = 3.5,
                  rotational_stiffness: float = 0.3, rotational_damping: float = 0.017):
-        for name, value in (('stiffness', stiffness), ('damping', damping),
-                            ('rotational_stiffness', rotational_stiffness),
-                            ('rotational_damping', rotational_damping)):
+        stiffness, damping, rotational_stiffness, rotational_damping = (
             checked_number(value, f'OperatorHand {name}', minimum=0.0)
-        self.script = script
-        self.stiffness = np.array([stiffness] * 3 + [rotational_stiffness] * 2, dtype=float)
-        """(5,) float: N/m on x, y, z, N·m/rad on roll, yaw."""
-        self.damping = np.array([damping] * 3 + [rotational_damping] * 2, dtype=float)
-        """(5,) float: N·s/m on x, y, z, N·m·s/rad on roll, yaw."""
+            for name, value in (('stiffness', stiffness), ('damping', damping),
+                                ('rotational_stiffness', rotational_stiffness),
+                                ('rotational_damping', rotational_damping)))
+        self._script = script
+        self._target_components = _float_target(script)
+        self._stiffness = read_only_vector([stiffness] * 3 + [rotational_stiffness] * 2)
+        self._damping = read_only_vector([damping] * 3 + [rotational_damping] * 2)
+
+    @property
+    def script(self) -> Script:
+        """The script the hand follows."""
+        return self._script
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        """(5,) float, read-only: N/m on x, y, z, N·m/rad on roll, yaw."""
+        return self._stiffness
+
+    @property
+    def damping(self) -> np.ndarray:
+        """(5,) float, read-only: N·s/m on x, y, z, N·m·s/rad on roll, yaw."""
+        return self._damping
 
     def effort(self, t: float, coordinates: np.ndarray, rates: np.ndarray) -> np.ndarray:
         """Return the hand's generalized force on the wand's joints.
@@ -61,6 +98,27 @@ class OperatorHand:
         effort : (5,) float
             Force on x, y, z [N] and torque on roll, yaw [N·m].
         """
-        target = self.script.target(t)
-        return (self.stiffness * (target.coordinates - coordinates)
-                + self.damping * (target.rates - rates))
+        target = self._script.target(t)
+        return impedance(self._stiffness, self._damping, target.coordinates, target.rates,
+                         coordinates, rates)
+
+    def target_components(self, t: float) -> TargetComponents:
+        """Return the script's target at ``t`` (s) as finite floats, for the wand's substeps.
+
+        A waypoint script's targets are finite by construction; any other script's are checked.
+        """
+        return self._target_components(t)
+
+
+def _float_target(script: Script) -> Callable[[float], TargetComponents]:
+    """Return the script's own ``target_components``, or its ``target`` as checked floats."""
+    components = getattr(script, 'target_components', None)
+    if components is not None:
+        return components
+
+    def checked_target(t: float) -> TargetComponents:
+        target = script.target(t)
+        name = f'{type(script).__name__}.target({t!r})'
+        return (finite_components(target.coordinates, 5, f'{name}.coordinates'),
+                finite_components(target.rates, 5, f'{name}.rates'))
+    return checked_target

@@ -8,12 +8,15 @@ Because roll is measured about a yawed axis, the world angular velocity and the 
 the two joints both go through the same (3, 2) Jacobian, :func:`roll_yaw_jacobian`.
 """
 
+import math
+
 import numpy as np
 
 __all__ = [
     'PITCH_TOLERANCE',
     'PitchError',
     'quaternion_from_roll_yaw',
+    'roll_axis',
     'roll_yaw_from_quaternion',
     'roll_yaw_jacobian',
 ]
@@ -43,8 +46,8 @@ def quaternion_from_roll_yaw(roll: float, yaw: float) -> np.ndarray:
     quaternion : (4,) float
         (x, y, z, w), with w >= 0 for |roll|, |yaw| < pi.
     """
-    sin_roll, cos_roll = np.sin(0.5 * roll), np.cos(0.5 * roll)
-    sin_yaw, cos_yaw = np.sin(0.5 * yaw), np.cos(0.5 * yaw)
+    sin_roll, cos_roll = math.sin(0.5 * roll), math.cos(0.5 * roll)
+    sin_yaw, cos_yaw = math.sin(0.5 * yaw), math.cos(0.5 * yaw)
     return np.array([cos_yaw * sin_roll, sin_yaw * sin_roll, sin_yaw * cos_roll,
                      cos_yaw * cos_roll])
 
@@ -86,6 +89,15 @@ def roll_yaw_from_quaternion(quaternion: np.ndarray, *,
     return float(roll), float(yaw)
 
 
+def roll_axis(yaw: float) -> tuple[float, float, float]:
+    """Return the roll joint's world axis at this yaw, (cos yaw, sin yaw, 0), as floats.
+
+    The first column of :func:`roll_yaw_jacobian` (the second is z), for the per-tick paths,
+    where building a (3, 2) array costs more than the arithmetic it carries.
+    """
+    return math.cos(yaw), math.sin(yaw), 0.0
+
+
 def roll_yaw_jacobian(yaw: float) -> np.ndarray:
     """Return the world axes of the roll and yaw joints at this yaw.
 
@@ -102,6 +114,7 @@ def roll_yaw_jacobian(yaw: float) -> np.ndarray:
     jacobian : (3, 2) float
         Columns: the roll axis (cos yaw, sin yaw, 0) and the yaw axis (0, 0, 1), world frame.
     """
-    return np.array([[np.cos(yaw), 0.0],
-                     [np.sin(yaw), 0.0],
-                     [0.0, 1.0]])
+    x, y, z = roll_axis(yaw)
+    return np.array([[x, 0.0],
+                     [y, 0.0],
+                     [z, 1.0]])

@@ -8,18 +8,25 @@ stops only ever remove energy.
 ``read(now)`` advances in fixed substeps of ``step`` seconds with semi-implicit Euler (velocity
 first, the device's own damping implicit), so the trajectory depends only on the wrench applied
 before each substep, never on when ``read`` was called: a jittery timer that reads the same
-instants gets the same states, bit for bit. The held wrench applies from the next substep on.
+instants gets the same states, bit for bit. The held wrench applies from the next substep on,
+and substep k pulls toward the hand's target at k · step seconds of the wand's clock.
+
+The substeps run in the haptic loop's thread, once or twice per 1 kHz tick, so the joints are
+plain floats: numpy's per-call cost on 5-vectors is larger than the arithmetic. Everything that
+enters (the configuration, the applied wrench, the hand's targets) is finite where it enters and
+the stops bound the coordinates, so the states it returns need no second check.
 """
 
 from dataclasses import dataclass, field
+import math
 
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number, finite_vector
+from haptic_wand_driver._checks import checked_number, finite_components, finite_vector
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState
-from haptic_wand_driver.operator import OperatorHand
-from haptic_wand_driver.orientation import roll_yaw_jacobian
-from haptic_wand_driver.wrench_input import saturate
+from haptic_wand_driver.operator import impedance, OperatorHand
+from haptic_wand_driver.orientation import roll_axis
+from haptic_wand_driver.wrench_input import saturate_components
 
 __all__ = ['SimulatedWand', 'SimulatedWandConfig']
 
@@ -93,6 +100,10 @@ class SimulatedWandConfig:
         return np.concatenate([self.initial_position, [self.initial_roll, self.initial_yaw]])
 
 
+_ZERO = (0.0, 0.0, 0.0)
+_NO_TARGET = ((0.0,) * 5, (0.0,) * 5)  # for no hand, whose gains are 0
+
+
 class SimulatedWand(HapticDevice):
     """A 5-DOF wand simulated in real time, moved by an operator's hand and the applied wrench.
 
@@ -106,29 +117,22 @@ class SimulatedWand(HapticDevice):
     def __init__(self, config: SimulatedWandConfig = SimulatedWandConfig(), *,
                  operator: OperatorHand | None = None):
         self._config = config
-        self._inverse_inertia = 1.0 / config.inertia
-        self._damping_decay = 1.0 / (1.0 + config.step * config.joint_damping
-                                     * self._inverse_inertia)
-        self._lower, self._upper = config.limits.workspace.coordinate_bounds
+        inverse_inertia = 1.0 / config.inertia
         if operator is not None:
-            self._check_step_resolves(operator)
+            _check_step_resolves(config.step, operator, inverse_inertia)
         self._operator = operator
-        self._coordinates = config.initial_coordinates
-        self._rates = np.zeros(5)
-        self._force = np.zeros(3)
-        self._torque = np.zeros(3)
+        self._step = config.step
+        damping_decay = 1.0 / (1.0 + config.step * config.joint_damping * inverse_inertia)
+        lower, upper = config.limits.workspace.coordinate_bounds
+        hand_gains = (np.zeros((2, 5)) if operator is None
+                      else np.array([operator.stiffness, operator.damping]))
+        self._joints = list(zip(*hand_gains.tolist(), inverse_inertia.tolist(),
+                                damping_decay.tolist(), lower.tolist(), upper.tolist()))
+        self._coordinates = config.initial_coordinates.tolist()
+        self._rates = [0.0] * 5
+        self._force = self._torque = _ZERO
         self._start: float | None = None
         self._steps_done = 0
-
-    def _check_step_resolves(self, operator: OperatorHand) -> None:
-        step = self._config.step
-        stiffness_ratio = step * np.sqrt(operator.stiffness * self._inverse_inertia).max()
-        damping_ratio = step * (operator.damping * self._inverse_inertia).max()
-        if max(stiffness_ratio, damping_ratio) > _STABLE_STEP:
-            raise ValueError(
-                f'SimulatedWandConfig.step {step} s is too long for the operator hand on this '
-                f'mass: step·sqrt(k/m) = {stiffness_ratio:.3g} and step·c/m = '
-                f'{damping_ratio:.3g} must stay <= {_STABLE_STEP}')
 
     @property
     def limits(self) -> DeviceLimits:
@@ -148,43 +152,70 @@ class SimulatedWand(HapticDevice):
         self._raise_if_closed()
         now = checked_number(now, 'SimulatedWand.read now')
         if self._start is None:
-            self._start = float(now)
+            self._start = now
         elif now < self._time():
             raise ValueError(f'SimulatedWand.read: now {now!r} s is before the last state '
                              f'({self._time()!r} s); the clock must not go back')
-        target_steps = int(np.floor((now - self._start) / self._config.step + 1e-9))
-        while self._steps_done < target_steps:
-            self._substep()
-        return WandState.from_coordinates(self._time(), self._coordinates, self._rates)
+        target_steps = math.floor((now - self._start) / self._step + 1e-9)
+        if target_steps > self._steps_done:
+            self._advance(target_steps)
+        return WandState._from_checked(self._time(), self._coordinates, self._rates)
 
     def apply(self, force: np.ndarray, torque: np.ndarray) -> None:
         """Hold this wrench (N, N·m, workspace frame), saturated to the limits, until the next."""
         self._raise_if_closed()
-        force = finite_vector(force, 3, 'SimulatedWand.apply force')
-        torque = finite_vector(torque, 3, 'SimulatedWand.apply torque')
-        self._force = saturate(force, self.limits.force_limit)
-        self._torque = saturate(torque, self.limits.torque_limit)
+        force = finite_components(force, 3, 'SimulatedWand.apply force')
+        torque = finite_components(torque, 3, 'SimulatedWand.apply torque')
+        limits = self._config.limits
+        self._force = saturate_components(force, limits.force_limit)
+        self._torque = saturate_components(torque, limits.torque_limit)
 
     def close(self) -> None:
         """Drop the held wrench and stop."""
-        self._force = np.zeros(3)
-        self._torque = np.zeros(3)
+        self._force = self._torque = _ZERO
         super().close()
 
     def _time(self) -> float:
-        return self._start + self._steps_done * self._config.step
+        return self._start + self._steps_done * self._step
 
-    def _substep(self) -> None:
-        step = self._config.step
+    def _advance(self, target_steps: int) -> None:
+        """Substep semi-implicit Euler on every joint up to ``target_steps``; stops hold."""
+        step = self._step
+        force_x, force_y, force_z = self._force
+        torque_x, torque_y, torque_z = self._torque
+        hand = None if self._operator is None else self._operator.target_components
+        joints = self._joints
         coordinates, rates = self._coordinates, self._rates
-        joint_torques = roll_yaw_jacobian(coordinates[4]).T @ self._torque
-        effort = np.concatenate([self._force, joint_torques])
-        if self._operator is not None:
-            effort += self._operator.effort(self._time() - self._start, coordinates, rates)
-        rates = (rates + step * effort * self._inverse_inertia) * self._damping_decay
-        coordinates = coordinates + step * rates
-        below, above = coordinates < self._lower, coordinates > self._upper
-        coordinates = np.clip(coordinates, self._lower, self._upper)
-        rates = np.where((below & (rates < 0.0)) | (above & (rates > 0.0)), 0.0, rates)
+        for done in range(self._steps_done, target_steps):
+            roll_x, roll_y, roll_z = roll_axis(coordinates[4])
+            efforts = (force_x, force_y, force_z,  # then roll_yaw_jacobian(yaw).T @ torque
+                       roll_x * torque_x + roll_y * torque_y + roll_z * torque_z, torque_z)
+            targets, target_rates = _NO_TARGET if hand is None else hand(done * step)
+            moved, kept = [], []
+            for (coordinate, rate, effort, target, target_rate,
+                 (stiffness, damping, inverse_inertia, decay, lower, upper)) in zip(
+                    coordinates, rates, efforts, targets, target_rates, joints):
+                effort += impedance(stiffness, damping, target, target_rate, coordinate, rate)
+                rate = (rate + step * effort * inverse_inertia) * decay
+                coordinate += step * rate
+                if coordinate < lower:
+                    coordinate, rate = lower, max(rate, 0.0)
+                elif coordinate > upper:
+                    coordinate, rate = upper, min(rate, 0.0)
+                moved.append(coordinate)
+                kept.append(rate)
+            coordinates, rates = moved, kept
         self._coordinates, self._rates = coordinates, rates
-        self._steps_done += 1
+        self._steps_done = target_steps
+
+
+def _check_step_resolves(step: float, operator: OperatorHand,
+                         inverse_inertia: np.ndarray) -> None:
+    """Refuse a step too long for the hand's explicit spring-damper on this inertia."""
+    stiffness_ratio = step * np.sqrt(operator.stiffness * inverse_inertia).max()
+    damping_ratio = step * (operator.damping * inverse_inertia).max()
+    if max(stiffness_ratio, damping_ratio) > _STABLE_STEP:
+        raise ValueError(
+            f'SimulatedWandConfig.step {step} s is too long for the operator hand on this '
+            f'mass: step·sqrt(k/m) = {stiffness_ratio:.3g} and step·c/m = '
+            f'{damping_ratio:.3g} must stay <= {_STABLE_STEP}')
