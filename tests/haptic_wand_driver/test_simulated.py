@@ -330,3 +330,27 @@ def test_states_are_read_only():
     for vector in (state.position, state.linear_velocity):
         with pytest.raises(ValueError):
             vector[0] = 1.0
+
+
+def test_a_held_force_drops_to_zero_at_its_deadline_without_another_call():
+    """The device-level watchdog: past ``until`` the wand moves as if no force were applied."""
+    config = SimulatedWandConfig(step=5e-4)
+    held = SimulatedWand(config)
+    free = SimulatedWand(config)
+    for wand in (held, free):
+        wand.read(0.0)
+    held.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0], until=0.0035)
+    free.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    assert held.read(0.002).position.tolist() == free.read(0.002).position.tolist()
+    free.read(0.0035)
+    free.apply([0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    for t in (0.0035, 0.01, 0.05):
+        assert held.read(t).position.tolist() == free.read(t).position.tolist()
+    assert held.read(0.05).linear_velocity[0] > 0.0  # the force did act before the deadline
+
+
+def test_a_deadline_already_past_renders_no_force():
+    wand = SimulatedWand(SimulatedWandConfig())
+    wand.read(1.0)
+    wand.apply([5.0, 0.0, 0.0], [0.0, 0.0, 0.0], until=0.5)
+    assert wand.read(1.1).linear_velocity.tolist() == [0.0, 0.0, 0.0]

@@ -1,5 +1,7 @@
 """WrenchCommand: staleness, NaN, order, saturation and the actuated-DOF projection."""
 
+import math
+
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -121,3 +123,12 @@ def test_saturate_components_is_saturate_on_floats(vector, limit):
     components = saturate_components(tuple(vector.tolist()), limit)
     assert all(type(c) is float for c in components)
     np.testing.assert_array_equal(components, saturate(vector, limit))
+
+
+def test_expiry_is_the_stamp_plus_the_timeout_and_minus_infinity_when_nothing_is_held():
+    command = WrenchCommand(force_limit=10.0, torque_limit=1.0, timeout=0.010)
+    assert command.expiry == -math.inf
+    assert command.update([1.0, 0.0, 0.0], [0.0, 0.0, 0.0], stamp=2.0, now=2.001) is None
+    assert command.expiry == pytest.approx(2.010)
+    command.clear()
+    assert command.expiry == -math.inf

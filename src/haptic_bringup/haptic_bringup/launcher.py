@@ -184,6 +184,18 @@ class Loop:
         """Return the first child that has exited, or None."""
         return next((c for c in self.children if c.returncode is not None), None)
 
+    def child(self, name: str):
+        """Return the running child ``name`` (a node, ``composed`` or ``recorder``)."""
+        return next(c for c in self.children if c.name == name)
+
+    def restart(self, name: str):
+        """Start child ``name`` again as it was started (after it died); return it."""
+        old = self.child(name)
+        old.process.wait()
+        new = start_child(name, old.argv, old.env)
+        self.children[self.children.index(old)] = new
+        return new
+
     def pids(self) -> dict:
         return {child.name: child.pid for child in self.children}
 

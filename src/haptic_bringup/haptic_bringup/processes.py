@@ -22,11 +22,13 @@ SHM_DIR = pathlib.Path('/dev/shm')
 
 
 class Child:
-    """A named child process in its own process group."""
+    """A named child process in its own process group, and how to start it again."""
 
-    def __init__(self, name: str, process: subprocess.Popen) -> None:
+    def __init__(self, name: str, process: subprocess.Popen, argv: list, env: dict) -> None:
         self.name = name
         self.process = process
+        self.argv = argv
+        self.env = env
 
     @property
     def pid(self) -> int:
@@ -52,7 +54,7 @@ def start_child(name: str, argv: list, env: dict) -> Child:
     """Start ``argv`` as a new session whose processes die with the launcher."""
     process = subprocess.Popen(argv, env=env, start_new_session=True,
                                preexec_fn=_die_with_parent)
-    return Child(name, process)
+    return Child(name, process, argv, env)
 
 
 def stop_children(children: list, *, timeout: float = 5.0) -> dict:

@@ -19,9 +19,10 @@ Frame and units
     Everything is in the workspace frame (REP-103: x forward, y left, z up; ``world`` by default)
     and in SI: m, s, rad, N, N·m. The position is the tip; the torque is about the tip.
 Wrench
-    ``apply`` holds the wrench (zero-order hold) until the next ``apply``. A backend renders only
-    what it can actuate (forces x, y, z; torques about its roll and yaw axes) and saturates to its
-    declared ``limits``; non-finite or mis-shaped input raises ``ValueError``.
+    ``apply`` holds the wrench (zero-order hold) until the next ``apply``, or until its
+    ``until`` deadline passes, whichever comes first (a device-level watchdog). A backend
+    renders only what it can actuate (forces x, y, z; torques about its roll and yaw axes) and
+    saturates to its declared ``limits``; non-finite or mis-shaped input raises ``ValueError``.
 Lifetime
     ``close`` is idempotent and leaves the device commanding no force; afterwards ``read`` and
     ``apply`` raise :class:`DeviceClosedError`. Devices are context managers.
@@ -30,6 +31,7 @@ Lifetime
 import abc
 from dataclasses import dataclass, field
 import importlib
+import math
 from typing import Callable, Sequence
 
 import numpy as np
@@ -222,8 +224,13 @@ class HapticDevice(abc.ABC):
         """Return the tip state at (or just before) ``now``, seconds on the caller's clock."""
 
     @abc.abstractmethod
-    def apply(self, force: np.ndarray, torque: np.ndarray) -> None:
-        """Hold a wrench until the next call: force (3,) N and torque (3,) N·m, workspace frame."""
+    def apply(self, force: np.ndarray, torque: np.ndarray, *, until: float = math.inf) -> None:
+        """Hold a wrench until the next call: force (3,) N and torque (3,) N·m, workspace frame.
+
+        ``until`` (s, the device's clock) is a watchdog deadline: past it the device renders zero
+        even if no further call comes, so a dead loop cannot leave a force on the user's hand.
+        A backend with a hardware watchdog arms it with this deadline.
+        """
 
     def close(self) -> None:
         """Stop rendering and release the device; idempotent.

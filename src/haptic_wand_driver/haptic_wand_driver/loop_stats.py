@@ -1,9 +1,10 @@
-"""Round-trip book-keeping of the haptic loop, as the driver sees it.
+"""Book-keeping of the haptic loop as the driver sees it: round trips and force drop-outs.
 
 Every wrench carries the stamp of the pose it answers, so the driver, which stamped that pose,
-knows the loop's round trip exactly, on one clock, without any extra traffic. Counted from the
-first pose after ``start()``: poses sent, poses answered (a wrench with that pose's stamp), and
-each answer's latency.
+knows the loop's round trip exactly, on one clock, without any extra traffic: poses sent, poses
+answered (a wrench with that pose's stamp), each answer's latency and arrival time. It also notes
+each instant the applied force started (became non-zero) and stopped (dropped to zero, at the
+watchdog deadline when the wrenches stopped), which is what the fail-safe tests measure.
 """
 import numpy as np
 
@@ -17,6 +18,9 @@ class LoopStats:
         self._sent: set = set()
         self._answered: set = set()
         self._latency_ns: list = []
+        self._arrival_ns: list = []
+        self._force_on_ns: list = []
+        self._force_off_ns: list = []
         self._first_ns = None
         self._last_ns = None
 
@@ -31,6 +35,15 @@ class LoopStats:
         if stamp_ns in self._sent and stamp_ns not in self._answered:
             self._answered.add(stamp_ns)
             self._latency_ns.append(received_ns - stamp_ns)
+            self._arrival_ns.append(received_ns)
+
+    def force_on(self, instant_ns: int) -> None:
+        """Note that the applied force became non-zero at ``instant_ns``."""
+        self._force_on_ns.append(instant_ns)
+
+    def force_off(self, instant_ns: int) -> None:
+        """Note that the applied force dropped to zero at ``instant_ns``."""
+        self._force_off_ns.append(instant_ns)
 
     @property
     def poses(self) -> int:
@@ -70,4 +83,8 @@ class LoopStats:
 
     def save(self, path, **extra) -> None:
         """Write the raw latencies, the summary and ``extra`` figures to an .npz file."""
-        np.savez(path, latencies=self.latencies, **self.summary(), **extra)
+        np.savez(path, latencies=self.latencies,
+                 arrival_ns=np.asarray(self._arrival_ns, dtype=np.int64),
+                 force_on_ns=np.asarray(self._force_on_ns, dtype=np.int64),
+                 force_off_ns=np.asarray(self._force_off_ns, dtype=np.int64),
+                 **self.summary(), **extra)

@@ -6,6 +6,7 @@ each ``wand/wrench`` (WrenchStamped) to the device when it arrives. A wrench old
 it answers, so the driver measures the loop's round trip (``stats_file``).
 """
 import enum
+import math
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from rclpy.node import Node
@@ -61,6 +62,8 @@ class WandDriverNode(Node):
         self._last_probe_ns = -1
         self._published = 0
         self._recorder_ready = False
+        self._pushing = False
+        self._deadline = -math.inf  # [s] when the wrench applied to the device goes stale
         self._pose = PoseStamped()
         self._twist = TwistStamped()
         self._pose.header.frame_id = self._twist.header.frame_id = params.frame_id
@@ -113,7 +116,7 @@ class WandDriverNode(Node):
         elif self._phase is Phase.RUNNING:
             device_now = now - self._device_offset
             state = self._state = self.device.read(device_now)
-            self.device.apply(*self.wrench.current(now, state.yaw))
+            self._apply(now, state.yaw)
             self._publish(state, now_ns)
             self.stats.sent(now_ns)
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
@@ -161,7 +164,22 @@ class WandDriverNode(Node):
         reason = self._take(msg, stamp_ns * 1e-9, now)
         if reason is not None:
             self.get_logger().warn(reason, throttle_duration_sec=WARN_PERIOD)
-        self.device.apply(*self.wrench.current(now, state.yaw))
+        self._apply(now, state.yaw)
+
+    def _apply(self, now: float, yaw: float) -> None:
+        """Apply the held wrench, armed with its staleness deadline as the device's watchdog."""
+        wrench = self.wrench
+        force, torque = wrench.current(now, yaw)
+        pushing = any(force)
+        if self._pushing and not pushing:
+            # The force on the hand dropped at the applied wrench's deadline, if that came first
+            # (the device's watchdog), or now (a zero, stale or refused wrench replaced it).
+            self.stats.force_off(round(1e9 * min(self._deadline, now)))
+        elif pushing and not self._pushing:
+            self.stats.force_on(round(1e9 * now))
+        self._pushing = pushing
+        self._deadline = wrench.expiry
+        self.device.apply(force, torque, until=self._deadline - self._device_offset)
 
     def _take(self, msg: WrenchStamped, stamp: float, now: float):
         """Hand a received wrench to the command; return why it was refused, or None."""

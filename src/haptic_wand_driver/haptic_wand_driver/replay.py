@@ -9,6 +9,7 @@ is interpolated linearly between samples; the velocity comes from differencing t
 applied wrench is accepted and ignored: nothing pushes back on a recording.
 """
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -184,6 +185,6 @@ class ReplayDevice(HapticDevice):
         rates = [np.interp(played, self._times, column) for column in self._rates.T]
         return WandState.from_coordinates(now, np.array(coordinates), np.array(rates))
 
-    def apply(self, force: np.ndarray, torque: np.ndarray) -> None:
+    def apply(self, force: np.ndarray, torque: np.ndarray, *, until: float = math.inf) -> None:
         """Ignore the wrench: a recording cannot be pushed."""
         self._raise_if_closed()

@@ -131,6 +131,7 @@ class SimulatedWand(HapticDevice):
         self._coordinates = config.initial_coordinates.tolist()
         self._rates = [0.0] * 5
         self._force = self._torque = _ZERO
+        self._until = math.inf
         self._start: float | None = None
         self._steps_done = 0
 
@@ -161,14 +162,20 @@ class SimulatedWand(HapticDevice):
             self._advance(target_steps)
         return WandState._from_checked(self._time(), self._coordinates, self._rates)
 
-    def apply(self, force: np.ndarray, torque: np.ndarray) -> None:
-        """Hold this wrench (N, N·m, workspace frame), saturated to the limits, until the next."""
+    def apply(self, force: np.ndarray, torque: np.ndarray, *, until: float = math.inf) -> None:
+        """Hold this wrench (N, N·m, workspace frame), saturated, until the next or ``until``.
+
+        Substeps that start at or after ``until`` (s, the wand's clock) render zero.
+        """
         self._raise_if_closed()
         force = finite_components(force, 3, 'SimulatedWand.apply force')
         torque = finite_components(torque, 3, 'SimulatedWand.apply torque')
+        if math.isnan(until):
+            raise ValueError('SimulatedWand.apply until must not be NaN')
         limits = self._config.limits
         self._force = saturate_components(force, limits.force_limit)
         self._torque = saturate_components(torque, limits.torque_limit)
+        self._until = until
 
     def close(self) -> None:
         """Drop the held wrench and stop."""
@@ -178,6 +185,14 @@ class SimulatedWand(HapticDevice):
     def _time(self) -> float:
         return self._start + self._steps_done * self._step
 
+    def _expiry_step(self) -> float:
+        """The first substep at or after the hold deadline (inf when there is none)."""
+        if self._until == math.inf or self._start is None:
+            return math.inf
+        if self._until == -math.inf:
+            return self._steps_done
+        return max(math.ceil((self._until - self._start) / self._step - 1e-9), self._steps_done)
+
     def _advance(self, target_steps: int) -> None:
         """Substep semi-implicit Euler on every joint up to ``target_steps``; stops hold."""
         step = self._step
@@ -186,7 +201,11 @@ class SimulatedWand(HapticDevice):
         hand = None if self._operator is None else self._operator.target_components
         joints = self._joints
         coordinates, rates = self._coordinates, self._rates
+        expires = self._expiry_step()
         for done in range(self._steps_done, target_steps):
+            if done == expires:  # the watchdog deadline: the held wrench drops to zero
+                force_x = force_y = force_z = torque_x = torque_y = torque_z = 0.0
+                self._force = self._torque = _ZERO
             roll_x, roll_y, roll_z = roll_axis(coordinates[4])
             efforts = (force_x, force_y, force_z,  # then roll_yaw_jacobian(yaw).T @ torque
                        roll_x * torque_x + roll_y * torque_y + roll_z * torque_z, torque_z)

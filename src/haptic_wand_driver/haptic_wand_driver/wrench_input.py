@@ -109,6 +109,11 @@ class WrenchCommand:
         self._force, self._torque, self._stamp = force_components, torque_components, float(stamp)
         return None
 
+    @property
+    def expiry(self) -> float:
+        """When the held wrench goes stale (s, the stamps' clock); -inf when none is held."""
+        return -math.inf if self._stamp is None else self._stamp + self._timeout
+
     def clear(self) -> None:
         """Drop the held wrench: zero force until a good one arrives."""
         self._stamp = None
