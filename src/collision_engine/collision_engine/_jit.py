@@ -6,9 +6,10 @@ process loads machine code from ``__pycache__`` instead of compiling (seconds sa
 ``best = inf``. ``error_model='numpy'`` makes a division by zero give inf/NaN (which the kernels
 test for) instead of raising from compiled code.
 
-numba keys a cached kernel on its own file only, yet the entry points inline the kernels of
-other modules: after an edit to ``gjk.py`` the cached ``_kernels`` code would silently be the
-old algorithm. So the package's cache files are dropped whenever any kernel module changes.
+numba keys a cached kernel on its own file only, yet an entry point's cached machine code
+includes the kernels it calls from other modules: after an edit to ``gjk.py`` the cached
+``_kernels`` code would silently be the old algorithm. So the package's cache files are dropped
+whenever any kernel module changes.
 """
 
 import hashlib
@@ -43,15 +44,6 @@ def _drop_stale_cache() -> None:
 _drop_stale_cache()
 
 
-def jit(function=None, *, inline: bool = False):
-    """Compile ``function`` with the engine's numba options (see the module docstring).
-
-    ``inline=True`` makes numba inline the function into its callers: for the small helpers of
-    the hot path, a real call passing arrays costs more (reference counting) than their work.
-    """
-    options = dict(cache=True, error_model='numpy', nogil=True)
-    if inline:
-        options['inline'] = 'always'
-    if function is None:
-        return njit(**options)
-    return njit(**options)(function)
+def jit(function):
+    """Compile ``function`` with the engine's numba options (see the module docstring)."""
+    return njit(cache=True, error_model='numpy', nogil=True)(function)

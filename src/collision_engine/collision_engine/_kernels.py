@@ -9,7 +9,7 @@ Packed scene layout
 ``floats``: ``[tip radius, rel_tol, abs_tol, scratch offset]``, then per object a record of
 ``OBJECT_FLOATS`` values: rotation (9, row-major, local to world), translation (3),
 bounding-sphere centre in the local frame (3) and in the world frame (3), bounding-sphere radius
-(1); then the shapes' float blocks; then scratch space (GJK simplex, weights, search stack).
+(1); then the shapes' float blocks; then scratch space (GJK simplex, search stack).
 ``ints``: ``[object count, GJK iteration cap, EPA iteration cap, scratch offset]``, then per
 object ``[kind, object float record offset, shape float offset, shape int offset, hint]``
 (``hint`` is the last nearest triangle of a mesh, rewritten by every query as a warm start),
@@ -18,8 +18,8 @@ then the shapes' int blocks (layouts in ``support`` and ``bvh``), then the searc
 The scratch space lives in the packed arrays because allocating it costs as much as a
 primitive's query; so does the hint. Hence one packed scene must not serve two threads at once.
 
-Output row (``OUT_SIZE`` float64), world frame, m
--------------------------------------------------
+Output rows (``OUT_SIZE`` float64 each, in one flat array), world frame, m
+--------------------------------------------------------------------------
 distance (tip radius subtracted), closest point (3), outward normal (3), object index (-1 for
 none), iterations, status, tip (3), triangle index (-1 unless a mesh), lower bound on the
 distance (tip radius subtracted; equal to the distance to rounding when converged).
@@ -44,7 +44,7 @@ OUT_SIZE = 15
 OBJECT_FLOATS = 19
 _HEADER_FLOATS = 4
 _HEADER_INTS = 4
-_SCRATCH_FLOATS = 16 + bvh.STACK_SIZE
+_SCRATCH_FLOATS = 12 + bvh.STACK_SIZE
 _OBJECT_INTS = 5
 
 
@@ -101,9 +101,9 @@ def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
     return pack_convex(shape)
 
 
-@jit(inline=True)
+@jit
 def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy, gz,
-                     rel_tol, abs_tol, max_iter, max_epa_iter, W, lam):
+                     rel_tol, abs_tol, max_iter, max_epa_iter, W):
     """Signed distance to a convex shape: GJK outside, exact interior or EPA inside.
 
     (cx, cy, cz) is the shape's centre, (gx, gy, gz) a first search direction (zero: from the
@@ -120,7 +120,7 @@ def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy,
         if kind == CYLINDER or kind == CAPSULE:
             gz = qz - min(max(qz, -floats[fo + 1]), floats[fo + 1])
     status, contact, count, vx, vy, vz, lower, iterations = gjk(
-        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, rel_tol, abs_tol, max_iter, W, lam)
+        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, rel_tol, abs_tol, max_iter, W)
     if not contact:
         distance = math.sqrt(vx * vx + vy * vy + vz * vz)
         return (status, distance, lower, qx + vx, qy + vy, qz + vz,
@@ -133,8 +133,8 @@ def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy,
     return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
 
 
-@jit(inline=True)
-def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, lam, stack, stack_d2):
+@jit
+def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2):
     """Signed distance from the world point p to object k, in the world frame.
 
     Returns (status, distance, lower bound, x, y, z, nx, ny, nz, iterations, triangle).
@@ -158,7 +158,7 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, lam, stack, sta
         status, distance, lower, x, y, z, nx, ny, nz, iterations = _convex_distance(
             kind, floats, fo, ints, io, qx, qy, qz,
             floats[r + 12], floats[r + 13], floats[r + 14], lx, ly, lz,
-            floats[1], floats[2], ints[1], ints[2], W, lam)
+            floats[1], floats[2], ints[1], ints[2], W)
     wx = floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9]
     wy = floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10]
     wz = floats[r + 6] * x + floats[r + 7] * y + floats[r + 8] * z + floats[r + 11]
@@ -168,21 +168,23 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, lam, stack, sta
     return status, distance, lower, wx, wy, wz, mx, my, mz, iterations, triangle
 
 
-@jit(inline=True)
+@jit
 def _write(out, row, distance, x, y, z, nx, ny, nz, index, iterations, status, px, py, pz,
            triangle, lower):
-    out[row, 0] = distance
-    out[row, 1], out[row, 2], out[row, 3] = x, y, z
-    out[row, 4], out[row, 5], out[row, 6] = nx, ny, nz
-    out[row, 7] = index
-    out[row, 8] = iterations
-    out[row, 9] = status
-    out[row, 10], out[row, 11], out[row, 12] = px, py, pz
-    out[row, 13] = triangle
-    out[row, 14] = lower
+    """Fill output row ``row`` of the flat output array (rows of ``OUT_SIZE``)."""
+    base = row * OUT_SIZE
+    out[base] = distance
+    out[base + 1], out[base + 2], out[base + 3] = x, y, z
+    out[base + 4], out[base + 5], out[base + 6] = nx, ny, nz
+    out[base + 7] = index
+    out[base + 8] = iterations
+    out[base + 9] = status
+    out[base + 10], out[base + 11], out[base + 12] = px, py, pz
+    out[base + 13] = triangle
+    out[base + 14] = lower
 
 
-@jit(inline=True)
+@jit
 def _invalid(out, row, px, py, pz):
     """Write an INVALID_INPUT row and return true when p is not finite."""
     if math.isfinite(px) and math.isfinite(py) and math.isfinite(pz):
@@ -193,7 +195,7 @@ def _invalid(out, row, px, py, pz):
 
 
 @jit
-def _nearest(floats, ints, out, row, px, py, pz, W, lam, stack, stack_d2):
+def _nearest(floats, ints, out, row, px, py, pz, W, stack, stack_d2):
     """Nearest object to p (signed), written to out[row]."""
     if _invalid(out, row, px, py, pz):
         return
@@ -207,51 +209,52 @@ def _nearest(floats, ints, out, row, px, py, pz, W, lam, stack, stack_d2):
         if math.sqrt(cx * cx + cy * cy + cz * cz) - floats[r + 18] >= best:
             continue
         status, d, lower, ox, oy, oz, mx, my, mz, iterations, t = _object_distance(
-            floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, lam, stack, stack_d2)
+            floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, stack, stack_d2)
         total += iterations
         if status != STATUS_OK:
             unsure = min(unsure, lower)
         if d < best:
             best, best_lower, best_status, best_k, best_t = d, lower, status, k, t
             x, y, z, nx, ny, nz = ox, oy, oz, mx, my, mz
-    if best_k >= 0:
-        best_status = STATUS_NOT_CONVERGED if unsure < best else STATUS_OK
+    if unsure < best:
+        # An unconverged object might be nearer than the answer: the answer is a bound only.
+        best_status = STATUS_NOT_CONVERGED
     _write(out, row, best - floats[0], x, y, z, nx, ny, nz, best_k, total, best_status,
            px, py, pz, best_t, min(best_lower, unsure) - floats[0])
 
 
-@jit(inline=True)
+@jit
 def _scratch(floats, ints):
-    """View the scratch space: simplex (4, 3), weights (4,), search stack and its bounds."""
+    """View the scratch space: simplex (12,), search stack and its bounds."""
     f = int(floats[3])
     i = ints[3]
-    return (floats[f:f + 12].reshape((4, 3)), floats[f + 12:f + 16], ints[i:i + bvh.STACK_SIZE],
-            floats[f + 16:f + 16 + bvh.STACK_SIZE])
+    return (floats[f:f + 12], ints[i:i + bvh.STACK_SIZE],
+            floats[f + 12:f + 12 + bvh.STACK_SIZE])
 
 
 @jit
 def query_point(floats, ints, out, px, py, pz):
-    """Nearest object to the world point p, written to ``out`` (1, OUT_SIZE)."""
-    W, lam, stack, stack_d2 = _scratch(floats, ints)
-    _nearest(floats, ints, out, 0, px, py, pz, W, lam, stack, stack_d2)
+    """Nearest object to the world point p, written to ``out`` (OUT_SIZE,)."""
+    W, stack, stack_d2 = _scratch(floats, ints)
+    _nearest(floats, ints, out, 0, px, py, pz, W, stack, stack_d2)
 
 
 @jit
 def query_points(floats, ints, points, out):
-    """Nearest object to each world point, points (n, 3) to out (n, OUT_SIZE)."""
-    W, lam, stack, stack_d2 = _scratch(floats, ints)
+    """Nearest object to each world point, points (n, 3) to out (n * OUT_SIZE,)."""
+    W, stack, stack_d2 = _scratch(floats, ints)
     for row in range(points.shape[0]):
         _nearest(floats, ints, out, row, points[row, 0], points[row, 1], points[row, 2],
-                 W, lam, stack, stack_d2)
+                 W, stack, stack_d2)
 
 
 @jit
 def query_each_object(floats, ints, out, px, py, pz):
-    """Signed distance from p to every object, out (objects, OUT_SIZE)."""
-    W, lam, stack, stack_d2 = _scratch(floats, ints)
+    """Signed distance from p to every object, out (objects * OUT_SIZE,)."""
+    W, stack, stack_d2 = _scratch(floats, ints)
     for k in range(ints[0]):
         status, d, lower, x, y, z, nx, ny, nz, iterations, t = _object_distance(
-            floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, lam, stack, stack_d2)
+            floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, stack, stack_d2)
         _write(out, k, d - floats[0], x, y, z, nx, ny, nz, k, iterations, status,
                px, py, pz, t, lower - floats[0])
 
@@ -261,8 +264,8 @@ def query_shape(floats, ints, out, px, py, pz, gx, gy, gz):
     """Object 0 alone with a first search direction (world frame): the single-shape API."""
     if _invalid(out, 0, px, py, pz):
         return
-    W, lam, stack, stack_d2 = _scratch(floats, ints)
+    W, stack, stack_d2 = _scratch(floats, ints)
     status, d, lower, x, y, z, nx, ny, nz, iterations, t = _object_distance(
-        floats, ints, 0, px, py, pz, gx, gy, gz, W, lam, stack, stack_d2)
+        floats, ints, 0, px, py, pz, gx, gy, gz, W, stack, stack_d2)
     _write(out, 0, d - floats[0], x, y, z, nx, ny, nz, 0, iterations, status, px, py, pz,
            t, lower - floats[0])

@@ -6,8 +6,10 @@ child first, skipping every box farther than the best distance found so far; the
 answer's triangle is tried first, which tightens the bound from the start on a trajectory. Each
 candidate triangle is a convex piece handed to GJK (``gjk.nearest_on_triangle``), which also says
 which feature the nearest point lies on; the sign comes from that feature's angle-weighted
-pseudonormal (``pseudonormals``). Vertices must be welded and the surface closed and consistently
-wound (``shapes.TriangleMesh`` checks).
+pseudonormal (``pseudonormals``). The normal returned is the face's when the nearest point is
+inside a face, else the unit vector between the point and the surface (or, within 1e-9 of the
+mesh's size, where that vector is mostly rounding, the feature's pseudonormal). Vertices must be
+welded and the surface closed and consistently wound (``shapes.TriangleMesh`` checks).
 
 Packed layout (one object's blocks; ``t`` triangles, ``e`` edges, ``n`` vertices, ``b`` nodes),
 triangles in tree-leaf order:
@@ -104,7 +106,7 @@ def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndar
     return floats.astype(np.float64), ints.astype(np.int64)
 
 
-@jit(inline=True)
+@jit
 def _box_distance2(floats, b, qx, qy, qz):
     """Squared distance from q to the box at floats[b:b + 6] (0 inside)."""
     dx = max(floats[b] - qx, 0.0, qx - floats[b + 3])
@@ -113,7 +115,7 @@ def _box_distance2(floats, b, qx, qy, qz):
     return dx * dx + dy * dy + dz * dz
 
 
-@jit(inline=True)
+@jit
 def _triangle_distance2(floats, corners, t, qx, qy, qz):
     c = corners + 9 * t
     return nearest_on_triangle(
@@ -126,8 +128,8 @@ def _triangle_distance2(floats, corners, t, qx, qy, qz):
 def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     """Signed distance from q to a packed triangle mesh, local frame.
 
-    ``hint`` is a triangle (leaf order) to try first, or -1. ``stack`` and ``stack_d2``
-    (``STACK_SIZE``,) are scratch: a depth-first search holds at most one node per
+    ``hint`` is a triangle (leaf order) to try first, or -1. ``stack`` (int) and ``stack_d2``
+    (float), (``STACK_SIZE``,) each, are scratch: a depth-first search holds at most one node per
     level plus one, and a median-split tree over t triangles has ceil(log2(t)) levels, so 128
     entries never fill.
 

@@ -76,7 +76,11 @@ class DistanceResult:
     distance : float, m
         Negative inside.
     lower_bound : float, m
-        Proven lower bound; ``distance`` is the upper one (equal to rounding when converged).
+        GJK's proven lower bound (``distance`` is the upper one), from its last support plane.
+        Farther than ~1e-9 of the shape's size from the surface it meets ``distance`` within
+        the request's tolerance; nearer, that plane's normal carries the rounding of a vector
+        as short as the distance, so the bound can be loose (even 0) while ``distance`` stays
+        exact to rounding. Inside a primitive or a mesh it equals ``distance``.
     point : (3,) float64, m
         Closest point on the shape's surface.
     normal : (3,) float64
@@ -141,9 +145,8 @@ def distance(shape, pose: Pose, point, request: DistanceRequest = DistanceReques
     floats, ints = _packed(shape, request)
     _kernels.place_object(floats, ints, 0, shape, pose)
     gx, gy, gz = request.guess or (0.0, 0.0, 0.0)
-    row = np.empty((1, _kernels.OUT_SIZE))
+    row = np.empty(_kernels.OUT_SIZE)
     _kernels.query_shape(floats, ints, row, *values.tolist(), gx, gy, gz)
-    row = row[0]
     if row[9] == STATUS_INVALID_INPUT:
         raise ValueError(f'point must be finite, got {values.tolist()}')
     closest = row[1:4].copy()

@@ -124,8 +124,9 @@ def epa(kind, floats, fo, ints, io, q, W, count, rel_tol, abs_tol, max_iter):
     Parameters
     ----------
     q : (3,) float, m, local frame
-    W : (4, 3) float
-        GJK's final simplex of ``C = A - q`` (``count`` rows), which contains the origin.
+    W : (12,) float
+        GJK's final simplex of ``C = A - q`` (``count`` rows of a row-major (4, 3) array),
+        which contains the origin.
 
     Returns
     -------
@@ -139,7 +140,7 @@ def epa(kind, floats, fo, ints, io, q, W, count, rel_tol, abs_tol, max_iter):
     N = np.empty((2 * max_vertices, 3))
     D = np.empty(2 * max_vertices)
     alive = np.zeros(2 * max_vertices, dtype=np.bool_)
-    V[:count] = W[:count]
+    V[:count] = W[:3 * count].reshape((count, 3))
     scale = 0.0
     for k in range(count):
         scale = max(scale, math.sqrt(V[k, 0] ** 2 + V[k, 1] ** 2 + V[k, 2] ** 2))

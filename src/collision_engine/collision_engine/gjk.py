@@ -17,10 +17,13 @@ The loop stops on whichever comes first:
   about 2e-13 of the shape's size, what float64 sub-algorithm steps on it can resolve;
 * contact: the origin lies in the simplex (the point is inside or on the shape);
 * no progress: the new support point is already in the simplex, or the new simplex is not
-  nearer. In exact arithmetic that proves optimality; in float64 it is reported as converged
-  when the gap is at the rounding of v (``1024 eps max|w|^2``: v carries about eps max|w| of
-  rounding, so near the surface its direction, hence the lower bound, is loose while |v| is
-  exact to rounding), else as ``NOT_CONVERGED`` with the best bound;
+  nearer. In exact arithmetic that proves optimality (classic GJK stops there). In float64, v
+  carries about eps max|w| of rounding, so near the surface its direction, hence the lower
+  bound, is loose while |v| stays exact to that rounding: the stall is reported as converged
+  when the gap is at that rounding (``1024 eps max|w|^2``), else as ``NOT_CONVERGED`` with the
+  best bound. On a sliver hull, whose corners are closer than that direction can tell apart,
+  the stall can come early: errors of ~2e-10 of the size were seen on hulls with corners
+  1e-9 of the size apart;
 * the iteration cap, reported as ``NOT_CONVERGED`` with the best upper bound found.
 
 A relative test alone cycles near the surface of a many-vertex hull, hence all of them.
@@ -47,12 +50,12 @@ _ROUNDING = 1024.0 * _EPS
 _CONTACT = 16.0 * _EPS
 
 
-@jit(inline=True)
+@jit
 def _same_sign(a, b):
     return (a > 0.0 and b > 0.0) or (a < 0.0 and b < 0.0)
 
 
-@jit(inline=True)
+@jit
 def _s1d(ax, ay, az, bx, by, bz):
     """Nearest point to the origin on the segment a b.
 
@@ -85,7 +88,7 @@ def _s1d(ax, ay, az, bx, by, bz):
     return 1, 1, -1, 1.0, bx, by, bz
 
 
-@jit(inline=True)
+@jit
 def _cross_k(ux, uy, uz, wx, wy, wz, k):
     """Component k of u x w: the signed area of (0, u, w) seen along axis k (doubled)."""
     if k == 0:
@@ -95,13 +98,17 @@ def _cross_k(ux, uy, uz, wx, wy, wz, k):
     return ux * wy - uy * wx
 
 
-@jit(inline=True)
+@jit
 def _s2d(ax, ay, az, bx, by, bz, cx, cy, cz):
     """Nearest point to the origin on the triangle a b c.
 
     Returns (count, i0, i1, i2, l0, l1, l2, vx, vy, vz): the support set as local indices in
     increasing order (0 a, 1 b, 2 c; unused slots -1), their weights and the nearest point.
     """
+    # No point of the triangle is nearer than its nearest point, nor farther than a corner:
+    # the consistency check that catches rounding on slivers.
+    corner2 = min(ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz,
+                  cx * cx + cy * cy + cz * cz)
     ux, uy, uz = bx - ax, by - ay, bz - az
     wx, wy, wz = cx - ax, cy - ay, cz - az
     nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
@@ -122,23 +129,40 @@ def _s2d(ax, ay, az, bx, by, bz, cx, cy, cz):
         if _same_sign(mu, c0) and _same_sign(mu, c1) and _same_sign(mu, c2):
             total = c0 + c1 + c2
             l0, l1, l2 = c0 / total, c1 / total, c2 / total
-            return (3, 0, 1, 2, l0, l1, l2, l0 * ax + l1 * bx + l2 * cx,
-                    l0 * ay + l1 * by + l2 * cy, l0 * az + l1 * bz + l2 * cz)
+            vx = l0 * ax + l1 * bx + l2 * cx
+            vy = l0 * ay + l1 * by + l2 * cy
+            vz = l0 * az + l1 * bz + l2 * cz
+            if vx * vx + vy * vy + vz * vz <= corner2:
+                return 3, 0, 1, 2, l0, l1, l2, vx, vy, vz
     # The projection is outside (or the triangle is degenerate): the nearest point is on an
     # edge facing the origin, one opposite a vertex whose signed area has the wrong sign.
+    result = _nearest_edge(ax, ay, az, bx, by, bz, cx, cy, cz, mu, c0, c1, c2, False)
+    if result[7] ** 2 + result[8] ** 2 + result[9] ** 2 > corner2:
+        # Farther than a corner: on a sliver, rounding tilted the plane or flipped a sign.
+        # No cheap test is left to trust, so every edge is tried.
+        result = _nearest_edge(ax, ay, az, bx, by, bz, cx, cy, cz, mu, c0, c1, c2, True)
+    return result
+
+
+@jit
+def _nearest_edge(ax, ay, az, bx, by, bz, cx, cy, cz, mu, c0, c1, c2, every):
+    """Nearest point on the edges facing the origin (``every``: on all three edges).
+
+    Returns the ``_s2d`` result tuple.
+    """
     best = np.inf
     result = (1, 0, -1, -1, 1.0, 0.0, 0.0, ax, ay, az)
-    if not _same_sign(mu, c0):
+    if every or not _same_sign(mu, c0):
         n, f, s, lf, vx, vy, vz = _s1d(bx, by, bz, cx, cy, cz)
         best = vx * vx + vy * vy + vz * vz
         result = (n, f + 1, s + 1 if s >= 0 else -1, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
-    if not _same_sign(mu, c1):
+    if every or not _same_sign(mu, c1):
         n, f, s, lf, vx, vy, vz = _s1d(ax, ay, az, cx, cy, cz)
         dist = vx * vx + vy * vy + vz * vz
         if dist < best:
             best = dist
             result = (n, 2 * f, 2 if s >= 0 else -1, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
-    if not _same_sign(mu, c2):
+    if every or not _same_sign(mu, c2):
         n, f, s, lf, vx, vy, vz = _s1d(ax, ay, az, bx, by, bz)
         dist = vx * vx + vy * vy + vz * vz
         if dist < best:
@@ -146,24 +170,38 @@ def _s2d(ax, ay, az, bx, by, bz, cx, cy, cz):
     return result
 
 
-@jit(inline=True)
+@jit
+def _vertex(W, i):
+    """Row i of the flat (4 x 3, row-major) simplex W."""
+    return W[3 * i], W[3 * i + 1], W[3 * i + 2]
+
+
+@jit
+def _put(W, i, x, y, z):
+    W[3 * i], W[3 * i + 1], W[3 * i + 2] = x, y, z
+
+
+@jit
 def _det3(W, i, j, k):
-    return (W[i, 0] * (W[j, 1] * W[k, 2] - W[j, 2] * W[k, 1])
-            - W[i, 1] * (W[j, 0] * W[k, 2] - W[j, 2] * W[k, 0])
-            + W[i, 2] * (W[j, 0] * W[k, 1] - W[j, 1] * W[k, 0]))
+    ax, ay, az = _vertex(W, i)
+    bx, by, bz = _vertex(W, j)
+    cx, cy, cz = _vertex(W, k)
+    return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
 
 
-@jit(inline=True)
+@jit
 def _face_s2d(W, i, j, k):
     """``_s2d`` on the rows i < j < k of W, with the support set as rows of W."""
-    n, a, b, c, la, lb, lc, vx, vy, vz = _s2d(W[i, 0], W[i, 1], W[i, 2], W[j, 0], W[j, 1],
-                                              W[j, 2], W[k, 0], W[k, 1], W[k, 2])
+    ax, ay, az = _vertex(W, i)
+    bx, by, bz = _vertex(W, j)
+    cx, cy, cz = _vertex(W, k)
+    n, a, b, c, la, lb, lc, vx, vy, vz = _s2d(ax, ay, az, bx, by, bz, cx, cy, cz)
     rows = (i, j, k)
     return (n, rows[a], rows[b] if b >= 0 else -1, rows[c] if c >= 0 else -1,
             la, lb, lc, vx, vy, vz)
 
 
-@jit(inline=True)
+@jit
 def _s3d(W):
     """Nearest point to the origin on the tetrahedron W[0..3].
 
@@ -178,11 +216,26 @@ def _s3d(W):
     if (_same_sign(det, c0) and _same_sign(det, c1) and _same_sign(det, c2)
             and _same_sign(det, c3)):
         return 4, 0, 1, 2, 3, c0 / det, c1 / det, c2 / det, c3 / det, 0.0, 0.0, 0.0
+    result = _nearest_face(W, det, c0, c1, c2, c3, False)
+    corner2 = min(W[0] ** 2 + W[1] ** 2 + W[2] ** 2, W[3] ** 2 + W[4] ** 2 + W[5] ** 2,
+                  W[6] ** 2 + W[7] ** 2 + W[8] ** 2, W[9] ** 2 + W[10] ** 2 + W[11] ** 2)
+    if result[9] ** 2 + result[10] ** 2 + result[11] ** 2 > corner2:
+        # Farther than a corner: rounding flipped a sign on a sliver; try every face.
+        result = _nearest_face(W, det, c0, c1, c2, c3, True)
+    return result
+
+
+@jit
+def _nearest_face(W, det, c0, c1, c2, c3, every):
+    """Nearest point on the faces facing the origin (``every``: on all four faces).
+
+    Returns the ``_s3d`` result tuple.
+    """
     best = np.inf
-    result = (1, 0, -1, -1, -1, 1.0, 0.0, 0.0, 0.0, W[0, 0], W[0, 1], W[0, 2])
+    result = (1, 0, -1, -1, -1, 1.0, 0.0, 0.0, 0.0, W[0], W[1], W[2])
     for slot in range(4):
         c = c0 if slot == 0 else (c1 if slot == 1 else (c2 if slot == 2 else c3))
-        if _same_sign(det, c):
+        if not every and _same_sign(det, c):
             continue
         # The face opposite the vertex in this slot, its rows in increasing order.
         n, a, b, c_, la, lb, lc, vx, vy, vz = _face_s2d(
@@ -194,43 +247,42 @@ def _s3d(W):
     return result
 
 
-@jit(inline=True)
-def nearest_on_simplex(W, count, lam):
-    """Reduce the simplex W[:count] to the support set of its point nearest the origin.
+@jit
+def nearest_on_simplex(W, count):
+    """Reduce the simplex to the support set of its point nearest the origin.
 
-    Rewrites W[:new_count] and lam[:new_count] (the barycentric weights) in place. Returns
-    (new_count, vx, vy, vz).
+    ``W`` is (12,): ``count`` vertices as rows of a row-major (4, 3) array. Its first
+    ``new_count`` rows are rewritten with the support set. Returns (new_count, vx, vy, vz).
     """
     if count == 1:
-        lam[0] = 1.0
-        return 1, W[0, 0], W[0, 1], W[0, 2]
+        return 1, W[0], W[1], W[2]
     if count == 2:
-        n, a, b, la, vx, vy, vz = _s1d(W[0, 0], W[0, 1], W[0, 2], W[1, 0], W[1, 1], W[1, 2])
-        _keep(W, lam, a, b, -1, -1, la, 1.0 - la, 0.0, 0.0)
+        n, a, b, la, vx, vy, vz = _s1d(W[0], W[1], W[2], W[3], W[4], W[5])
+        _keep(W, a, b, -1, -1)
         return n, vx, vy, vz
     if count == 3:
         n, a, b, c, la, lb, lc, vx, vy, vz = _face_s2d(W, 0, 1, 2)
-        _keep(W, lam, a, b, c, -1, la, lb, lc, 0.0)
+        _keep(W, a, b, c, -1)
         return n, vx, vy, vz
     n, a, b, c, d, la, lb, lc, ld, vx, vy, vz = _s3d(W)
-    _keep(W, lam, a, b, c, d, la, lb, lc, ld)
+    _keep(W, a, b, c, d)
     return n, vx, vy, vz
 
 
-@jit(inline=True)
-def _keep(W, lam, a, b, c, d, la, lb, lc, ld):
+@jit
+def _keep(W, a, b, c, d):
     """Move rows a, b, c, d (-1 = absent, present ones in increasing order) of W to the front."""
     slot = 0
-    for index, weight in ((a, la), (b, lb), (c, lc), (d, ld)):
+    for index in (a, b, c, d):
         if index < 0:
             continue
         if index != slot:
-            W[slot, 0], W[slot, 1], W[slot, 2] = W[index, 0], W[index, 1], W[index, 2]
-        lam[slot] = weight
+            x, y, z = _vertex(W, index)
+            _put(W, slot, x, y, z)
         slot += 1
 
 
-@jit(inline=True)
+@jit
 def nearest_on_triangle(ax, ay, az, bx, by, bz, cx, cy, cz):
     """Nearest point to the origin on one triangle, with the feature it lies on.
 
@@ -249,12 +301,12 @@ def nearest_on_triangle(ax, ay, az, bx, by, bz, cx, cy, cz):
 
 
 @jit
-def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, rel_tol, abs_tol, max_iter, W, lam):
+def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, rel_tol, abs_tol, max_iter, W):
     """Distance from the point q to a convex shape (packed as in ``support``), local frame.
 
     (dx, dy, dz) is the first search direction, from the shape toward the point (a warm start
-    when it is near the answer). ``W`` (4, 3) and ``lam`` (4,) are scratch; on contact they
-    hold the final simplex of ``C = A - q`` for EPA.
+    when it is near the answer). ``W`` (12,) is scratch; on contact it holds the final
+    simplex of ``C = A - q`` for EPA, as rows of a row-major (4, 3) array.
 
     Returns (status, contact, count, vx, vy, vz, lower, iterations): ``q + v`` is the nearest
     point found, ``|v|`` the upper bound on the distance and ``lower`` the best lower bound.
@@ -262,8 +314,7 @@ def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, rel_tol, abs_tol, ma
     """
     sx, sy, sz, vertex = support(kind, floats, fo, ints, io, dx, dy, dz, 0)
     vx, vy, vz = sx - qx, sy - qy, sz - qz
-    W[0, 0], W[0, 1], W[0, 2] = vx, vy, vz
-    lam[0] = 1.0
+    _put(W, 0, vx, vy, vz)
     count = 1
     vv = vx * vx + vy * vy + vz * vz
     w_max2 = vv
@@ -286,24 +337,21 @@ def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, rel_tol, abs_tol, ma
         if gap <= tolerance:
             status = STATUS_OK
             break
-        # A stall (the support point is already in the simplex, or the new simplex is not
-        # nearer) proves optimality in exact arithmetic; in float64 it is convergence when the
-        # gap is at the rounding of v, whose error is about eps max|w| in each coordinate.
-        stalled_ok = STATUS_OK if gap <= _ROUNDING * w_max2 else STATUS_NOT_CONVERGED
+        stalled = STATUS_OK if gap <= _ROUNDING * w_max2 else STATUS_NOT_CONVERGED
         duplicate = False
         for m in range(count):
-            if W[m, 0] == wx and W[m, 1] == wy and W[m, 2] == wz:
+            if W[3 * m] == wx and W[3 * m + 1] == wy and W[3 * m + 2] == wz:
                 duplicate = True
         if duplicate:
-            status = stalled_ok
+            status = stalled
             break
-        W[count, 0], W[count, 1], W[count, 2] = wx, wy, wz
-        count, nx, ny, nz = nearest_on_simplex(W, count + 1, lam)
+        _put(W, count, wx, wy, wz)
+        count, nx, ny, nz = nearest_on_simplex(W, count + 1)
         nn = nx * nx + ny * ny + nz * nz
         if count == 4 or nn <= (_CONTACT * _CONTACT) * w_max2:
             return STATUS_OK, True, count, nx, ny, nz, 0.0, iteration
         if nn >= vv:
-            status = stalled_ok
+            status = stalled
             break
         vx, vy, vz, vv = nx, ny, nz, nn
     return status, False, count, vx, vy, vz, lower, iteration

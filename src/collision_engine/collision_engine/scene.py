@@ -86,7 +86,7 @@ class Scene:
             shapes, poses, tip_radius=self.tip_radius, rel_tol=self.request.rel_tol,
             abs_tol=self.request.abs_tol, max_iterations=self.request.max_iterations,
             max_epa_iterations=self.request.max_epa_iterations)
-        self._row = np.empty((1, _kernels.OUT_SIZE))
+        self._row = np.empty(_kernels.OUT_SIZE)
         self._validator = None
         if cross_validation is not None and cross_validation.fcl and self.objects:
             from collision_engine.cross_validation import FclCrossValidator
@@ -134,7 +134,7 @@ class Scene:
         x, y, z = _point(point)
         row = self._row
         _kernels.query_point(self._floats, self._ints, row, x, y, z)
-        values = row[0].tolist()
+        values = row.tolist()
         if values[9] == STATUS_INVALID_INPUT:
             raise _invalid((x, y, z))
         validator = self._validator
@@ -163,7 +163,7 @@ class Scene:
             bad = int(np.argmin(np.all(np.isfinite(points), axis=1)))
             raise ValueError(f'points[{bad}] is not finite: {points[bad].tolist()}')
         rows = np.empty((len(points), _kernels.OUT_SIZE))
-        _kernels.query_points(self._floats, self._ints, points, rows)
+        _kernels.query_points(self._floats, self._ints, points, rows.reshape(-1))
         return BatchResult.from_rows(rows, self._names)
 
     def query_within(self, point, radius: float) -> list[QueryResult]:
@@ -184,7 +184,7 @@ class Scene:
         if math.isnan(radius):
             raise ValueError('radius must not be NaN')
         rows = np.empty((len(self.objects), _kernels.OUT_SIZE))
-        _kernels.query_each_object(self._floats, self._ints, rows, x, y, z)
+        _kernels.query_each_object(self._floats, self._ints, rows.reshape(-1), x, y, z)
         rows = rows[rows[:, 0] <= radius]
         rows = rows[np.argsort(rows[:, 0], kind='stable')]
         return [QueryResult(row, self._names) for row in rows.tolist()]

@@ -301,6 +301,8 @@ def _pose(reader: _Reader, value, where: str) -> Pose:
 
 def _material(reader: _Reader, value, where: str) -> MaterialSpec:
     fields = reader.mapping(value, where, ('stiffness', 'damping'))
-    return MaterialSpec(
-        stiffness=reader.vector(fields['stiffness'], f'{where}.stiffness', 3, minimum=0.0),
-        damping=reader.vector(fields['damping'], f'{where}.damping', 3, minimum=0.0))
+    stiffness = reader.vector(fields['stiffness'], f'{where}.stiffness', 3, minimum=0.0)
+    damping = reader.vector(fields['damping'], f'{where}.damping', 3, minimum=0.0)
+    stiffness.setflags(write=False)
+    damping.setflags(write=False)
+    return MaterialSpec(stiffness, damping)

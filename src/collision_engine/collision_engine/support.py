@@ -68,7 +68,7 @@ def pack_convex(shape) -> tuple[int, np.ndarray, np.ndarray]:
     raise ValueError(f'shape kind {kind!r} has no support function')
 
 
-@jit(inline=True)
+@jit
 def support(kind, floats, fo, ints, io, dx, dy, dz, start):
     """Farthest point of a convex shape along the direction (dx, dy, dz), local frame.
 
@@ -131,7 +131,7 @@ def _hill_climb(floats, fo, ints, io, dx, dy, dz, start):
     return floats[fo + 3 * best], floats[fo + 3 * best + 1], floats[fo + 3 * best + 2], best
 
 
-@jit(inline=True)
+@jit
 def interior(kind, floats, fo, qx, qy, qz):
     """Exact signed distance of a point inside (or on) a primitive, with its surface witness.
 
@@ -156,7 +156,7 @@ def interior(kind, floats, fo, qx, qy, qz):
     return norm - r, r * nx, r * ny, cz + r * nz, nx, ny, nz
 
 
-@jit(inline=True)
+@jit
 def _box_interior(hx, hy, hz, qx, qy, qz):
     ex = abs(qx) - hx
     ey = abs(qy) - hy
@@ -172,7 +172,7 @@ def _box_interior(hx, hy, hz, qx, qy, qz):
     return ez, x, y, sz * hz, 0.0, 0.0, sz
 
 
-@jit(inline=True)
+@jit
 def _cylinder_interior(r, hh, qx, qy, qz):
     rho = math.sqrt(qx * qx + qy * qy)
     e_side = rho - r

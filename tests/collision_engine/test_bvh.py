@@ -1,0 +1,118 @@
+"""Exact signed distance to the shipped non-convex hand, against brute force.
+
+``ground_truth.mesh_signed_distance`` tests every triangle and takes the sign from the winding
+number: no tree, no pseudonormals, no code shared with the engine.
+"""
+
+from ground_truth import hand_mesh_path, mesh_signed_distance, sample_near_surface
+import numpy as np
+import pytest
+
+from collision_engine.bvh import build_tree, LEAF_SIZE, STACK_SIZE
+from collision_engine.distance import distance
+from collision_engine.gjk import STATUS_OK
+from collision_engine.mesh_io import load_mesh
+from collision_engine.shapes import TriangleMesh
+from collision_engine.transforms import Pose
+
+POSE = Pose.from_rpy([0.01, -0.02, -0.075], [0.2, 0.1, -0.4])
+
+
+@pytest.fixture(scope='module')
+def hand():
+    data = load_mesh(hand_mesh_path(), scale=0.001, check_self_intersection=False)
+    assert len(data.vertices) >= 3000
+    return TriangleMesh(data.vertices, data.faces)
+
+
+def query(mesh, local_points):
+    world = POSE.to_world(local_points)
+    results = [distance(mesh, POSE, p) for p in world]
+    assert all(r.status == STATUS_OK for r in results)
+    return (np.array([r.distance for r in results]),
+            POSE.to_local(np.array([r.point for r in results])))
+
+
+def check(mesh, local_points, closest_too=True):
+    found, closest = query(mesh, local_points)
+    truth, truth_closest = mesh_signed_distance(local_points, mesh.vertices, mesh.faces)
+    np.testing.assert_allclose(found, truth, rtol=0, atol=1e-14)
+    assert np.count_nonzero(np.sign(found) != np.sign(truth)) == 0
+    np.testing.assert_allclose(np.linalg.norm(closest - local_points, axis=1), np.abs(found),
+                               rtol=0, atol=1e-14)
+    if closest_too:
+        np.testing.assert_allclose(closest, truth_closest, rtol=0, atol=1e-12)
+
+
+def test_random_points(hand):
+    rng = np.random.default_rng(11)
+    low, high = hand.vertices.min(axis=0), hand.vertices.max(axis=0)
+    centre, half = 0.5 * (low + high), 0.5 * (high - low)
+    check(hand, centre + rng.uniform(-2 * half, 2 * half, size=(1500, 3)))
+
+
+def test_near_surface_points(hand):
+    points, _ = sample_near_surface(hand.vertices, hand.faces, 1500, 0.002,
+                                    np.random.default_rng(12))
+    check(hand, points)
+
+
+def unit(vectors):
+    return vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+
+
+def feature_points(mesh, rng, count):
+    """Points on vertices, edges and faces, each with a direction off the surface there (the
+    plain mean of the adjacent face normals: any direction pointing out will do)."""
+    corners = mesh.vertices[mesh.faces]
+    face_normal = unit(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
+    vertex_normal = np.zeros_like(mesh.vertices)
+    np.add.at(vertex_normal, mesh.faces.ravel(), np.repeat(face_normal, 3, axis=0))
+    vertices = rng.choice(len(mesh.vertices), count, replace=False)
+    faces = rng.choice(len(mesh.faces), count, replace=False)
+    weights = rng.dirichlet(np.ones(3), size=count)
+    # An edge (a, b) of a face and the face across it, found by its reversed direction.
+    edge_faces = rng.choice(len(mesh.faces), count, replace=False)
+    a, b = mesh.faces[edge_faces, 0], mesh.faces[edge_faces, 1]
+    directed = {(int(p), int(q)): f for f, face in enumerate(mesh.faces)
+                for p, q in ((face[0], face[1]), (face[1], face[2]), (face[2], face[0]))}
+    across = np.array([directed[(int(q), int(p))] for p, q in zip(a, b)])
+    t = rng.uniform(0.05, 0.95, size=(count, 1))
+    return [
+        (mesh.vertices[vertices], unit(vertex_normal[vertices])),
+        (mesh.vertices[a] + t * (mesh.vertices[b] - mesh.vertices[a]),
+         unit(face_normal[edge_faces] + face_normal[across])),
+        (np.einsum('fk,fkj->fj', weights, corners[faces]), face_normal[faces]),
+    ]
+
+
+@pytest.mark.parametrize('offset', [1e-9, 1e-10, 1e-11, 1e-12])
+def test_points_just_off_vertices_edges_and_faces(hand, offset):
+    rng = np.random.default_rng(13)
+    for points, direction in feature_points(hand, rng, 100):
+        for sign in (1.0, -1.0):
+            check(hand, points + sign * offset * direction, closest_too=False)
+
+
+def test_tree_covers_every_triangle_once_in_nested_boxes(hand):
+    corners = hand.vertices[hand.faces]
+    order, boxes, nodes = build_tree(corners)
+    assert sorted(order.tolist()) == list(range(len(hand.faces)))
+    leaves = nodes[nodes[:, 0] < 0]
+    assert leaves[:, 2].max() <= LEAF_SIZE and leaves[:, 2].sum() == len(hand.faces)
+    covered = np.zeros(len(hand.faces), dtype=int)
+    for (child, first, count), box in zip(nodes, boxes):
+        members = corners[order[first:first + count]].reshape(-1, 3)
+        assert np.all(members >= box[:3]) and np.all(members <= box[3:])
+        if child < 0:
+            covered[first:first + count] += 1
+        else:
+            for c in (child, child + 1):
+                assert np.all(boxes[c, :3] >= box[:3]) and np.all(boxes[c, 3:] <= box[3:])
+    assert np.all(covered == 1)
+    # Median splits keep it balanced, so the kernel's fixed search stack cannot overflow.
+    depth, level = 0, [0]
+    while level:
+        depth += 1
+        level = [c for n in level if nodes[n, 0] >= 0 for c in (nodes[n, 0], nodes[n, 0] + 1)]
+    assert depth <= np.ceil(np.log2(len(hand.faces))) + 1 < STACK_SIZE

@@ -1,0 +1,140 @@
+"""Scene files: what parses, and the one-line error naming file and key for what does not."""
+
+from pathlib import Path
+import textwrap
+
+from ground_truth import scene_path
+import numpy as np
+import pytest
+
+from collision_engine.errors import SceneError
+from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CylinderSpec, MeshSpec,
+                                         read_scene, SphereSpec)
+
+GOOD = """\
+frame_id: world
+tip_radius: 0.001
+cross_validation: {fcl: true, every: 10, tolerance: 1.0e-6}
+objects:
+  - name: cuboid
+    shape: {box: {size: [0.1, 0.1, 0.2]}}
+    pose: {position: [0.0, 0.0, -0.075], rpy: [0.0, 0.0, 0.0]}
+    material: {stiffness: [160, 160, 160], damping: [0.8, 0.8, 0.8]}
+  - name: ball
+    shape: {sphere: {radius: 0.02}}
+    pose: {position: [0.1, 0.0, 0.0], quaternion: [0.0, 0.0, 0.0, 1.0]}
+  - name: can
+    shape: {cylinder: {radius: 0.025, height: 0.1}}
+  - name: pill
+    shape: {capsule: {radius: 0.01, length: 0.05}}
+  - name: hand
+    shape: {mesh: {file: hand.stl, scale: 0.001}}
+"""
+
+
+def write(tmp_path: Path, text: str, name: str = 'scene.yaml') -> Path:
+    (tmp_path / 'hand.stl').write_bytes(b'')  # existence is all read_scene checks
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_a_full_scene_parses(tmp_path):
+    spec = read_scene(write(tmp_path, GOOD))
+    assert spec.frame_id == 'world' and spec.tip_radius == 0.001
+    assert spec.cross_validation.fcl and spec.cross_validation.every == 10
+    assert [o.name for o in spec.objects] == ['cuboid', 'ball', 'can', 'pill', 'hand']
+    cuboid, ball, can, pill, hand = spec.objects
+    assert cuboid.shape == BoxSpec((0.1, 0.1, 0.2))
+    np.testing.assert_allclose(cuboid.pose.translation, [0.0, 0.0, -0.075])
+    np.testing.assert_allclose(cuboid.material.stiffness, [160.0, 160.0, 160.0])
+    np.testing.assert_allclose(cuboid.material.damping, [0.8, 0.8, 0.8])
+    assert ball.shape == SphereSpec(0.02) and ball.material is None
+    assert can.shape == CylinderSpec(0.025, 0.1)
+    np.testing.assert_allclose(can.pose.rotation, np.eye(3))
+    assert pill.shape == CapsuleSpec(0.01, 0.05)
+    assert hand.shape == MeshSpec((tmp_path / 'hand.stl').resolve(), 0.001, None)
+
+
+def test_defaults(tmp_path):
+    spec = read_scene(write(tmp_path, 'objects: []\n'))
+    assert spec.frame_id == 'world' and spec.tip_radius == 0.0 and spec.objects == ()
+    assert not spec.cross_validation.fcl
+
+
+@pytest.mark.parametrize('name', ['cuboid', 'cylinder', 'hand', 'paper_cuboid_stl',
+                                  'paper_cylinder_stl'])
+def test_shipped_scenes_parse(name):
+    spec = read_scene(scene_path(name))
+    assert len(spec.objects) == 1 and spec.objects[0].material is not None
+
+
+@pytest.mark.parametrize('old, new, message', [
+    ('frame_id: world', 'frame: world', r"frame: unknown key \(did you mean 'frame_id'\?\)"),
+    ('size: [0.1, 0.1, 0.2]', 'sise: [0.1, 0.1, 0.2]',
+     r"objects\[0\]\.shape\.box\.sise: unknown key \(did you mean 'size'\?\)"),
+    ('stiffness: [160, 160, 160]', 'stiffness: [160, .nan, 160]',
+     r'objects\[0\]\.material\.stiffness: must be 3 finite numbers >= 0'),
+    ('stiffness: [160, 160, 160]', 'stiffness: [160, -1, 160]',
+     r'objects\[0\]\.material\.stiffness: must be 3 finite numbers >= 0'),
+    ('stiffness: [160, 160, 160]', 'stiffness: 160',
+     r'objects\[0\]\.material\.stiffness: must be a list of 3 numbers'),
+    ('damping: [0.8, 0.8, 0.8]', 'damping: [0.8, 0.8, "a"]',
+     r'objects\[0\]\.material\.damping: must be 3 finite numbers'),
+    ('shape: {box: {size: [0.1, 0.1, 0.2]}}', 'shape: {cone: {radius: 1}}',
+     r'objects\[0\]\.shape\.cone: unknown key; allowed: box, sphere, cylinder, capsule, mesh'),
+    ('shape: {box: {size: [0.1, 0.1, 0.2]}}', 'shape: {boxx: {size: [0.1, 0.1, 0.2]}}',
+     r"objects\[0\]\.shape\.boxx: unknown key \(did you mean 'box'\?\)"),
+    ('shape: {box: {size: [0.1, 0.1, 0.2]}}', 'shape: {box: {size: [0.1, 0.1]}}',
+     r'objects\[0\]\.shape\.box\.size: must be a list of 3 numbers'),
+    ('shape: {box: {size: [0.1, 0.1, 0.2]}}', 'shape: {box: {size: [0.1, 0.0, 0.2]}}',
+     r'objects\[0\]\.shape\.box\.size: must be 3 finite numbers > 0'),
+    ('shape: {box: {size: [0.1, 0.1, 0.2]}}', 'shape: {}',
+     r'objects\[0\]\.shape: must name exactly one shape'),
+    ('radius: 0.02', 'radius: -0.02', r'objects\[1\]\.shape\.sphere\.radius: must be a finite '
+     r'number > 0'),
+    ('radius: 0.02', 'radius: true', r'objects\[1\]\.shape\.sphere\.radius: must be a number'),
+    ('file: hand.stl', 'file: missing.stl',
+     r'objects\[4\]\.shape\.mesh\.file: no such file: .*missing\.stl'),
+    ('scale: 0.001', 'scale: 0.001, convex: yes please',
+     r'objects\[4\]\.shape\.mesh\.convex: must be true or false'),
+    ('name: ball', 'name: cuboid', r"objects\[1\]\.name: duplicate name 'cuboid'"),
+    ('quaternion: [0.0, 0.0, 0.0, 1.0]', 'quaternion: [0.0, 0.0, 0.0, 0.0]',
+     r'objects\[1\]\.pose\.quaternion: must be non-zero'),
+    ('quaternion: [0.0, 0.0, 0.0, 1.0]', 'quaternion: [0.0, 0.0, 0.0, 1.0], rpy: [0, 0, 0]',
+     r'objects\[1\]\.pose: give rpy or quaternion, not both'),
+    ('every: 10', 'every: 0', r'cross_validation\.every: must be an integer >= 1'),
+    ('tolerance: 1.0e-6', 'tolerance: 0', r'cross_validation\.tolerance: must be a finite '
+     r'number > 0'),
+    ('tip_radius: 0.001', 'tip_radius: -0.001', r'tip_radius: must be a finite number >= 0'),
+    ('  - name: ball\n', '  - nam: ball\n', r"objects\[1\]\.nam: unknown key \(did you mean "
+     r"'name'\?\)"),
+    ('position: [0.1, 0.0, 0.0]', 'position: [0.1, 0.0, .inf]',
+     r'objects\[1\]\.pose\.position: must be 3 finite numbers'),
+])
+def test_errors_name_the_file_and_the_key(tmp_path, old, new, message):
+    assert old in GOOD
+    with pytest.raises(SceneError, match=f'^scene.yaml: {message}') as raised:
+        read_scene(write(tmp_path, GOOD.replace(old, new, 1)))
+    assert '\n' not in str(raised.value)
+
+
+@pytest.mark.parametrize('text, message', [
+    ('objects: [\n', r'^scene\.yaml: line \d+: not valid YAML'),
+    ('- 1\n- 2\n', r'^scene\.yaml: : must be a mapping'),
+    ('frame_id: world\n', r'^scene\.yaml: objects: missing'),
+    ('objects: {a: 1}\n', r'^scene\.yaml: objects: must be a list'),
+    ('objects: [{name: a}]\n', r'^scene\.yaml: objects\[0\]\.shape: missing'),
+])
+def test_structural_errors(tmp_path, text, message):
+    with pytest.raises(SceneError, match=message):
+        read_scene(write(tmp_path, text))
+
+
+def test_missing_scene_file(tmp_path):
+    with pytest.raises(SceneError, match='nope.yaml: cannot read the scene file'):
+        read_scene(tmp_path / 'nope.yaml')
+
+
+def test_scene_error_is_a_value_error():
+    assert issubclass(SceneError, ValueError)
