@@ -186,7 +186,7 @@ class SimulatedWand(HapticDevice):
         return self._start + self._steps_done * self._step
 
     def _expiry_step(self) -> float:
-        """The first substep at or after the hold deadline (inf when there is none)."""
+        """Return the first substep at or after the hold deadline (inf when there is none)."""
         if self._until == math.inf or self._start is None:
             return math.inf
         if self._until == -math.inf:
