@@ -30,6 +30,7 @@ __all__ = ['WandDriverNode', 'main']
 
 WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
 DIAGNOSTICS_PERIOD = 1.0  # [s]
+IN_FLIGHT_GRACE = 0.05  # [s] after the last pose, for its answer to arrive
 
 
 class Phase(enum.Enum):
@@ -122,7 +123,8 @@ class WandDriverNode(Node):
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
                 self._phase = Phase.DONE
                 self.get_logger().info(f'experiment done after {self.params.duration:g} s')
-                request_stop()
+                # The last poses are still on their way round: let their wrenches come back.
+                self.create_timer(IN_FLIGHT_GRACE, request_stop)
 
     def _start(self, now: float) -> None:
         """Start the session once a wrench answered a probe (or at once, open loop)."""
@@ -157,9 +159,9 @@ class WandDriverNode(Node):
                 self._phase = Phase.RUNNING
                 self._start(now)
             return
+        self.stats.answered(stamp_ns, now_ns)
         if self._phase is not Phase.RUNNING:
             return
-        self.stats.answered(stamp_ns, now_ns)
         state = self._state = self.device.read(now - self._device_offset)  # acts from now on
         reason = self._take(msg, stamp_ns * 1e-9, now)
         if reason is not None:
