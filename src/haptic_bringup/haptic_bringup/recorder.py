@@ -26,6 +26,7 @@ __all__ = ['BagRecorder', 'main', 'custom_definitions']
 
 CUSTOM_PACKAGES = ('haptic_msgs',)
 GRAPH_POLL_PERIOD = 0.02  # [s]
+WRITER_MATCH_SETTLE = 0.5  # [s] see subscribe_new_topics
 
 
 def custom_definitions(packages=CUSTOM_PACKAGES) -> list:
@@ -81,8 +82,15 @@ class BagRecorder(Node):
             self._pending.remove(topic)
         if not self._pending and all(s.get_publisher_count() for s in self._stream_subscriptions):
             self._poll.cancel()
-            self._ready_pub.publish(Bool(data=True))
-            self.get_logger().info('every topic has a matched publisher: ready')
+            # DDS matches each reader-writer pair on both sides separately; the writers' side
+            # can lag ours by tens of milliseconds, and what a writer sends before it has matched
+            # us never reaches the bag. So ready is said only after a settling time.
+            self._settle = self.create_timer(WRITER_MATCH_SETTLE, self.say_ready)
+
+    def say_ready(self) -> None:
+        self._settle.cancel()
+        self._ready_pub.publish(Bool(data=True))
+        self.get_logger().info('every topic has a matched publisher: ready')
 
     def _writer_for(self, topic: str):
         clock = self.get_clock()
