@@ -3,17 +3,24 @@ from dataclasses import dataclass
 
 from haptic_util.parameters import parameter
 
-__all__ = ['RecorderParams', 'LOOP_TOPICS']
+__all__ = ['RecorderParams', 'LOOP_TOPICS', 'LATCHED_TOPICS']
 
 # What a haptic session is: the loop's streams, the scene it ran against, and what each node
-# said about itself (its last report carries its final counts).
-LOOP_TOPICS = ('/wand/pose', '/wand/twist', '/collision/state', '/wand/wrench',
-               '/scene/description', '/diagnostics')
-# The streams a session must not start before the recorder hears them.
-STREAM_TOPICS = LOOP_TOPICS[:4]
+# said about itself (its last report carries its final counts), with their types, so that the
+# recorder subscribes at once instead of waiting to see them in the graph.
+LOOP_TOPICS = {
+    '/wand/pose': 'geometry_msgs/msg/PoseStamped',
+    '/wand/twist': 'geometry_msgs/msg/TwistStamped',
+    '/collision/state': 'haptic_msgs/msg/CollisionState',
+    '/wand/wrench': 'geometry_msgs/msg/WrenchStamped',
+    '/scene/description': 'std_msgs/msg/String',
+    '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
+}
+LATCHED_TOPICS = ('/scene/description',)
 
 
 @dataclass(frozen=True)
 class RecorderParams:
     output: str = parameter('bags/haptic_session', 'new bag directory to write')
-    topics: tuple[str, ...] = parameter(LOOP_TOPICS, 'topics to record')
+    topics: tuple[str, ...] = parameter(tuple(LOOP_TOPICS), 'topics to record (others than '
+                                        'the loop\'s are typed from the graph)')

@@ -1,8 +1,9 @@
 """A rosbag2 recorder for machines without ``ros2 bag``: raw CDR in, mcap (Jazzy format) out.
 
 Subscriptions are raw, so no message is converted to Python; each one is written with its
-receive time, as ``ros2 bag record`` does. A topic's type is taken from the graph once a
-publisher appears; latched topics (the scene description) are subscribed transient-local.
+receive time, as ``ros2 bag record`` does. The loop's topics are subscribed at once; another
+topic's type is taken from the graph once a publisher appears. Latched topics (the scene
+description) are subscribed transient-local.
 Once every topic has a matched publisher it says so on ``recorder/ready`` (latched), so that a
 driver can hold its session until nothing it publishes can be missed. On SIGINT or SIGTERM the
 bag is closed and complete; after ``kill -9`` it is recoverable up to the last flush (see
@@ -17,7 +18,7 @@ from rclpy.qos import DurabilityPolicy
 from std_msgs.msg import Bool
 
 from haptic_bringup.bag import BagWriter, typestore_with
-from haptic_bringup.params import RecorderParams
+from haptic_bringup.params import LATCHED_TOPICS, LOOP_TOPICS, RecorderParams
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.qos import LATCHED_QOS, RECORDER_QOS
@@ -56,31 +57,31 @@ class BagRecorder(Node):
             raise StartupError(f'{self.get_name()}: output {output} exists already; '
                                'give a new directory')
         self.bag = BagWriter(output, typestore_with(custom_definitions()))
-        self._pending = [self.resolve_topic_name(t) for t in self.params.topics]
-        self._stream_subscriptions = []
+        topics = [self.resolve_topic_name(t) for t in self.params.topics]
+        self._subscribed = []
         self._ready_pub = self.create_publisher(Bool, 'recorder/ready', LATCHED_QOS)
         self._ready_pub.publish(Bool(data=False))
+        for topic in [t for t in topics if t in LOOP_TOPICS]:
+            self._subscribe(topic, LOOP_TOPICS[topic], topic in LATCHED_TOPICS)
+        self._pending = [t for t in topics if t not in LOOP_TOPICS]
         self._poll = self.create_timer(GRAPH_POLL_PERIOD, self.subscribe_new_topics)
-        self.get_logger().info(f'recording {", ".join(self._pending)} to {output}')
+        self.get_logger().info(f'recording {", ".join(topics)} to {output}')
 
-    @property
-    def waiting_for(self) -> list:
-        """Topics not subscribed yet (no publisher seen)."""
-        return list(self._pending)
+    def _subscribe(self, topic: str, type_name: str, latched: bool) -> None:
+        self.bag.add_topic(topic, type_name)
+        self._subscribed.append(self.create_subscription(
+            message_class(type_name), topic, self._writer_for(topic),
+            LATCHED_QOS if latched else RECORDER_QOS, raw=True))
 
     def subscribe_new_topics(self) -> None:
+        """Subscribe the topics of unknown type once the graph shows them; say when ready."""
         types = dict(self.get_topic_names_and_types())
         for topic in [t for t in self._pending if t in types]:
-            type_name = types[topic][0]
             publishers = self.get_publishers_info_by_topic(topic)
-            latched = any(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
-                          for p in publishers)
-            self.bag.add_topic(topic, type_name)
-            self._stream_subscriptions.append(self.create_subscription(
-                message_class(type_name), topic, self._writer_for(topic),
-                LATCHED_QOS if latched else RECORDER_QOS, raw=True))
+            self._subscribe(topic, types[topic][0], any(
+                p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers))
             self._pending.remove(topic)
-        if not self._pending and all(s.get_publisher_count() for s in self._stream_subscriptions):
+        if not self._pending and all(s.get_publisher_count() for s in self._subscribed):
             self._poll.cancel()
             # DDS matches each reader-writer pair on both sides separately; the writers' side
             # can lag ours by tens of milliseconds, and what a writer sends before it has matched

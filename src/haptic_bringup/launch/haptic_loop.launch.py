@@ -16,11 +16,11 @@ from launch.actions import (DeclareLaunchArgument, ExecuteProcess, OpaqueFunctio
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
+from haptic_bringup.params import LOOP_TOPICS
+
 NODES = (('haptic_wand_driver', 'wand_driver', 'wand_driver'),
          ('collision_engine', 'collision_node', 'collision_engine'),
          ('force_renderer', 'force_node', 'force_renderer'))
-LOOP_TOPICS = ['/wand/pose', '/wand/twist', '/collision/state', '/wand/wrench',
-               '/scene/description']
 
 
 def _config(package: str) -> str:
@@ -49,6 +49,8 @@ def _nodes(context):
     if record:
         actions.append(ExecuteProcess(
             cmd=['ros2', 'bag', 'record', '-s', 'mcap', '-o', record, *LOOP_TOPICS],
+            # (ros2 bag starts recording when it sees each topic: the first samples may be lost;
+            # the local launcher's recorder holds the session until it hears every topic.)
             output='screen'))
     return actions
 
