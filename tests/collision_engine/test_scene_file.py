@@ -4,8 +4,11 @@ from pathlib import Path
 import textwrap
 
 from ground_truth import scene_path
+from hypothesis import given, HealthCheck, settings
+from hypothesis import strategies as st
 import numpy as np
 import pytest
+import yaml
 
 from collision_engine.errors import SceneError
 from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CylinderSpec, MeshSpec,
@@ -138,3 +141,40 @@ def test_missing_scene_file(tmp_path):
 
 def test_scene_error_is_a_value_error():
     assert issubclass(SceneError, ValueError)
+
+
+# Fuzzing: whatever a scene file holds, read_scene returns a scene or raises SceneError, with the
+# file's name in the message; nothing else escapes (no KeyError, TypeError, YAML error, crash).
+KEYS = ['frame_id', 'tip_radius', 'cross_validation', 'fcl', 'every', 'tolerance', 'objects',
+        'name', 'shape', 'pose', 'position', 'rpy', 'quaternion', 'material', 'stiffness',
+        'damping', 'box', 'size', 'sphere', 'radius', 'cylinder', 'height', 'capsule', 'length',
+        'mesh', 'file', 'scale', 'convex', 'colour']
+SCALARS = st.one_of(st.none(), st.booleans(), st.integers(-10**6, 10**6),
+                    st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=8))
+DOCUMENTS = st.recursive(
+    SCALARS,
+    lambda inner: st.one_of(st.lists(inner, max_size=4),
+                            st.dictionaries(st.sampled_from(KEYS), inner, max_size=5)),
+    max_leaves=25)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(document=DOCUMENTS)
+def test_fuzzed_structures_give_a_scene_or_a_scene_error(tmp_path_factory, document):
+    path = tmp_path_factory.mktemp('fuzz') / 'fuzzed.yaml'
+    path.write_text(yaml.safe_dump(document))
+    try:
+        read_scene(path)
+    except SceneError as error:
+        assert 'fuzzed.yaml' in str(error)
+
+
+@settings(max_examples=300, deadline=None)
+@given(raw=st.binary(max_size=300))
+def test_fuzzed_bytes_give_a_scene_or_a_scene_error(tmp_path_factory, raw):
+    path = tmp_path_factory.mktemp('fuzz') / 'bytes.yaml'
+    path.write_bytes(raw)
+    try:
+        read_scene(path)
+    except SceneError as error:
+        assert 'bytes.yaml' in str(error)

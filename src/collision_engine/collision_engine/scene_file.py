@@ -209,6 +209,9 @@ def read_scene(path) -> SceneSpec:
         document = yaml.safe_load(path.read_text(encoding='utf-8'))
     except OSError as error:
         raise SceneError(f'{path}: cannot read the scene file: {error.strerror}') from None
+    except UnicodeDecodeError as error:
+        raise SceneError(f'{path.name}: not a text file (byte {error.start} is not UTF-8)') \
+            from None
     except yaml.YAMLError as error:
         mark = getattr(error, 'problem_mark', None)
         at = f'line {mark.line + 1}' if mark is not None else 'document'
