@@ -12,6 +12,7 @@ from rclpy.node import Node
 
 from haptic_msgs.msg import CollisionState
 from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.stamps import to_stamp
 
 
 class LoopClient:
@@ -52,9 +53,10 @@ class LoopClient:
         raise TimeoutError('the loop did not connect to the test client')
 
     def send(self, position, *, frame_id: str = 'world', orientation=(0.0, 0.0, 0.0, 1.0),
-             velocity=(0.0, 0.0, 0.0)) -> tuple:
-        """Publish one pose and its twist, stamped now; return the stamp key."""
-        stamp = self.node.get_clock().now().to_msg()
+             velocity=(0.0, 0.0, 0.0), stamp_offset: float = 0.0) -> tuple:
+        """Publish one pose and its twist, stamped now (+ offset s); return the stamp key."""
+        now = self.node.get_clock().now().nanoseconds + round(stamp_offset * 1e9)
+        stamp = to_stamp(now)
         pose = PoseStamped()
         pose.header.stamp, pose.header.frame_id = stamp, frame_id
         pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = position
@@ -66,6 +68,21 @@ class LoopClient:
         self.twist_pub.publish(twist)
         self.pose_pub.publish(pose)
         return (stamp.sec, stamp.nanosec)
+
+    def flood(self, position, rate: float, duration: float) -> int:
+        """Publish poses alone (no twist) at ``rate`` Hz for ``duration`` s; return how many."""
+        pose = PoseStamped()
+        pose.header.frame_id = 'world'
+        pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = position
+        pose.pose.orientation.w = 1.0
+        clock, sent = self.node.get_clock(), 0
+        start = time.monotonic()
+        while (elapsed := time.monotonic() - start) < duration:
+            if sent < elapsed * rate:
+                pose.header.stamp = clock.now().to_msg()
+                self.pose_pub.publish(pose)
+                sent += 1
+        return sent
 
     def hold(self, position, duration: float, period: float = 0.001, **kwargs) -> list:
         """Send the same pose every ``period`` for ``duration`` s; return the stamps sent."""

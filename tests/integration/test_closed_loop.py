@@ -76,3 +76,27 @@ def test_bad_poses_are_refused_and_the_force_is_zero(collision_and_force, client
                for w in wrenches), label
     states = [client.states[s] for s in stamps if s in client.states]
     assert states and all(s.status == CollisionState.STATUS_INVALID_INPUT for s in states), label
+
+
+@pytest.mark.parametrize('label, offset', [
+    ('stamped 1 s in the future', 1.0),
+    ('stamped 0.5 s in the past (going backwards)', -0.5),
+])
+def test_poses_with_bad_stamps_get_zero_force(collision_and_force, client, label, offset):
+    client.wait_connected()
+    press = held_forces(client, (0.0, 0.0, TOP - 0.002))
+    assert press[-1][2] == pytest.approx(K * 0.002)
+    stamps = client.hold((0.0, 0.0, TOP - 0.002), HOLD, stamp_offset=offset)
+    wrenches = [w for w in client.collect(stamps) if w is not None]
+    assert wrenches, label
+    assert all(w.wrench.force.z == 0.0 for w in wrenches), label
+
+
+def test_a_20_khz_flood_of_poses_crashes_nothing_and_the_loop_answers_after(
+        collision_and_force, client):
+    client.wait_connected()
+    flooded = client.flood((0.0, 0.0, TOP - 0.001), rate=20000.0, duration=1.0)
+    assert flooded >= 19000, f'the flood reached only {flooded} poses/s'
+    assert all(child.returncode is None for child in collision_and_force.children)
+    forces = held_forces(client, (0.0, 0.0, TOP - 0.003))
+    np.testing.assert_allclose(forces[:, 2], K * 0.003, rtol=1e-9)
