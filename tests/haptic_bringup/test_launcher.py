@@ -1,0 +1,47 @@
+"""The local launcher's pieces: environment, parameters, and the discovery's expectations."""
+import os
+import pathlib
+import sys
+
+import yaml
+
+from haptic_bringup.launcher import (expected_endpoints, loop_environment, LoopConfig,
+                                     node_parameters)
+
+
+def test_children_discover_on_localhost_only_in_the_chosen_domain(tmp_path, monkeypatch):
+    monkeypatch.delenv('ROS_AUTOMATIC_DISCOVERY_RANGE', raising=False)
+    env = loop_environment(17, tmp_path / 'log')
+    assert env['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'LOCALHOST'
+    assert env['ROS_DOMAIN_ID'] == '17'
+    assert env['ROS_LOG_DIR'] == str(tmp_path / 'log')
+    assert any(pathlib.Path(p).samefile(sys.prefix)
+               for p in env['AMENT_PREFIX_PATH'].split(os.pathsep))
+
+
+def test_parameters_layer_package_defaults_a_user_file_and_the_options(tmp_path):
+    user = tmp_path / 'mine.yaml'
+    user.write_text(yaml.safe_dump({'force_renderer': {'ros__parameters': {
+        'stiffness': [500.0, 500.0, 500.0]}}}))
+    config = LoopConfig(scene='scene.yaml', experiment='hand', record=str(tmp_path / 'bag'),
+                        params_file=str(user),
+                        overrides={'force_renderer': {'force_limit': 3.0}})
+    merged = node_parameters(config)
+    force = merged['force_renderer']['ros__parameters']
+    assert force['stiffness'] == [500.0, 500.0, 500.0]  # the user's file over the default
+    assert force['force_limit'] == 3.0  # an override over both
+    assert force['damping'] == [0.8, 0.8, 0.8]  # the package default stays
+    driver = merged['wand_driver']['ros__parameters']
+    assert driver['experiment'] == 'hand' and driver['scene_file'] == 'scene.yaml'
+    assert driver['wait_for_recorder'] is True
+    assert merged['recorder']['ros__parameters']['output'] == str(tmp_path / 'bag')
+    assert merged['collision_engine']['ros__parameters']['scene_file'] == 'scene.yaml'
+
+
+def test_the_loop_is_closed_when_every_stream_has_its_publisher_and_subscribers():
+    full = expected_endpoints(LoopConfig(record='bag'))
+    assert full['/wand/pose'] == (1, 2)  # the collision node and the recorder
+    assert full['/collision/state'] == (1, 2)
+    assert full['/wand/wrench'] == (1, 1)
+    partial = expected_endpoints(LoopConfig(nodes=('collision_engine', 'force_renderer')))
+    assert partial['/wand/pose'] == (0, 1) and partial['/collision/state'] == (1, 1)

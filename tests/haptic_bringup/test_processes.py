@@ -1,0 +1,49 @@
+"""Child processes: stopped in escalating steps with their whole group; stale shm removed."""
+import fcntl
+import os
+import signal
+import sys
+import time
+
+import psutil
+
+from haptic_bringup.processes import clean_stale_shm, start_child, stop_children
+
+STUBBORN = """
+import signal, subprocess, sys, time
+signal.signal(signal.SIGINT, signal.SIG_IGN)   # ignores Ctrl-C, as a hung node would
+subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(60)'])   # and has a child
+print('ready', flush=True)
+time.sleep(60)
+"""
+
+
+def test_a_child_that_ignores_sigint_is_stopped_with_its_whole_group():
+    child = start_child('stubborn', [sys.executable, '-c', STUBBORN], env=None)
+    time.sleep(1.0)
+    group = [p for p in psutil.process_iter(['pid']) if _group_of(p) == child.pid]
+    assert len(group) == 2
+    started = time.monotonic()
+    codes = stop_children([child], timeout=0.5)
+    assert codes['stubborn'] == -signal.SIGTERM
+    assert time.monotonic() - started < 3.0
+    time.sleep(0.2)
+    assert not [p for p in group if p.is_running() and p.status() != psutil.STATUS_ZOMBIE]
+
+
+def _group_of(process):
+    try:
+        return os.getpgid(process.pid)
+    except (ProcessLookupError, psutil.NoSuchProcess):
+        return None
+
+
+def test_only_segments_no_live_process_holds_are_removed(tmp_path):
+    for name in ('fastrtps_dead', 'fastrtps_live'):
+        (tmp_path / name).write_bytes(b'segment')
+        (tmp_path / f'{name}_el').write_bytes(b'')
+    (tmp_path / 'sem.fastrtps_dead_mutex').write_bytes(b'')
+    with open(tmp_path / 'fastrtps_live_el', 'rb') as held:
+        fcntl.flock(held, fcntl.LOCK_SH)  # a live participant holds its lock
+        assert clean_stale_shm(tmp_path) == ['fastrtps_dead']
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['fastrtps_live', 'fastrtps_live_el']
