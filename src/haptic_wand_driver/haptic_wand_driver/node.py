@@ -18,11 +18,12 @@ from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
 from haptic_util.stamps import to_nanoseconds
-from haptic_wand_driver.device import make_device
+from haptic_wand_driver.device import DeviceLimits, make_device
 from haptic_wand_driver.experiments import make_script, needs_scene
 from haptic_wand_driver.loop_stats import LoopStats
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
+from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.simulated import SimulatedWandConfig
 from haptic_wand_driver.wrench_input import WrenchCommand
 
@@ -57,6 +58,9 @@ class WandDriverNode(Node):
                                     torque_limit=limits.torque_limit,
                                     timeout=params.wrench_timeout)
         self.stats = LoopStats()
+        self.passivity = (PortPassivity(params.passivity_max_damping) if params.passivity
+                          else None)
+        self._period = 1.0 / params.rate
         self._phase = Phase.WAITING
         self._state = None
         self._probe_start = self._device_offset = 0.0
@@ -89,8 +93,10 @@ class WandDriverNode(Node):
         if needs_scene(params.experiment):
             project = _surface_projection(
                 resolve_path(params.scene_file, what='parameter scene_file'))
-        config = SimulatedWandConfig(mass=[params.device_mass] * 3,
-                                     damping=[params.device_damping] * 3)
+        config = SimulatedWandConfig(
+            mass=[params.device_mass] * 3, damping=[params.device_damping] * 3,
+            limits=DeviceLimits(force_limit=params.force_limit,
+                                torque_limit=params.torque_limit))
         hand = OperatorHand(make_script(params.experiment, project),
                             stiffness=params.hand_stiffness, damping=params.hand_damping)
         return make_device('simulated', config=config, operator=hand)
@@ -117,7 +123,7 @@ class WandDriverNode(Node):
         elif self._phase is Phase.RUNNING:
             device_now = now - self._device_offset
             state = self._state = self.device.read(device_now)
-            self._apply(now, state.yaw)
+            self._apply(now, state)
             self._publish(state, now_ns)
             self.stats.sent(now_ns)
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
@@ -166,12 +172,15 @@ class WandDriverNode(Node):
         reason = self._take(msg, stamp_ns * 1e-9, now)
         if reason is not None:
             self.get_logger().warn(reason, throttle_duration_sec=WARN_PERIOD)
-        self._apply(now, state.yaw)
+        self._apply(now, state)
 
-    def _apply(self, now: float, yaw: float) -> None:
-        """Apply the held wrench, armed with its staleness deadline as the device's watchdog."""
+    def _apply(self, now: float, state) -> None:
+        """Apply the held wrench, kept passive, armed with its deadline as the device watchdog."""
         wrench = self.wrench
-        force, torque = wrench.current(now, yaw)
+        force, torque = wrench.current(now, state.yaw)
+        if self.passivity is not None:
+            force = self.passivity.control(force, state.position, state.linear_velocity,
+                                           self._period)
         pushing = any(force)
         if self._pushing and not pushing:
             # The force on the hand dropped at the applied wrench's deadline, if that came first
@@ -199,6 +208,8 @@ class WandDriverNode(Node):
         """Report the session's phase, counts and round trip so far, for /diagnostics."""
         summary = self.stats.summary()
         values = {'phase': self._phase.value, 'published': self._published, **summary}
+        if self.passivity is not None:
+            values['port_net_work_j'] = self.passivity.net_work
         return Report(OK, f'{self._phase.value}: {summary["answered_percent"]:.1f} % of '
                       f'{summary["poses"]} poses answered, p99 '
                       f'{1e3 * summary["latency_p99_s"]:.2f} ms', values)
@@ -207,7 +218,10 @@ class WandDriverNode(Node):
         self.diagnostics.final()
         self.device.close()
         if self.params.stats_file:
-            self.stats.save(self.params.stats_file, published=self._published)
+            extra = {'published': self._published}
+            if self.passivity is not None:
+                extra['port_net_work_j'] = self.passivity.net_work
+            self.stats.save(self.params.stats_file, **extra)
         self.get_logger().info(f'published {self._published} poses; experiment loop: '
                                f'{self.stats.summary()}')
         return super().destroy_node()

@@ -23,6 +23,11 @@ class WandDriverParams:
     wrench_timeout: float = parameter(0.010, 'a wrench older than this is stale: zero force',
                                       unit='s', low=0.0005, high=1.0)
     force_limit: float = parameter(10.0, 'device force limit (saturation)', unit='N', low=0.0)
+    passivity: bool = parameter(True, 'passivity observer and controller at the device port: '
+                                'removes the energy the loop delay makes a stiff wall return')
+    passivity_max_damping: float = parameter(50.0, 'largest damping it adds (keep below '
+                                             'device mass / servo period)', unit='N*s/m',
+                                             low=0.0)
     torque_limit: float = parameter(0.5, 'device torque limit (saturation)', unit='N*m', low=0.0)
     device_mass: float = parameter(0.15, 'simulated apparent mass per axis', unit='kg',
                                    low=1e-4)

@@ -1,0 +1,87 @@
+"""A passivity observer and controller at the device's port (Hannaford and Ryu, 2002).
+
+Why here as well as in the force renderer: the renderer sees the force it computes, but the
+wand feels that force a round trip later (about a millisecond over ROS 2), held until the next
+one arrives. That delay makes a stiff wall return more energy on the way out than it took on
+the way in, and the wand bounces. Only the device side knows the force actually applied and the
+motion it did work on, so only here can that energy be observed and removed.
+
+Sign rule: ``energy`` is what the environment has absorbed through the port, the negative of the
+work its force did on the tip (a spring's stored energy counts as absorbed). A passive
+environment keeps it >= 0. Each period the controller predicts the energy left once the force
+has done its work at the present velocity; if that would be negative, it adds a damping force,
+opposed to the velocity, just large enough to keep it at zero, capped at ``max_damping``. The
+added damping may cancel the force but never reverse it: the wall never pulls the tip in.
+
+The books are closed whenever the force is zero: out of contact the environment holds no
+energy, and dissipation in one contact may not pay for the next. (Carrying a deficit into the
+next contact was tried: the controller then cancels the wall's push until the deficit is paid,
+and the tip sinks into a soft wall.)
+"""
+import math
+
+__all__ = ['PortPassivity']
+
+Vector3 = tuple
+
+
+class PortPassivity:
+    """Keep the force applied at the device passive, against loop delay, jitter and drops.
+
+    Parameters
+    ----------
+    max_damping : float, N·s/m
+        Largest damping added; keep it below mass / servo period (a sampled damper oscillates
+        beyond).
+    """
+
+    def __init__(self, max_damping: float) -> None:
+        if not (max_damping >= 0.0 and math.isfinite(max_damping)):
+            raise ValueError(f'max_damping must be a finite number >= 0, got {max_damping!r}')
+        self.max_damping = float(max_damping)
+        self.energy = 0.0  # [J] absorbed by the environment in this contact
+        self.net_work = 0.0  # [J] done on the tip by the applied force since the start
+        self._force = (0.0, 0.0, 0.0)
+        self._position = None
+
+    def control(self, force: Vector3, position: Vector3, velocity: Vector3,
+                period: float) -> Vector3:
+        """Return the force to apply now, given the rendered one and the tip's motion.
+
+        Parameters
+        ----------
+        force : (3,) float, N
+            The force the renderer asks for.
+        position : (3,) float, m
+            The tip now.
+        velocity : (3,) float, m/s
+            The tip's velocity now.
+        period : float, s
+            Time until the next call (the servo period).
+        """
+        self._observe(position)
+        if not any(force):
+            self.energy = 0.0
+            self._force = (0.0, 0.0, 0.0)
+            return self._force
+        speed2 = velocity[0] ** 2 + velocity[1] ** 2 + velocity[2] ** 2
+        along = force[0] * velocity[0] + force[1] * velocity[1] + force[2] * velocity[2]
+        alpha = 0.0
+        # The energy left after the coming period if the force did its work at this velocity.
+        predicted = self.energy - along * period
+        if predicted < 0.0 and speed2 > 0.0 and period > 0.0:
+            alpha = min(-predicted / (period * speed2), self.max_damping)
+            if along > 0.0:  # at most cancel the force along itself, never turn it round
+                alpha = min(alpha, (force[0] ** 2 + force[1] ** 2 + force[2] ** 2) / along)
+        self._force = (force[0] - alpha * velocity[0], force[1] - alpha * velocity[1],
+                       force[2] - alpha * velocity[2])
+        return self._force
+
+    def _observe(self, position: Vector3) -> None:
+        """Book the work the held force did on the tip since the last call."""
+        if self._position is not None:
+            f, p, q = self._force, self._position, position
+            work = f[0] * (q[0] - p[0]) + f[1] * (q[1] - p[1]) + f[2] * (q[2] - p[2])
+            self.energy -= work
+            self.net_work += work
+        self._position = (position[0], position[1], position[2])

@@ -1,0 +1,85 @@
+"""The device-port passivity observer and controller: its books, and what it may and may not do."""
+import math
+
+import pytest
+
+from haptic_wand_driver.port_passivity import PortPassivity
+
+
+def test_the_observer_books_minus_the_work_of_the_held_force():
+    port = PortPassivity(max_damping=0.0)
+    port.control((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    port.control((2.0, 0.0, 0.0), (0.001, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)  # 1 N over +1 mm
+    port.control((2.0, 0.0, 0.0), (0.0005, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)  # 2 N over -0.5 mm
+    assert port.energy == pytest.approx(-1.0 * 0.001 + 2.0 * 0.0005)
+    assert port.net_work == pytest.approx(1.0 * 0.001 - 2.0 * 0.0005)
+
+
+def test_a_deficit_is_dissipated_by_damping_against_the_velocity():
+    port = PortPassivity(max_damping=1000.0)
+    port.control((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    velocity = (0.0, 0.0, -0.1)  # moving along -z while the force pushed +x: no reversal risk
+    force = port.control((1.0, 0.0, 0.0), (0.002, 0.0, 0.0), velocity, 0.001)
+    deficit = 1.0 * 0.002  # the force did 2 mJ of work on the tip
+    alpha = deficit / (0.001 * 0.1 ** 2)
+    assert force == pytest.approx((1.0, 0.0, alpha * 0.1))
+
+
+def test_damping_is_capped_and_never_turns_the_force_round():
+    port = PortPassivity(max_damping=1e6)
+    port.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    force = port.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.01), (0.0, 0.0, 0.5), 0.001)
+    assert force[2] == pytest.approx(0.0, abs=1e-12)  # cancelled, not reversed
+    capped = PortPassivity(max_damping=2.0)
+    capped.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    force = capped.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.01), (0.0, 0.0, 0.1), 0.001)
+    assert force[2] == pytest.approx(1.0 - 2.0 * 0.1)
+
+
+def test_the_books_close_when_the_force_is_zero():
+    port = PortPassivity(max_damping=100.0)
+    port.control((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    port.control((0.0, 0.0, 0.0), (0.003, 0.0, 0.0), (0.1, 0.0, 0.0), 0.001)
+    assert port.energy == 0.0
+    # A push against a tip coming in takes energy in: it passes untouched.
+    assert port.control((1.0, 0.0, 0.0), (0.003, 0.0, 0.0), (-0.1, 0.0, 0.0), 0.001) == \
+        (1.0, 0.0, 0.0)
+
+
+def test_a_push_that_would_give_energy_it_never_took_is_damped():
+    fast = PortPassivity(max_damping=100.0)
+    fast.control((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    assert fast.control((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.1, 0.0, 0.0), 0.001)[0] == \
+        pytest.approx(0.0, abs=1e-12)
+    # A slow tip is only slowed, at most max_damping: a wall still pushes out a tip inside it.
+    slow = PortPassivity(max_damping=50.0)
+    slow.control((1.6, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    assert slow.control((1.6, 0.0, 0.0), (0.0, 0.0, 0.0), (0.01, 0.0, 0.0), 0.001)[0] == \
+        pytest.approx(1.6 - 50.0 * 0.01)
+
+
+def bounce(k: float, delay_steps: int, port) -> float:
+    """A 0.15 kg tip dropped at 0.2 m/s on a wall at z = 0, the wall force one step late; return
+    the work the applied force did on the tip (J) over 1 s."""
+    mass, period, substeps = 0.15, 0.001, 20
+    z, v, work = 0.005, -0.2, 0.0
+    pending = [0.0] * (delay_steps + 1)
+    for _ in range(1000):
+        pending.append(k * max(-z, 0.0))
+        force = pending.pop(0)
+        if port is not None:
+            force = port.control((0.0, 0.0, force), (0.0, 0.0, z), (0.0, 0.0, v), period)[2]
+        for _ in range(substeps):
+            dt = period / substeps
+            v += dt * (force - 0.5) / mass  # a hand pressing down with 0.5 N
+            z += dt * v
+            work += force * v * dt
+    return work
+
+
+def test_with_a_late_stiff_wall_it_removes_the_energy_the_delay_creates():
+    free = bounce(5000.0, 1, None)
+    controlled = bounce(5000.0, 1, PortPassivity(max_damping=100.0))
+    assert free > 1e-4  # the delayed wall pushes back harder than it was pushed: active
+    assert controlled < 0.02 * free
+    assert math.isfinite(controlled)
