@@ -1,10 +1,12 @@
 """The main job: the simulated wand taps the paper's objects over ROS 2, recorded and summarised.
 
-    demo [--experiments cuboid cylinder hand] [--composed] [--out build/demo]
+    demo [--experiments cuboid cylinder hand cuboid-no-force] [--composed] [--out build/demo]
 
 For each experiment it launches the loop (driver, collision engine, force renderer and a
 recorder), lets the scripted operator tap for 10 s, stops, reads the bag back and prints one
 line per contact: depth, mean force per axis, and how far the force pointed from the normal.
+``cuboid-no-force`` is the control: the same taps with the force held at zero, to show how deep
+the operator's hand would go if nothing pushed back.
 """
 import argparse
 import os
@@ -24,10 +26,13 @@ from haptic_bringup.session import (published_counts, PUBLISHERS, read_session,
 
 __all__ = ['main', 'EXPERIMENTS', 'run_experiment']
 
+# name → (scene, operator script, parameter overrides)
 EXPERIMENTS = {
-    'cuboid': 'package://collision_engine/scenes/cuboid.yaml',
-    'cylinder': 'package://collision_engine/scenes/cylinder.yaml',
-    'hand': 'package://collision_engine/scenes/hand.yaml',
+    'cuboid': ('package://collision_engine/scenes/cuboid.yaml', 'cuboid', {}),
+    'cylinder': ('package://collision_engine/scenes/cylinder.yaml', 'cylinder', {}),
+    'hand': ('package://collision_engine/scenes/hand.yaml', 'hand', {}),
+    'cuboid-no-force': ('package://collision_engine/scenes/cuboid.yaml', 'cuboid',
+                        {'force_renderer': {'force_limit': 0.0}}),
 }
 DURATION = 10.0  # [s] as the paper's experiments
 
@@ -39,10 +44,10 @@ def run_experiment(name: str, out: pathlib.Path, *, composed: bool = False,
     shutil.rmtree(run, ignore_errors=True)
     run.mkdir(parents=True)
     stats = run / 'loop_stats.npz'
-    config = LoopConfig(composed=composed, scene=EXPERIMENTS[name], experiment=name,
-                        duration=duration, record=str(run / 'bag'), domain_id=domain_id,
-                        run_dir=run / 'launch',
-                        overrides={'wand_driver': {'stats_file': str(stats)}})
+    scene, script, overrides = EXPERIMENTS[name]
+    config = LoopConfig(composed=composed, scene=scene, experiment=script, duration=duration,
+                        record=str(run / 'bag'), domain_id=domain_id, run_dir=run / 'launch',
+                        overrides={**overrides, 'wand_driver': {'stats_file': str(stats)}})
     with Loop(config) as loop:
         ended = loop.wait(duration + 10.0)
         if ended is None or ended.name not in ('wand_driver', 'composed'):
@@ -60,7 +65,8 @@ def summarise(name: str, files: dict) -> str:
     recorded = topic_counts(files['bag'])
     published = published_counts(files['bag'], typestore)
     lines = [
-        f'== {name}: {len(contacts)} contacts in {session.time[-1]:.1f} s ==',
+        f'== {name}: {len(contacts)} contacts in {session.time[-1]:.1f} s, deepest '
+        f'{1e3 * max((c.max_depth for c in contacts), default=0.0):.2f} mm ==',
         format_contacts(contacts),
         f'loop: {float(loop["rate_hz"]):.0f} Hz, {float(loop["answered_percent"]):.1f} % of '
         f'{int(loop["poses"])} poses answered, round trip p50 '
@@ -76,7 +82,7 @@ def summarise(name: str, files: dict) -> str:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog='demo', description=__doc__.split('\n\n')[0])
     parser.add_argument('--experiments', nargs='+', choices=list(EXPERIMENTS),
-                        default=['cuboid'])
+                        default=list(EXPERIMENTS))
     parser.add_argument('--composed', action='store_true', help='one process for the loop')
     parser.add_argument('--out', default='build/demo', type=pathlib.Path)
     parser.add_argument('--domain-id', type=int,
