@@ -18,8 +18,11 @@ Three refinements of Hannaford and Ryu's scheme (bench/stiffness_sweep.py runs b
   buzz long before E reaches zero; against the continuous law, the energy the sampling generates
   shows up in the interval it is generated.
 - The damping is predicted for the coming interval (as Hannaford and Ryu include the current
-  force's power) and acts along the law's force only, so it scales that force: it never drags the
-  tip sideways, and it never reverses the force (no pulling).
+  force's power) and acts along the law's force only, so it scales that force and never reverses
+  it (no pulling). It scales it up when the tip moves against it (entering a wall: the sampled
+  spring's missing K·T/2 damping), and down when the tip moves with it. Its only sideways push is
+  on a force that is itself sideways: the damper's tangential residue as a contact ends, where the
+  report measured up to 62 mN.
 """
 
 import math
