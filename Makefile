@@ -25,7 +25,8 @@ $(STAMP): $(SETUP_INPUTS)
 	touch $@
 
 demo: $(STAMP)
-	$(VENV)/bin/demo
+	$(VENV)/bin/demo --out build/demo
+	$(PY) bench/report.py --demo-dir build/demo --out report
 
 test: $(STAMP)
 	$(PY) -m pytest -q tests
