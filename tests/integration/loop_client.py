@@ -85,14 +85,17 @@ class LoopClient:
         return sent
 
     def hold(self, position, duration: float, period: float = 0.001, **kwargs) -> list:
-        """Send the same pose every ``period`` for ``duration`` s; return the stamps sent."""
+        """Send the same pose every ``period`` for ``duration`` s; return the stamps sent.
+
+        Like a driver's timer, a late send does not make up for missed ones with a burst.
+        """
         stamps = []
-        start = time.monotonic()
-        for index in range(round(duration / period)):
-            next_send = start + index * period
+        next_send = time.monotonic()
+        for _ in range(round(duration / period)):
             while (remaining := next_send - time.monotonic()) > 0:
                 self.executor.spin_once(timeout_sec=remaining)
             stamps.append(self.send(position, **kwargs))
+            next_send = max(next_send + period, time.monotonic())
         return stamps
 
     def collect(self, stamps, timeout: float = 1.0) -> list:
