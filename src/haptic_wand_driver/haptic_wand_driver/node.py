@@ -58,8 +58,9 @@ class WandDriverNode(Node):
                                     torque_limit=limits.torque_limit,
                                     timeout=params.wrench_timeout)
         self.stats = LoopStats()
-        self.passivity = (PortPassivity(params.passivity_max_damping) if params.passivity
-                          else None)
+        # The observer always runs (its books are the port's energy figures); the controller acts
+        # only when enabled.
+        self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
         self._period = 1.0 / params.rate
         self._phase = Phase.WAITING
         self._state = None
@@ -178,9 +179,8 @@ class WandDriverNode(Node):
         """Apply the held wrench, kept passive, armed with its deadline as the device watchdog."""
         wrench = self.wrench
         force, torque = wrench.current(now, state.yaw)
-        if self.passivity is not None:
-            force = self.passivity.control(force, state.position, state.linear_velocity,
-                                           self._period)
+        force = self.passivity.control(force, state.position, state.linear_velocity,
+                                       self._period)
         pushing = any(force)
         if self._pushing and not pushing:
             # The force on the hand dropped at the applied wrench's deadline, if that came first
@@ -207,9 +207,8 @@ class WandDriverNode(Node):
     def report(self) -> Report:
         """Report the session's phase, counts and round trip so far, for /diagnostics."""
         summary = self.stats.summary()
-        values = {'phase': self._phase.value, 'published': self._published, **summary}
-        if self.passivity is not None:
-            values['port_net_work_j'] = self.passivity.net_work
+        values = {'phase': self._phase.value, 'published': self._published,
+                  'port_net_work_j': self.passivity.net_work, **summary}
         return Report(OK, f'{self._phase.value}: {summary["answered_percent"]:.1f} % of '
                       f'{summary["poses"]} poses answered, p99 '
                       f'{1e3 * summary["latency_p99_s"]:.2f} ms', values)
@@ -218,10 +217,8 @@ class WandDriverNode(Node):
         self.diagnostics.final()
         self.device.close()
         if self.params.stats_file:
-            extra = {'published': self._published}
-            if self.passivity is not None:
-                extra['port_net_work_j'] = self.passivity.net_work
-            self.stats.save(self.params.stats_file, **extra)
+            self.stats.save(self.params.stats_file, published=self._published,
+                            port_net_work_j=self.passivity.net_work)
         self.get_logger().info(f'published {self._published} poses; experiment loop: '
                                f'{self.stats.summary()}')
         return super().destroy_node()
