@@ -18,17 +18,15 @@ The methods: ours (``Scene.query``, the public API, points as tuples of floats);
 call); coal (the same probe through a cached ``ComputeDistance``, its result cleared per call).
 FCL and coal use their ``Box`` and ``Cylinder`` primitives, a ``Convex`` for the convex STL and
 a BVH for the hand, which they can only answer unsigned. Importable: ``run(...)`` returns the
-rows as dicts and ``machine()`` the context.
+rows as dicts.
 """
 
 import argparse
-from importlib.metadata import PackageNotFoundError, version
-import os
 from pathlib import Path
-import platform
 import sys
 import time
 
+import machine
 import numpy as np
 
 import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
@@ -39,7 +37,7 @@ from collision_engine.shapes import Box, ConvexMesh, Cylinder, TriangleMesh
 sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
 import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
 
-__all__ = ['OBJECTS', 'machine', 'point_sets', 'run', 'main']
+__all__ = ['OBJECTS', 'point_sets', 'run', 'main']
 
 # Bench object -> shipped scene file.
 OBJECTS = {'cuboid': 'cuboid', 'cylinder': 'cylinder', 'cylinder_stl': 'paper_cylinder_stl',
@@ -51,24 +49,6 @@ TAP_DEPTH = 0.001
 TAP_HEIGHT = 0.005
 RATE = 1000.0
 WARM_UP = 200
-
-
-def machine() -> dict:
-    """CPU model, core count, Python and library versions."""
-    cpu = platform.processor()
-    try:
-        with open('/proc/cpuinfo') as cpuinfo:
-            cpu = next(line.split(':', 1)[1].strip() for line in cpuinfo
-                       if line.startswith('model name'))
-    except (OSError, StopIteration):
-        pass
-    info = {'cpu': cpu, 'cores': os.cpu_count(), 'python': platform.python_version()}
-    for package in ('numpy', 'numba', 'scipy', 'python-fcl', 'coal'):
-        try:
-            info[package] = version(package)
-        except PackageNotFoundError:
-            info[package] = 'not installed'
-    return info
 
 
 def _truth_function(scene_object):
@@ -303,7 +283,7 @@ def main(argv=None) -> None:
     parser.add_argument('--tapping', type=float, default=10.0, help='tapping seconds at 1 kHz')
     parser.add_argument('--seed', type=int, default=0)
     args = parser.parse_args(argv)
-    print('machine:', ', '.join(f'{k} {v}' for k, v in machine().items()))
+    print('machine:', machine.line('numpy', 'numba', 'scipy', 'python-fcl', 'coal'))
     print(f'timer overhead (empty call, included below): {timer_overhead():.2f} us median')
     started = time.perf_counter()
     rows = run(args.objects, random=args.random, near=args.near, tapping=args.tapping,

@@ -12,11 +12,11 @@ answered, latency p50/p90/p99/max, and CPU of the loop's processes (100 % = one 
 import argparse
 import os
 import pathlib
-import platform
 import sys
 import tempfile
 import time
 
+import machine
 import numpy as np
 import psutil
 
@@ -24,16 +24,6 @@ from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 
 SCENE = 'package://collision_engine/scenes/cuboid.yaml'
 CPU_WINDOW_SKIP = 1.0  # [s] CPU is measured inside the session, this far from either end
-
-
-def machine() -> str:
-    """CPU model, cores, Python and rclpy versions: the context every figure needs."""
-    cpu = next((line.split(':', 1)[1].strip() for line in open('/proc/cpuinfo')
-                if line.startswith('model name')), platform.processor())
-    from importlib.metadata import version
-    return (f'{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, '
-            f'rclpy {version("rclpy")}, numba {version("numba")}, '
-            f'{time.strftime("%Y-%m-%d %H:%M")}')
 
 
 def cpu_seconds(pids) -> float:
@@ -88,7 +78,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    print(f'machine: {machine()}')
+    print(f'machine: {machine.line("rclpy", "numba")}')
     print(f'{args.runs} run(s) of {args.duration:g} s per layout and rate; latency in ms; '
           'CPU in % of one core, all loop processes')
     print(f'{"layout / rate / run":<28} {"pose Hz":>7} {"answered":>8} {"p50":>7} {"p90":>7} '

@@ -19,14 +19,12 @@ the median and p99 in µs, then the spread over repeats (min..max of each). The 
 """
 
 import argparse
-from importlib.metadata import version
-import os
 from pathlib import Path
-import platform
 import sys
 import tempfile
 import time
 
+import machine
 import numpy as np
 
 from haptic_wand_driver.operator import OperatorHand
@@ -38,26 +36,12 @@ from haptic_wand_driver.wrench_input import WrenchCommand
 sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests' / 'haptic_wand_driver'))
 from wand_ground_truth import Box, wall_force  # noqa: E402,I100 -- needs the tests on the path
 
-__all__ = ['machine', 'run_repeat', 'main']
+__all__ = ['run_repeat', 'main']
 
 TICK = 1e-3  # [s] the node's timer period
 WARM_UP = 500  # ticks left out of the statistics at the start of each repeat
 CUBOID = Box([0.0, 0.0, -0.075], [0.2, 0.1, 0.1])
 WRENCH_TIMEOUT = 0.010  # [s] the node's default
-
-
-def machine() -> str:
-    """CPU model, cores, Python and numpy/numba versions: the context every figure needs."""
-    cpu = platform.processor()
-    try:
-        with open('/proc/cpuinfo') as cpuinfo:
-            cpu = next(line.split(':', 1)[1].strip() for line in cpuinfo
-                       if line.startswith('model name'))
-    except (OSError, StopIteration):
-        pass
-    return (f'{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, '
-            f'numpy {version("numpy")}, numba {version("numba")}, '
-            f'{time.strftime("%Y-%m-%d %H:%M")}')
 
 
 def _timer_cost(calls: int) -> np.ndarray:
@@ -117,7 +101,7 @@ def main(argv=None) -> int:
     parser.add_argument('--seconds', type=float, default=10.5,
                         help='simulated seconds (1 kHz ticks) per repeat')
     args = parser.parse_args(argv)
-    print(f'machine: {machine()}')
+    print(f'machine: {machine.line("numpy", "numba")}')
     timer_median, timer_p99 = _summary(_timer_cost(100_000))
     print(f'timer cost (included below): median {timer_median:.3f} µs, p99 {timer_p99:.3f} µs')
     print(f'{args.repeats} repeat(s) of {args.seconds:g} s at 1 kHz, {WARM_UP} warm-up ticks '

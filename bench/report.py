@@ -30,6 +30,7 @@ import subprocess
 import sys
 import time
 
+import machine as bench_machine
 import numpy as np
 
 import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
@@ -805,7 +806,7 @@ def _git(*args: str) -> str:
 
 def provenance() -> dict:
     """Describe the machine, the versions, the date and the commit the report is made on."""
-    machine = bench_collision.machine()
+    machine = bench_machine.describe()
     versions = {}
     for package in VERSIONED:
         try:

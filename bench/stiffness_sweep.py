@@ -21,17 +21,16 @@ Usage: .venv/bin/python bench/stiffness_sweep.py [--points 13] [--timing]
 
 import argparse
 from dataclasses import dataclass
-import importlib.metadata
-import platform
 import time
 
+import machine
 import numpy as np
 
 from force_renderer import (Contact, ForcePipeline, GodObjectProxy, passivity_bound,
                             PipelineConfig, SpringDamper)
 from force_renderer.virtual_wall import Device, HalfSpace, OperatorHand, simulate
 
-__all__ = ['HannafordRyu2002', 'SweepRow', 'machine', 'sweep', 'time_step']
+__all__ = ['HannafordRyu2002', 'SweepRow', 'sweep', 'time_step']
 
 MODES = ('off', 'on', 'hannaford-ryu')
 DEVICE = Device(mass=0.15, damping=1.0, axes=np.array([[0.0, 0.0, 1.0]]))
@@ -153,27 +152,13 @@ def time_step(calls: int = 20000) -> dict[str, np.ndarray]:
     return times
 
 
-def machine() -> str:
-    """CPU model, Python and library versions."""
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open('/proc/cpuinfo') as cpuinfo:
-            cpu = next(line.split(':', 1)[1].strip() for line in cpuinfo
-                       if line.startswith('model name'))
-    except (OSError, StopIteration):
-        pass
-    versions = ', '.join(f'{name} {importlib.metadata.version(name)}'
-                         for name in ('numpy', 'scipy'))
-    return f'{cpu}; Python {platform.python_version()}; {versions}'
-
-
 def main() -> None:
     """Print the sweep table (and the step timing with --timing)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--points', type=int, default=13, help='stiffnesses from 1e2 to 1e5')
     parser.add_argument('--timing', action='store_true', help='also time ForcePipeline.step')
     args = parser.parse_args()
-    print(f'machine: {machine()}')
+    print(f'machine: {machine.line("numpy", "scipy")}')
     bound = passivity_bound(DEVICE.damping, PipelineConfig().servo_period, WALL_DAMPING)
     print(f'device m = {DEVICE.mass} kg, b = {DEVICE.damping} N*s/m; hand {HAND_STIFFNESS} N/m, '
           f'{HAND_DAMPING} N*s/m; C = {WALL_DAMPING} N*s/m; T = 1 ms; limit {FORCE_LIMIT} N; '
