@@ -60,6 +60,9 @@ def test_a_sequence_free_touch_press_release(collision_and_force, client):
 
 @pytest.mark.parametrize('label, kwargs', [
     ('NaN position', dict(position=(math.nan, 0.0, TOP - 0.002))),
+    ('infinite position', dict(position=(0.0, math.inf, TOP - 0.002))),
+    ('NaN orientation', dict(position=(0.0, 0.0, TOP - 0.002),
+                             orientation=(0.0, 0.0, math.nan, 1.0))),
     ('unknown frame', dict(position=(0.0, 0.0, TOP - 0.002), frame_id='base_link')),
     ('non-unit quaternion', dict(position=(0.0, 0.0, TOP - 0.002),
                                  orientation=(0.0, 0.0, 0.0, 0.5))),
