@@ -43,7 +43,13 @@ def test_only_segments_no_live_process_holds_are_removed(tmp_path):
         (tmp_path / name).write_bytes(b'segment')
         (tmp_path / f'{name}_el').write_bytes(b'')
     (tmp_path / 'sem.fastrtps_dead_mutex').write_bytes(b'')
+    for name, age in (('fastrtps_port7411', 60.0), ('fastrtps_port7413', 1.0)):
+        (tmp_path / name).write_bytes(b'port without a lock file')
+        (tmp_path / f'sem.{name}_mutex').write_bytes(b'')
+        os.utime(tmp_path / name, (time.time() - age, time.time() - age))
     with open(tmp_path / 'fastrtps_live_el', 'rb') as held:
         fcntl.flock(held, fcntl.LOCK_SH)  # a live participant holds its lock
-        assert clean_stale_shm(tmp_path) == ['fastrtps_dead']
-    assert sorted(p.name for p in tmp_path.iterdir()) == ['fastrtps_live', 'fastrtps_live_el']
+        assert clean_stale_shm(tmp_path) == ['fastrtps_dead', 'fastrtps_port7411']
+    # The live one stays, and so does a fresh lock-less one (its creator may be making the lock).
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        'fastrtps_live', 'fastrtps_live_el', 'fastrtps_port7413', 'sem.fastrtps_port7413_mutex']

@@ -19,6 +19,7 @@ __all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'wait_any
 
 PR_SET_PDEATHSIG = 1
 SHM_DIR = pathlib.Path('/dev/shm')
+UNLOCKED_SEGMENT_AGE = 10.0  # [s] a segment without a lock file this old has no owner
 
 
 class Child:
@@ -77,21 +78,35 @@ def stop_children(children: list, *, timeout: float = 5.0) -> dict:
 
 
 def clean_stale_shm(directory: pathlib.Path = SHM_DIR) -> list:
-    """Remove Fast DDS segments whose lock no live process holds; return their names."""
+    """Remove Fast DDS segments no live process holds; return their names.
+
+    A segment is held through its ``_el`` lock file: one nobody has locked is stale, and so is a
+    segment left without a lock file at all (once older than a creator needs to make one).
+    """
     removed = []
     for lock in sorted(directory.glob('fastrtps_*_el')):
         try:
             with lock.open('rb') as handle:
                 fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            continue  # a live participant holds it
-        except FileNotFoundError:
+        except (BlockingIOError, FileNotFoundError):
+            continue  # a live participant holds it, or it is already gone
+        removed.append(_remove_segment(directory, lock.name[:-len('_el')]))
+    now = time.time()
+    for segment in sorted(directory.glob('fastrtps_*')):
+        if segment.name.endswith('_el') or (directory / f'{segment.name}_el').exists():
             continue
-        segment = lock.name[:-len('_el')]
-        for name in (segment, lock.name, f'sem.{segment}_mutex'):
-            (directory / name).unlink(missing_ok=True)
-        removed.append(segment)
+        try:
+            if now - segment.stat().st_mtime > UNLOCKED_SEGMENT_AGE:
+                removed.append(_remove_segment(directory, segment.name))
+        except FileNotFoundError:
+            pass
     return removed
+
+
+def _remove_segment(directory: pathlib.Path, segment: str) -> str:
+    for name in (segment, f'{segment}_el', f'sem.{segment}_mutex'):
+        (directory / name).unlink(missing_ok=True)
+    return segment
 
 
 def wait_any_exit(children: list, timeout: float, poll: float = 0.05) -> Optional[Child]:
