@@ -1135,7 +1135,7 @@ def _stiff_wall_section(rows: list) -> str:
 
 
 def _force_effect_section(recordings: dict, demo_dir: Path) -> str:
-    """The cuboid taps with the force and without it (the demo's control run), side by side."""
+    """Put the cuboid taps with the force and without it (the demo's control run) side by side."""
     control = demo_dir / NO_FORCE_RUN / 'bag'
     if not control.exists():
         return f'*The demo\'s control run ({NO_FORCE_RUN}) was not found in {demo_dir}.*'

@@ -56,7 +56,8 @@ def wait_for_fresh_force(client: LoopClient, since_ns: int, timeout: float) -> i
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         client.executor.spin_once(timeout_sec=0.005)
-        for (sec, nanosec), wrench in list(client.wrenches.items()):
+        arrived, client.wrenches = client.wrenches, {}  # look at each wrench once
+        for (sec, nanosec), wrench in arrived.items():
             stamp = sec * 1_000_000_000 + nanosec
             if stamp > since_ns and abs(wrench.wrench.force.z) > 0.05:
                 return time.time_ns()
