@@ -54,14 +54,19 @@ def pressing_loop(tmp_path_factory):
 def wait_for_fresh_force(client: LoopClient, since_ns: int, timeout: float) -> int:
     """Spin until a non-zero wrench answering a pose stamped after ``since_ns`` arrives."""
     deadline = time.monotonic() + timeout
+    seen, fresh, strongest = 0, 0, 0.0
     while time.monotonic() < deadline:
         client.executor.spin_once(timeout_sec=0.005)
         arrived, client.wrenches = client.wrenches, {}  # look at each wrench once
         for (sec, nanosec), wrench in arrived.items():
-            stamp = sec * 1_000_000_000 + nanosec
-            if stamp > since_ns and abs(wrench.wrench.force.z) > 0.05:
-                return time.time_ns()
-    raise TimeoutError('the loop did not recover')
+            seen += 1
+            if sec * 1_000_000_000 + nanosec > since_ns:
+                fresh += 1
+                strongest = max(strongest, abs(wrench.wrench.force.z))
+                if strongest > 0.05:
+                    return time.time_ns()
+    raise TimeoutError(f'the loop did not recover: {seen} wrenches seen, {fresh} fresh, '
+                       f'strongest fresh force {strongest:.3g} N')
 
 
 def wait_for_steady_contact(client: LoopClient, timeout: float = 10.0) -> None:
