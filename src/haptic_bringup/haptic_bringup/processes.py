@@ -19,7 +19,7 @@ __all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'wait_any
 
 PR_SET_PDEATHSIG = 1
 SHM_DIR = pathlib.Path('/dev/shm')
-UNLOCKED_SEGMENT_AGE = 10.0  # [s] a segment without a lock file this old has no owner
+UNLOCKED_SEGMENT_AGE = 1.0  # [s] a segment without a lock file this old has no owner
 
 
 class Child:
