@@ -43,7 +43,7 @@ def test_only_segments_no_live_process_holds_are_removed(tmp_path):
         (tmp_path / name).write_bytes(b'segment')
         (tmp_path / f'{name}_el').write_bytes(b'')
     (tmp_path / 'sem.fastrtps_dead_mutex').write_bytes(b'')
-    for name, age in (('fastrtps_port7411', 60.0), ('fastrtps_port7413', 1.0)):
+    for name, age in (('fastrtps_port7411', 60.0), ('fastrtps_port7413', 0.0)):
         (tmp_path / name).write_bytes(b'port without a lock file')
         (tmp_path / f'sem.{name}_mutex').write_bytes(b'')
         os.utime(tmp_path / name, (time.time() - age, time.time() - age))
