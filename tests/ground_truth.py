@@ -353,6 +353,22 @@ def sample_near_surface(vertices: np.ndarray, faces: np.ndarray, n: int, band: f
                      f'closed and wound outward, and band ({band} m) small beside its features?')
 
 
+def outward_hull(cloud: np.ndarray) -> tuple:
+    """Return the convex hull of a point cloud by scipy: faces (m, 3) wound outward, planes.
+
+    ``planes`` are scipy's facet equations: unit outward normal and offset (n·x + d = 0).
+    """
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(cloud)
+    faces = hull.simplices.copy()
+    corners = cloud[faces]
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    inward = np.einsum('ij,ij->i', normals, hull.equations[:, :3]) < 0.0
+    faces[inward] = faces[inward][:, ::-1]
+    return faces, hull.equations
+
+
 def scene_path(name: str) -> Path:
     """Path of a shipped scene file: ``'cuboid'`` gives ``scenes/cuboid.yaml``."""
     path = SCENES_DIR / f'{name.removesuffix(".yaml")}.yaml'

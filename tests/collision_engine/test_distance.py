@@ -6,11 +6,10 @@ frame, with the world-to-local transform done here by scipy's ``Rotation``. The 
 """
 
 from ground_truth import (box_signed_distance, capsule_signed_distance,
-                          cylinder_signed_distance, mesh_signed_distance,
+                          cylinder_signed_distance, mesh_signed_distance, outward_hull,
                           sphere_signed_distance)
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
 from collision_engine.distance import distance, DistanceRequest
@@ -204,15 +203,10 @@ def test_points_1e_12_from_a_convex_mesh():
     rng = np.random.default_rng(8)
     cloud = rng.normal(size=(200, 3)) * [0.05, 0.03, 0.02]
     shape = ConvexMesh(cloud)
-    hull = ConvexHull(cloud)
-    faces = hull.simplices.copy()
-    corners = cloud[faces]
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    inward = np.einsum('ij,ij->i', normals, hull.equations[:, :3]) < 0.0
-    faces[inward] = faces[inward][:, ::-1]
+    faces, planes = outward_hull(cloud)
     weights = rng.dirichlet(np.ones(3), size=len(faces))
     on_faces = np.einsum('fk,fkj->fj', weights, cloud[faces])
-    unit = hull.equations[:, :3]
+    unit = planes[:, :3]
     for offset in (1e-12, -1e-12, 1e-9, -1e-9, 1e-3, -1e-3):
         local = on_faces + offset * unit
         expected = mesh_signed_distance(local, cloud, faces)[0]

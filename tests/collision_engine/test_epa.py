@@ -1,12 +1,12 @@
 """EPA's penetration depth inside convex meshes, against brute force on scipy's hull facets."""
 
-from ground_truth import mesh_signed_distance
+from ground_truth import mesh_signed_distance, outward_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull, QhullError
+from scipy.spatial import QhullError
 
 from collision_engine.epa import epa
 from collision_engine.gjk import gjk, STATUS_OK
@@ -14,17 +14,6 @@ from collision_engine.shapes import ConvexMesh
 from collision_engine.support import pack_convex
 
 TOL = 1e-12
-
-
-def outward_hull(cloud: np.ndarray):
-    """scipy's hull of the cloud, facets wound outward, and the facets' unit normals."""
-    hull = ConvexHull(cloud)
-    faces = hull.simplices.copy()
-    corners = cloud[faces]
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    inward = np.einsum('ij,ij->i', normals, hull.equations[:, :3]) < 0.0
-    faces[inward] = faces[inward][:, ::-1]
-    return faces, hull.equations
 
 
 def penetration(shape: ConvexMesh, point: np.ndarray):

@@ -7,13 +7,13 @@ distance to a polytope by ``ground_truth.mesh_signed_distance`` on scipy's hull 
 
 from itertools import combinations
 
-from ground_truth import capsule_signed_distance, mesh_signed_distance
+from ground_truth import capsule_signed_distance, mesh_signed_distance, outward_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull, QhullError
+from scipy.spatial import QhullError
 
 from collision_engine.gjk import (gjk, nearest_on_simplex, nearest_on_triangle,
                                   STATUS_NOT_CONVERGED, STATUS_OK)
@@ -55,12 +55,7 @@ def run_gjk(shape, point, direction=None, max_iterations=100):
 
 def hull_distance(cloud: np.ndarray, points) -> np.ndarray:
     """Brute-force signed distance to the hull, its facets wound outward for the sign."""
-    hull = ConvexHull(cloud)
-    faces = hull.simplices.copy()
-    corners = cloud[faces]
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    inward = np.einsum('ij,ij->i', normals, hull.equations[:, :3]) < 0.0
-    faces[inward] = faces[inward][:, ::-1]
+    faces, _ = outward_hull(cloud)
     return mesh_signed_distance(np.asarray(points, dtype=np.float64), cloud, faces)[0]
 
 
