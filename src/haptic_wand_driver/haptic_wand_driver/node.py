@@ -117,8 +117,11 @@ class WandDriverNode(Node):
                 return
             self._state = self.device.read(now)
             self._probe_start = now
-            self._phase = Phase.PROBING if self.params.wait_for_wrench else Phase.RUNNING
-            self._start(now)
+            if not self.params.wait_for_wrench:
+                self._run(now)
+            else:
+                self._phase = Phase.PROBING
+                self.get_logger().info('loop connected: probing it end to end')
         if self._phase is Phase.PROBING:
             self._publish(self._state, now_ns)  # the device at rest where it starts
         elif self._phase is Phase.RUNNING:
@@ -133,11 +136,9 @@ class WandDriverNode(Node):
                 # The last poses are still on their way round: let their wrenches come back.
                 self.create_timer(IN_FLIGHT_GRACE, request_stop)
 
-    def _start(self, now: float) -> None:
-        """Start the session once a wrench answered a probe (or at once, open loop)."""
-        if self._phase is Phase.PROBING:
-            self.get_logger().info('loop connected: probing it end to end')
-            return
+    def _run(self, now: float) -> None:
+        """Start the session: once a wrench answered a probe, or at once when open loop."""
+        self._phase = Phase.RUNNING
         self._device_offset = now - self._probe_start  # the device's clock skips the probing
         self.get_logger().info('loop closed: experiment started')
 
@@ -163,8 +164,7 @@ class WandDriverNode(Node):
         stamp_ns = to_nanoseconds(msg.header.stamp)
         if self._phase is Phase.PROBING:
             if stamp_ns <= self._last_probe_ns:  # it answers a probe: the loop is closed
-                self._phase = Phase.RUNNING
-                self._start(now)
+                self._run(now)
             return
         self.stats.answered(stamp_ns, now_ns)
         if self._phase is not Phase.RUNNING:
