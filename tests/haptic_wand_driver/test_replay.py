@@ -203,3 +203,19 @@ def test_a_single_pose_cannot_be_replayed(tmp_path):
 def test_bad_options_are_refused(tmp_path, options, expected):
     with pytest.raises(ReplayError, match=expected):
         ReplayDevice(write_csv(tmp_path / 'track.csv'), **options)
+
+
+def test_playback_interpolates_each_coordinate_linearly_between_samples(tmp_path):
+    rng = np.random.default_rng(3)
+    times = np.cumsum(rng.uniform(0.0005, 0.002, size=200))
+    coordinates = np.column_stack([rng.uniform(-0.05, 0.05, size=(200, 3)),
+                                   rng.uniform(-0.4, 0.4, size=(200, 2))])
+    path = tmp_path / 'noisy.csv'
+    write_pose_csv(path, PoseTable(times, coordinates))
+    device = ReplayDevice(path)
+    device.read(10.0)  # starts playback at the first sample
+    queries = np.concatenate([rng.uniform(0.0, times[-1] - times[0], 50), times[:5] - times[0]])
+    for elapsed in np.sort(queries):
+        state = device.read(10.0 + elapsed)
+        expected = [np.interp(times[0] + elapsed, times, column) for column in coordinates.T]
+        np.testing.assert_allclose(state.coordinates, expected, rtol=0, atol=1e-12)

@@ -181,9 +181,15 @@ class ReplayDevice(HapticDevice):
             played %= self._duration
         elif played >= self._duration:
             return WandState.from_coordinates(now, self._coordinates[-1], np.zeros(5))
-        coordinates = [np.interp(played, self._times, column) for column in self._coordinates.T]
-        rates = [np.interp(played, self._times, column) for column in self._rates.T]
-        return WandState.from_coordinates(now, np.array(coordinates), np.array(rates))
+        # One search, then a blend of the two neighbouring rows: linear interpolation, as
+        # np.interp per column would give, at a tenth of the cost in the 1 kHz loop.
+        times = self._times
+        after = min(max(int(np.searchsorted(times, played, side='right')), 1), len(times) - 1)
+        weight = (played - times[after - 1]) / (times[after] - times[after - 1])
+        coordinates = self._coordinates[after - 1] + weight * (
+            self._coordinates[after] - self._coordinates[after - 1])
+        rates = self._rates[after - 1] + weight * (self._rates[after] - self._rates[after - 1])
+        return WandState.from_coordinates(now, coordinates, rates)
 
     def apply(self, force: np.ndarray, torque: np.ndarray, *, until: float = math.inf) -> None:
         """Ignore the wrench: a recording cannot be pushed."""
