@@ -178,7 +178,7 @@ class ConvexMesh(_ConvexShape):
         The hull's triangles, wound counter-clockwise seen from outside.
     """
 
-    __slots__ = ('vertices', 'faces')
+    __slots__ = ('vertices', 'faces', '_sphere')
     kind = _support.CONVEX_MESH
 
     def __init__(self, vertices) -> None:
@@ -201,6 +201,7 @@ class ConvexMesh(_ConvexShape):
         faces[inward] = faces[inward][:, ::-1]
         self.faces = faces
         self._packed = None
+        self._sphere = None
 
     def vertex_adjacency(self) -> tuple[np.ndarray, np.ndarray]:
         """Hull edges as compressed rows: neighbours of vertex i are ``neighbours[o[i]:o[i+1]]``.
@@ -220,7 +221,9 @@ class ConvexMesh(_ConvexShape):
 
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
         """Centre (3,) m and radius m of a sphere holding the shape, local frame."""
-        return _bounding_sphere(self.vertices)
+        if self._sphere is None:
+            self._sphere = _bounding_sphere(self.vertices)
+        return self._sphere
 
     def __repr__(self) -> str:
         return f'ConvexMesh({len(self.vertices)} hull vertices)'
@@ -246,7 +249,7 @@ class TriangleMesh:
         When the surface is open, non-manifold, inconsistently wound or has a degenerate face.
     """
 
-    __slots__ = ('vertices', 'faces', '__weakref__')
+    __slots__ = ('vertices', 'faces', '_sphere', '__weakref__')
     kind = _support.TRIANGLE_MESH
 
     def __init__(self, vertices, faces, *, name: str = 'TriangleMesh') -> None:
@@ -262,6 +265,7 @@ class TriangleMesh:
         _check_closed_and_wound(vertices, faces, name)
         self.vertices = vertices
         self.faces = faces
+        self._sphere = None
 
     def support(self, direction) -> np.ndarray:
         """Farthest vertex along ``direction`` (3,): the support of the convex hull, m."""
@@ -269,14 +273,18 @@ class TriangleMesh:
 
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
         """Centre (3,) m and radius m of a sphere holding the shape, local frame."""
-        return _bounding_sphere(self.vertices)
+        if self._sphere is None:
+            self._sphere = _bounding_sphere(self.vertices)
+        return self._sphere
 
     def __repr__(self) -> str:
         return f'TriangleMesh({len(self.vertices)} vertices, {len(self.faces)} faces)'
 
 
 def _bounding_sphere(vertices: np.ndarray) -> tuple[np.ndarray, float]:
+    """Computed once per mesh (it reads every vertex): the shapes keep it."""
     centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+    centre.setflags(write=False)
     return centre, float(np.linalg.norm(vertices - centre, axis=1).max())
 
 
