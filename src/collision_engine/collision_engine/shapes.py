@@ -282,7 +282,7 @@ class TriangleMesh:
 
 
 def _bounding_sphere(vertices: np.ndarray) -> tuple[np.ndarray, float]:
-    """Computed once per mesh (it reads every vertex): the shapes keep it."""
+    """Compute the sphere once per mesh (it reads every vertex): the shapes keep it."""
     centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
     centre.setflags(write=False)
     return centre, float(np.linalg.norm(vertices - centre, axis=1).max())
