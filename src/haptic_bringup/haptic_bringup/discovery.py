@@ -11,11 +11,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.node import Node
 
-__all__ = ['Endpoints', 'GraphWatcher']
-
-
-class Endpoints(dict):
-    """Topic → (minimum publishers, minimum subscribers)."""
+__all__ = ['GraphWatcher']
 
 
 class GraphWatcher:

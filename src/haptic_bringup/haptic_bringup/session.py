@@ -9,6 +9,8 @@ import pathlib
 import numpy as np
 from rosbags.highlevel import AnyReader
 
+from haptic_util.stamps import to_nanoseconds
+
 __all__ = ['Session', 'read_session', 'topic_counts', 'published_counts', 'PUBLISHERS']
 
 # Which node publishes each stream, by its name in /diagnostics reports.
@@ -77,9 +79,9 @@ def read_session(path: pathlib.Path, typestore) -> Session:
         for connection, _, raw in reader.messages():
             msg = reader.deserialize(raw, connection.msgtype)
             if connection.topic == '/collision/state':
-                states[_stamp(msg)] = msg
+                states[to_nanoseconds(msg.header.stamp)] = msg
             elif connection.topic == '/wand/wrench':
-                wrenches[_stamp(msg)] = msg
+                wrenches[to_nanoseconds(msg.header.stamp)] = msg
             elif connection.topic == '/scene/description':
                 scene = msg.data
     stamps = sorted(states)
@@ -101,10 +103,6 @@ def read_session(path: pathlib.Path, typestore) -> Session:
         fcl_distance=np.array([m.fcl_distance for m in rows]),
         fcl_discrepancy=np.array([m.fcl_discrepancy for m in rows]),
         scene=scene)
-
-
-def _stamp(msg) -> int:
-    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
 
 
 def _xyz(vector) -> tuple:

@@ -1,12 +1,7 @@
-"""Conversions between builtin_interfaces/Time and float seconds, in one place."""
+"""Conversions between builtin_interfaces/Time and integer nanoseconds, in one place."""
 from builtin_interfaces.msg import Time
 
-__all__ = ['to_seconds', 'to_stamp', 'to_nanoseconds']
-
-
-def to_seconds(stamp: Time) -> float:
-    """Return a stamp as float seconds (ns resolution is kept to ~0.2 µs for current epochs)."""
-    return stamp.sec + stamp.nanosec * 1e-9
+__all__ = ['to_stamp', 'to_nanoseconds']
 
 
 def to_nanoseconds(stamp: Time) -> int:
