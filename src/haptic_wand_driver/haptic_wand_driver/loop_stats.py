@@ -6,34 +6,48 @@ answered (a wrench with that pose's stamp), each answer's latency and arrival ti
 each instant the applied force started (became non-zero) and stopped (dropped to zero, at the
 watchdog deadline when the wrenches stopped), which is what the fail-safe tests measure.
 """
+from array import array
+
 import numpy as np
 
 __all__ = ['LoopStats']
 
 
 class LoopStats:
-    """Poses sent and answered, and round-trip latencies [s]."""
+    """Poses sent and answered, and round-trip latencies [s].
+
+    Its memory stays flat in sessions of hours: a pose waits for its answer at most
+    ``ANSWER_WINDOW`` (a wrench later than that could not be applied anyway), and each answer
+    keeps 16 bytes.
+    """
+
+    ANSWER_WINDOW_NS = 1_000_000_000
 
     def __init__(self) -> None:
-        self._sent: set = set()
-        self._answered: set = set()
-        self._latency_ns: list = []
-        self._arrival_ns: list = []
+        self._pending: dict = {}  # stamps of poses awaiting their wrench, oldest first
+        self._poses = 0
+        self._answers = 0
+        self._latency_ns = array('q')
+        self._arrival_ns = array('q')
         self._force_on_ns: list = []
         self._force_off_ns: list = []
         self._first_ns = None
         self._last_ns = None
 
     def sent(self, stamp_ns: int) -> None:
-        self._sent.add(stamp_ns)
+        pending = self._pending
+        pending[stamp_ns] = None
+        while (oldest := next(iter(pending))) < stamp_ns - self.ANSWER_WINDOW_NS:
+            del pending[oldest]
+        self._poses += 1
         if self._first_ns is None:
             self._first_ns = stamp_ns
         self._last_ns = stamp_ns
 
     def answered(self, stamp_ns: int, received_ns: int) -> None:
         """Record a wrench for the pose stamped ``stamp_ns``; others are not loop answers."""
-        if stamp_ns in self._sent and stamp_ns not in self._answered:
-            self._answered.add(stamp_ns)
+        if self._pending.pop(stamp_ns, False) is None:
+            self._answers += 1
             self._latency_ns.append(received_ns - stamp_ns)
             self._arrival_ns.append(received_ns)
 
@@ -47,16 +61,16 @@ class LoopStats:
 
     @property
     def poses(self) -> int:
-        return len(self._sent)
+        return self._poses
 
     @property
     def answers(self) -> int:
-        return len(self._answered)
+        return self._answers
 
     @property
     def latencies(self) -> np.ndarray:
         """(n,) float, s: round trip of each answered pose, in arrival order."""
-        return np.asarray(self._latency_ns, dtype=np.float64) * 1e-9
+        return np.frombuffer(self._latency_ns, dtype=np.int64) * 1e-9
 
     @property
     def rate(self) -> float:
@@ -65,9 +79,13 @@ class LoopStats:
             return 0.0
         return (self.poses - 1) / ((self._last_ns - self._first_ns) * 1e-9)
 
-    def summary(self) -> dict:
-        """Rate, share answered, and latency percentiles (s), for logs and benchmarks."""
-        latency = self.latencies
+    def summary(self, last: int = 0) -> dict:
+        """Rate, share answered, and latency percentiles (s), for logs and benchmarks.
+
+        ``last`` > 0 takes the percentiles over the last answers only (a periodic report stays
+        cheap however long the session); the counts are always the whole session's.
+        """
+        latency = self.latencies[-last:] if last else self.latencies
         percentiles = (np.percentile(latency, [50, 90, 99]) if latency.size
                        else np.full(3, np.nan))
         return {
@@ -84,7 +102,7 @@ class LoopStats:
     def save(self, path, **extra) -> None:
         """Write the raw latencies, the summary and ``extra`` figures to an .npz file."""
         np.savez(path, latencies=self.latencies,
-                 arrival_ns=np.asarray(self._arrival_ns, dtype=np.int64),
+                 arrival_ns=np.frombuffer(self._arrival_ns, dtype=np.int64),
                  force_on_ns=np.asarray(self._force_on_ns, dtype=np.int64),
                  force_off_ns=np.asarray(self._force_off_ns, dtype=np.int64),
                  **self.summary(), **extra)

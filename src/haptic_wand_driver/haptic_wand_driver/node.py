@@ -31,6 +31,7 @@ __all__ = ['WandDriverNode', 'main']
 
 WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
 DIAGNOSTICS_PERIOD = 1.0  # [s]
+DIAGNOSTICS_WINDOW = 10_000  # latencies in a report's percentiles: about the last 10 s
 IN_FLIGHT_GRACE = 0.05  # [s] after the last pose, for its answer to arrive
 
 
@@ -206,11 +207,11 @@ class WandDriverNode(Node):
 
     def report(self) -> Report:
         """Report the session's phase, counts and round trip so far, for /diagnostics."""
-        summary = self.stats.summary()
+        summary = self.stats.summary(last=DIAGNOSTICS_WINDOW)
         values = {'phase': self._phase.value, 'published': self._published,
                   'port_net_work_j': self.passivity.net_work, **summary}
         return Report(OK, f'{self._phase.value}: {summary["answered_percent"]:.1f} % of '
-                      f'{summary["poses"]} poses answered, p99 '
+                      f'{summary["poses"]} poses answered, recent p99 '
                       f'{1e3 * summary["latency_p99_s"]:.2f} ms', values)
 
     def destroy_node(self) -> bool:
