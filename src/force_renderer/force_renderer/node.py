@@ -7,7 +7,6 @@ zero torque. When no fresh state arrives for ``watchdog_timeout``, it publishes 
 """
 from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
 from rclpy.node import Node
-from std_msgs.msg import Header
 from visualization_msgs.msg import Marker
 
 from force_renderer.contact import Contact
@@ -132,9 +131,9 @@ class ForceNode(Node):
             self.get_logger().warn(f'force zeroed: {reason.value}',
                                    throttle_duration_sec=WARN_PERIOD)
         wrench = self._wrench
-        # A zero sent because the state is stale answers no pose: it is stamped now.
-        wrench.header = self._header if reason is not Reason.STALE else Header(
-            stamp=self.get_clock().now().to_msg(), frame_id=self._header.frame_id)
+        # Even the watchdog's zero carries the stamp of the state it judged, so it never
+        # supersedes an answer to a newer pose still on its way to the driver.
+        wrench.header = self._header
         f = wrench.wrench.force
         f.x, f.y, f.z = float(force[0]), float(force[1]), float(force[2])
         self._wrench_pub.publish(wrench)
