@@ -2,6 +2,7 @@
 
 It lives in its own rclpy context, so a test can use it beside a launched loop.
 """
+import struct
 import time
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
@@ -9,10 +10,14 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.serialization import serialize_message
 
 from haptic_msgs.msg import CollisionState
 from haptic_util.qos import HAPTIC_STREAM_QOS
 from haptic_util.stamps import to_stamp
+
+STAMP_OFFSET = 4  # [bytes] header.stamp in a CDR message, after the encapsulation header
+ANSWER_TIMEOUT = 5.0  # [s] for one pose's answer: ample on a machine busy with other work
 
 
 class LoopClient:
@@ -28,6 +33,7 @@ class LoopClient:
         self.twist_pub = self.node.create_publisher(TwistStamped, 'wand/twist',
                                                     HAPTIC_STREAM_QOS)
         self.wrenches = {}
+        self.arrivals = {}  # stamp key -> when its first wrench arrived [ns, this clock]
         self.states = {}
         self.wrench_sub = self.node.create_subscription(
             WrenchStamped, 'wand/wrench', self._on_wrench, HAPTIC_STREAM_QOS)
@@ -35,22 +41,33 @@ class LoopClient:
             CollisionState, 'collision/state', self._on_state, HAPTIC_STREAM_QOS)
 
     def _on_wrench(self, msg: WrenchStamped) -> None:
-        self.wrenches[(msg.header.stamp.sec, msg.header.stamp.nanosec)] = msg
+        key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+        if key not in self.wrenches:  # the answer; a watchdog's zero for the same stamp follows
+            self.wrenches[key] = msg
+            self.arrivals[key] = self.node.get_clock().now().nanoseconds
 
     def _on_state(self, msg: CollisionState) -> None:
         self.states[(msg.header.stamp.sec, msg.header.stamp.nanosec)] = msg
 
     def wait_connected(self, timeout: float = 20.0) -> None:
-        """Until our publishers and subscriptions have matched the loop's."""
+        """Until the loop answers a pose: both ways matched, so no later pose is lost to it."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if (self.pose_pub.get_subscription_count() >= 1
                     and self.twist_pub.get_subscription_count() >= 1
                     and self.wrench_sub.get_publisher_count() >= 1
-                    and self.state_sub.get_publisher_count() >= 1):
+                    and self.state_sub.get_publisher_count() >= 1
+                    and self.exchange((0.0, 0.0, 1.0), timeout=0.2)[1] is not None):
                 return
             self.executor.spin_once(timeout_sec=0.02)
         raise TimeoutError('the loop did not connect to the test client')
+
+    def spin_until(self, done, timeout: float = ANSWER_TIMEOUT) -> bool:
+        """Spin until ``done()`` or ``timeout`` s; return ``done()``."""
+        deadline = time.monotonic() + timeout
+        while not done() and time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=0.005)
+        return done()
 
     def send(self, position, *, frame_id: str = 'world', orientation=(0.0, 0.0, 0.0, 1.0),
              velocity=(0.0, 0.0, 0.0), stamp_offset: float = 0.0) -> tuple:
@@ -69,41 +86,37 @@ class LoopClient:
         self.pose_pub.publish(pose)
         return (stamp.sec, stamp.nanosec)
 
-    def flood(self, position, rate: float, duration: float) -> int:
-        """Publish poses alone (no twist) at ``rate`` Hz for ``duration`` s; return how many."""
+    def flood(self, position, count: int) -> float:
+        """Publish ``count`` poses alone (no twist) as fast as this client can; return the rate.
+
+        Each pose is serialized once and only its stamp rewritten, so the flood is limited by
+        DDS, not by Python message conversion. The rate (Hz) is what was actually sent.
+        """
         pose = PoseStamped()
         pose.header.frame_id = 'world'
         pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = position
         pose.pose.orientation.w = 1.0
-        clock, sent = self.node.get_clock(), 0
+        cdr = bytearray(serialize_message(pose))
         start = time.monotonic()
-        while (elapsed := time.monotonic() - start) < duration:
-            if sent < elapsed * rate:
-                pose.header.stamp = clock.now().to_msg()
-                self.pose_pub.publish(pose)
-                sent += 1
-        return sent
+        for _ in range(count):
+            sec, nanosec = divmod(time.time_ns(), 1_000_000_000)  # ROS time is system time
+            struct.pack_into('<iI', cdr, STAMP_OFFSET, sec, nanosec)
+            self.pose_pub.publish(bytes(cdr))
+        return count / (time.monotonic() - start)
 
-    def hold(self, position, duration: float, period: float = 0.001, **kwargs) -> list:
-        """Send the same pose every ``period`` for ``duration`` s; return the stamps sent.
+    def exchange(self, position, *, timeout: float = ANSWER_TIMEOUT, **kwargs):
+        """Send one pose (see ``send``) and wait for the wrench that answers it.
 
-        Like a driver's timer, a late send does not make up for missed ones with a burst.
+        Returns (stamp key, wrench or None if none came within ``timeout`` s, seconds from the
+        pose's stamp to the wrench's arrival on this client).
         """
-        stamps = []
-        next_send = time.monotonic()
-        for _ in range(round(duration / period)):
-            while (remaining := next_send - time.monotonic()) > 0:
-                self.executor.spin_once(timeout_sec=remaining)
-            stamps.append(self.send(position, **kwargs))
-            next_send = max(next_send + period, time.monotonic())
-        return stamps
-
-    def collect(self, stamps, timeout: float = 1.0) -> list:
-        """Wrenches answering ``stamps`` (None where none came), after waiting up to timeout."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline and any(s not in self.wrenches for s in stamps):
-            self.executor.spin_once(timeout_sec=0.01)
-        return [self.wrenches.get(s) for s in stamps]
+        stamp = self.send(position, **kwargs)
+        sent_ns = stamp[0] * 1_000_000_000 + stamp[1] - round(kwargs.get('stamp_offset', 0.0)
+                                                              * 1e9)
+        self.spin_until(lambda: stamp in self.wrenches, timeout)
+        wrench = self.wrenches.get(stamp)
+        arrived_ns = self.arrivals.get(stamp, sent_ns)
+        return stamp, wrench, (arrived_ns - sent_ns) * 1e-9
 
     def close(self) -> None:
         self.node.destroy_node()
