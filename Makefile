@@ -17,7 +17,7 @@ export ROS_HOME := $(CURDIR)/build/ros_home
 export AMENT_PREFIX_PATH := $(CURDIR)/$(VENV)
 unexport _ROS_WHEELS_BOOTSTRAP_COMPLETE
 
-.PHONY: setup demo test bench lint clean
+.PHONY: setup demo test fuzz bench lint clean
 setup: $(STAMP)
 
 $(STAMP): $(SETUP_INPUTS)
@@ -28,8 +28,13 @@ demo: $(STAMP)
 	$(VENV)/bin/demo --out build/demo
 	$(PY) bench/report.py --demo-dir build/demo --out report
 
+# Deterministic: Hypothesis's ci profile draws the same examples on every run.
 test: $(STAMP)
-	$(PY) -m pytest -q tests
+	CI=$${CI:-1} $(PY) -m pytest -q tests
+
+# Fresh random examples, ten times as many, for the property tests (no ROS processes).
+fuzz: $(STAMP)
+	HYPOTHESIS_PROFILE=fuzz $(PY) -m pytest -q tests --ignore=tests/integration
 
 bench: $(STAMP)
 	$(PY) bench/run_all.py

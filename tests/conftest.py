@@ -1,7 +1,15 @@
-"""Shared test set-up: ``tests/`` is importable, so ``ground_truth`` is one module for all."""
+"""Shared test set-up: ``tests/`` is importable, so ``ground_truth`` is one module for all.
+
+Hypothesis profiles: ``ci`` (loaded when ``CI`` is set, as ``make test`` and ``.ci/run`` do)
+draws the same examples on every run, so CI is deterministic; ``fuzz`` (``make fuzz``) draws
+fresh random examples, ten times as many (``fuzzing.examples``); ``dev`` is Hypothesis's default.
+``HYPOTHESIS_PROFILE`` picks one explicitly.
+"""
 import os
 import pathlib
 import sys
+
+from hypothesis import HealthCheck, settings
 
 TESTS = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(TESTS))
@@ -9,6 +17,14 @@ sys.path.insert(0, str(TESTS))
 # Anything a test starts that speaks DDS stays on this machine, in a domain of its own.
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 os.environ.setdefault('ROS_DOMAIN_ID', '42')
+
+settings.register_profile('ci', derandomize=True, deadline=None, print_blob=True,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile('fuzz', deadline=None, print_blob=True,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile('dev', deadline=None)
+settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE')
+                      or ('ci' if os.environ.get('CI') else 'dev'))
 
 
 def pytest_sessionfinish(session, exitstatus):

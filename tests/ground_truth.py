@@ -28,6 +28,16 @@ SCENES_DIR = Path(__file__).resolve().parents[1] / 'src' / 'collision_engine' / 
 _PAIRS_PER_CHUNK = 50_000
 
 
+def angle_between(u, v) -> float:
+    """Angle between two 3-vectors, degrees: atan2(|u x v|, u . v).
+
+    Unlike arccos of the normalised dot product, it needs no clipping (a cosine that rounds to
+    1.0000000000000002 on some processors gives arccos NaN) and it resolves small angles.
+    """
+    u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+    return float(np.degrees(np.arctan2(np.linalg.norm(np.cross(u, v)), u @ v)))
+
+
 def _as_points(points: np.ndarray) -> np.ndarray:
     """Return `points` as a float64 array whose last axis has length 3."""
     array = np.asarray(points, dtype=np.float64)

@@ -1,5 +1,6 @@
 """The ground truth itself, checked against closed forms and hand-worked points."""
 
+from fuzzing import examples
 from ground_truth import (
     box_signed_distance,
     capsule_signed_distance,
@@ -126,7 +127,7 @@ def test_cube_mesh_matches_box_formula():
     np.testing.assert_allclose(box_signed_distance(closest, UNIT), 0.0, rtol=0, atol=EXACT)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(rotation=st.integers(0, 2**32 - 1), size=st.tuples(*[st.floats(0.01, 0.3)] * 3),
        point=st.tuples(*[st.floats(-0.4, 0.4)] * 3))
 def test_rotated_scaled_cube_mesh_matches_box_formula(rotation, size, point):

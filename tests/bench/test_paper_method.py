@@ -6,6 +6,7 @@ no code with the re-implementation.
 """
 import math
 
+from fuzzing import examples
 from ground_truth import box_signed_distance, cylinder_signed_distance, mesh_signed_distance
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -136,7 +137,7 @@ def test_centroid_is_the_mean_of_rows_duplicates_included():
     np.testing.assert_allclose(PaperMethod(rows).centroid, [1.0, 0.0, 0.0])
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(st.tuples(*[st.floats(-2.0, 3.0)] * 3))
 def test_outside_it_never_under_estimates(point):
     """Its triangles are made of hull points, so their distance is at least the hull's."""
@@ -146,7 +147,7 @@ def test_outside_it_never_under_estimates(point):
         assert answer.distance.distance >= truth - 1e-12
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(st.lists(st.floats(-1.0, 1.0), min_size=9, max_size=9),
        st.tuples(*[st.floats(-1.0, 1.0)] * 3))
 def test_point_triangle_distance_matches_brute_force(corners, origin):

@@ -4,6 +4,7 @@ Expected values are counted or computed by hand in each test.
 """
 import math
 
+from fuzzing import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -19,7 +20,7 @@ def test_runs_finds_each_stretch_and_drops_short_ones():
     assert runs([0, 0]) == []
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(st.lists(st.booleans(), max_size=40))
 def test_runs_cover_exactly_the_true_samples(mask):
     covered = np.zeros(len(mask), dtype=bool)

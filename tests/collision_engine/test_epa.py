@@ -1,5 +1,6 @@
 """EPA's penetration depth inside convex meshes, against brute force on scipy's hull facets."""
 
+from fuzzing import examples
 from ground_truth import mesh_signed_distance, outward_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
@@ -29,7 +30,7 @@ def penetration(shape: ConvexMesh, point: np.ndarray):
     return status, depth, np.array([x, y, z]), np.array([nx, ny, nz])
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(arrays(np.int64, st.tuples(st.integers(4, 80), st.just(3)),
               elements=st.integers(-64, 64)).map(lambda a: a / 64.0),
        arrays(np.float64, (6, 4), elements=st.floats(0.0, 1.0)),

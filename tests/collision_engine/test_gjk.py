@@ -7,6 +7,7 @@ distance to a polytope by ``ground_truth.mesh_signed_distance`` on scipy's hull 
 
 from itertools import combinations
 
+from fuzzing import examples
 from ground_truth import capsule_signed_distance, mesh_signed_distance, outward_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
@@ -63,7 +64,7 @@ simplex_points = arrays(np.float64, st.tuples(st.integers(1, 4), st.just(3)),
                         elements=st.floats(-1.0, 1.0))
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(simplex_points)
 def test_sub_algorithm_matches_brute_force(points):
     W = np.zeros((4, 3))
@@ -98,7 +99,7 @@ def test_sub_algorithm_degenerate_simplices(points):
     assert np.linalg.norm([vx, vy, vz]) == pytest.approx(brute_nearest(points), abs=1e-12)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(arrays(np.float64, (3, 3), elements=st.floats(-1.0, 1.0)))
 def test_triangle_step_reports_the_feature(corners):
     d2, vx, vy, vz, feature, which = nearest_on_triangle(*corners.ravel())
@@ -140,7 +141,7 @@ def check_outside(shape, cloud, point, truth, scale):
     return status
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(grid_clouds(), arrays(np.float64, (8, 3), elements=st.floats(-3.0, 3.0)),
        st.floats(1e-3, 1e3))
 def test_gjk_matches_brute_force_on_random_polytopes(cloud, points, scale):
@@ -157,7 +158,7 @@ def test_gjk_matches_brute_force_on_random_polytopes(cloud, points, scale):
             assert run_gjk(shape, point)[1]
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(float_clouds(), arrays(np.float64, (8, 3), elements=st.floats(-3.0, 3.0)))
 def test_gjk_stays_within_1e_6_on_slivers(cloud, points):
     # With corners 1e-9 apart the search direction, known to rounding over the distance,

@@ -6,6 +6,7 @@ import subprocess
 import sys
 import tempfile
 
+from fuzzing import examples
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -413,7 +414,8 @@ def load_or_mesh_error(name: str, data: bytes) -> None:
             assert_solid(mesh)
 
 
-FUZZ = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+FUZZ = settings(max_examples=examples(60), deadline=None,
+                suppress_health_check=[HealthCheck.too_slow])
 
 
 @FUZZ

@@ -3,6 +3,7 @@
 from pathlib import Path
 import textwrap
 
+from fuzzing import examples
 from ground_truth import scene_path
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
@@ -158,7 +159,7 @@ DOCUMENTS = st.recursive(
     max_leaves=25)
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(document=DOCUMENTS)
 def test_fuzzed_structures_give_a_scene_or_a_scene_error(tmp_path_factory, document):
     path = tmp_path_factory.mktemp('fuzz') / 'fuzzed.yaml'
@@ -169,7 +170,7 @@ def test_fuzzed_structures_give_a_scene_or_a_scene_error(tmp_path_factory, docum
         assert 'fuzzed.yaml' in str(error)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(raw=st.binary(max_size=300))
 def test_fuzzed_bytes_give_a_scene_or_a_scene_error(tmp_path_factory, raw):
     path = tmp_path_factory.mktemp('fuzz') / 'bytes.yaml'

@@ -1,5 +1,6 @@
 """Support functions of the shapes: the farthest point along a direction, by brute force."""
 
+from fuzzing import examples
 from ground_truth import (box_signed_distance, capsule_signed_distance,
                           cylinder_signed_distance, sphere_signed_distance)
 from hypothesis import assume, given, settings
@@ -41,7 +42,7 @@ TRUTH = [lambda p: box_signed_distance(p, [0.2, 0.1, 0.05]),
 
 
 @pytest.mark.parametrize('index', range(4), ids=[type(s).__name__ for s in SHAPES])
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(direction=arrays(np.float64, 3, elements=st.floats(-1.0, 1.0)))
 def test_primitive_support_is_the_farthest_point(index, direction):
     assume(np.linalg.norm(direction) > 1e-3)
@@ -55,7 +56,7 @@ def test_primitive_support_is_the_farthest_point(index, direction):
     assert point @ direction <= reach.max() + 1e-4
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(arrays(np.float64, st.tuples(st.integers(4, 100), st.just(3)),
               elements=st.floats(-1.0, 1.0)),
        arrays(np.float64, (10, 3), elements=st.floats(-1.0, 1.0)))

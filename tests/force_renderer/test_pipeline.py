@@ -3,6 +3,7 @@
 import math
 
 from analytic_fields import Box
+from fuzzing import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -88,7 +89,7 @@ inputs = st.one_of(st.none(), st.tuples(anything, st.tuples(anything, anything, 
                                         st.floats(-0.01, 0.02)))
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(st.lists(inputs, min_size=1, max_size=40), st.booleans())
 def test_whatever_arrives_the_force_is_finite_and_within_the_limit(sequence, passivity):
     pipeline = ForcePipeline(SpringDamper(1e5, 5.0),

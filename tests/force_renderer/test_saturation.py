@@ -1,5 +1,6 @@
 """Saturation keeps the direction, respects the limit, and lets nothing non-finite through."""
 
+from fuzzing import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -13,7 +14,7 @@ components = st.one_of(st.just(0.0), st.floats(1e-9, 1e6), st.floats(-1e6, -1e-9
 limits = st.one_of(st.just(0.0), st.floats(1e-6, 50.0))
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.tuples(components, components, components), limits)
 def test_saturated_force_keeps_direction_and_respects_limit(force, limit):
     force = np.array(force)

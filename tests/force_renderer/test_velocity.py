@@ -1,5 +1,6 @@
 """Velocity from stamped positions: exact on lines, indifferent to jitter and bad stamps."""
 
+from fuzzing import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -12,7 +13,7 @@ VELOCITY = np.array([0.12, -0.05, 0.3])
 START = np.array([0.01, 0.02, -0.03])
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(st.lists(st.floats(0.001, 0.005), min_size=3, max_size=30), st.floats(0.0, 1.8e9))
 def test_exact_on_straight_motion_with_jittered_epoch_stamps(periods, epoch):
     estimator = VelocityEstimator(0.005)

@@ -1,5 +1,6 @@
 """Roll/yaw quaternions and the roll-yaw Jacobian against rotation matrices built independently."""
 
+from fuzzing import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -11,7 +12,7 @@ from haptic_wand_driver.orientation import (
     PitchError, quaternion_from_roll_yaw, roll_yaw_from_quaternion, roll_yaw_jacobian)
 
 angles = st.floats(-3.0, 3.0)
-SETTINGS = settings(max_examples=60, deadline=None)
+SETTINGS = settings(max_examples=examples(60), deadline=None)
 
 
 @SETTINGS

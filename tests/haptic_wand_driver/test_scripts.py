@@ -2,6 +2,7 @@
 
 from functools import lru_cache
 
+from fuzzing import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -44,7 +45,7 @@ def test_rest_before_and_after_and_at_waypoints():
     assert script.duration == 3.0
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(st.floats(0.01, 4.99))
 def test_rates_are_the_derivative_of_the_coordinates(t):
     script = WaypointScript.from_rows([(0.0, 0.0, 0.0, 0.0), (2.0, 0.05, 0.0, -0.05),

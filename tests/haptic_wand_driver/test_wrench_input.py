@@ -2,6 +2,7 @@
 
 import math
 
+from fuzzing import examples
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -74,7 +75,7 @@ def test_wrench_from_the_future_is_ignored():
 
 # Limits are 0 (no force) or a force a device can render; a subnormal limit such as 5e-324 N
 # cannot carry a direction at all (vector * limit / norm underflows to zero).
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(vectors, st.one_of(st.just(0.0), st.floats(1e-12, 20.0)))
 @example(np.array([0.0, 0.0, 1.4487731358402805e-214]), 0.0)  # its square underflows to 0
 def test_saturate_keeps_direction_and_bounds_the_norm(vector, limit):
@@ -95,7 +96,7 @@ def test_force_saturates_to_the_limit_keeping_direction():
     np.testing.assert_allclose(wrench.current(0.0, 0.0)[0], [3.0, 4.0, 0.0])
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(st.floats(-0.5, 0.5), st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-1.0, 1.0))
 def test_pitch_torque_is_dropped_and_roll_and_yaw_kept(yaw, about_roll, about_pitch, about_z):
     roll_axis = rotation_z(yaw) @ [1.0, 0.0, 0.0]
@@ -121,7 +122,7 @@ def test_rejects_bad_settings_by_name(name):
 
 # Limits are 0 (no force) or a force a device can render; a subnormal limit such as 5e-324 N
 # cannot carry a direction at all (vector * limit / norm underflows to zero).
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(vectors, st.one_of(st.just(0.0), st.floats(1e-12, 20.0)))
 def test_saturate_components_is_saturate_on_floats(vector, limit):
     components = saturate_components(tuple(vector.tolist()), limit)
