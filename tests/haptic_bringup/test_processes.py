@@ -20,15 +20,31 @@ time.sleep(60)
 
 def test_a_child_that_ignores_sigint_is_stopped_with_its_whole_group():
     child = start_child('stubborn', [sys.executable, '-c', STUBBORN], env=None)
-    time.sleep(1.0)
-    group = [p for p in psutil.process_iter(['pid']) if _group_of(p) == child.pid]
-    assert len(group) == 2
+    assert _eventually(lambda: len(_group(child.pid)) == 2), 'the child did not start its own'
+    group = _group(child.pid)
     started = time.monotonic()
     codes = stop_children([child], timeout=0.5)
     assert codes['stubborn'] == -signal.SIGTERM
-    assert time.monotonic() - started < 3.0
-    time.sleep(0.2)
-    assert not [p for p in group if p.is_running() and p.status() != psutil.STATUS_ZOMBIE]
+    assert time.monotonic() - started < 3.0  # escalated after the 0.5 s timeout, no hang
+    assert _eventually(lambda: not [p for p in group if _alive(p)]), 'the group outlived it'
+
+
+def _eventually(condition, timeout: float = 30.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while not condition() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return condition()
+
+
+def _group(pgid: int) -> list:
+    return [p for p in psutil.process_iter(['pid']) if _group_of(p) == pgid]
+
+
+def _alive(process) -> bool:
+    try:
+        return process.is_running() and process.status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
 
 
 def _group_of(process):
