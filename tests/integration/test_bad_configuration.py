@@ -80,6 +80,34 @@ def test_force_node_refuses_bad_parameters(tmp_path, parameter, expected):
     assert expected in line and 'force_renderer' in line
 
 
+@pytest.mark.parametrize('parameter, expected', [
+    ('passivity:=1', "'passivity' must be true or false, got 1"),
+    ('frame_id:=1.5', "'frame_id' must be a string, got 1.5"),
+    ('rate:=abc', "'rate' must be a number"),
+    ('rate:=true', "'rate' must be a number"),
+    ('min_subscribers:=1.5', "'min_subscribers' must be an integer"),
+    ('stats_file:=[1, 2]', "'stats_file' must be a string"),
+])
+def test_driver_names_a_parameter_of_the_wrong_type_in_one_line(tmp_path, parameter, expected):
+    line = error_line(run_node('haptic_wand_driver.node', tmp_path, parameter))
+    assert expected in line and 'wand_driver' in line, line
+
+
+def test_a_malformed_command_line_is_one_line(tmp_path):
+    result = subprocess.run([sys.executable, '-m', 'force_renderer.node', '--ros-args', '-p',
+                             'law'], env=loop_environment(99, tmp_path / 'log'),
+                            capture_output=True, text=True, timeout=120)
+    assert 'law' in error_line(result)
+
+
+def test_a_misspelt_parameter_is_named_with_its_likely_meaning(tmp_path):
+    result = run_node('force_renderer.node', tmp_path, 'stifness:=[1.0, 1.0, 1.0]',
+                      'law:=spring')  # the typo is reported before the bad law stops the node
+    error_line(result)
+    assert "'stifness' is not a parameter of this node, ignored; did you mean 'stiffness'?" \
+        in result.stderr
+
+
 def test_driver_refuses_a_device_that_is_not_available(tmp_path):
     line = error_line(run_node('haptic_wand_driver.node', tmp_path, 'device:=quanser'))
     assert "'quanser'" in line and 'simulated' in line

@@ -6,40 +6,74 @@ wheel its ``spin()`` never returns and ignores SIGINT, as does ``spin_until_futu
 without a timeout. Spinning in short slices hands control back to Python often enough to notice a
 stop request, at no measurable cost to latency.
 
-A stop (SIGINT, SIGTERM, or a node calling ``request_stop``) ends the spin while the context is
-still valid, so nodes are destroyed in order and can log and publish their last words (final
-counts, a zero wrench); only then is rclpy shut down. A second SIGINT exits at once.
+Stopping. SIGINT and SIGTERM only ever *request* a stop; the handler never raises inside an rclpy
+callback or ``destroy_node`` (a ``KeyboardInterrupt`` there aborted nodes). ``ros2 launch`` sends
+SIGINT to every node on top of the one its process group already got, so repeats are the same
+request. The spin then ends while the context is still valid, nodes are destroyed in order and
+say their last words (final counts, a zero wrench), and the process exits 0. Start-up is the
+exception: a node may spend seconds compiling its kernels before it spins, so a stop requested
+then interrupts the start at once (no rclpy callback runs yet), and the process still exits 0.
+
+A callback that raises does not end its node: the spin logs the exception once, with its
+traceback, counts it, and goes on. Each node decides what a failed callback means for its output
+(an invalid state, zero force); the count is in ``callback_errors()`` for its diagnostics.
 """
 import signal
 import sys
 import threading
+import traceback
 from typing import Callable, Iterable, Optional
 
 import rclpy
+from rclpy.exceptions import NameValidationException, ParameterException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
-__all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'request_stop', 'StartupError']
+__all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'request_stop', 'stop_requested',
+           'callback_errors', 'StartupError']
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
 
 EXECUTORS = {'events': EventsExecutor, 'single_threaded': SingleThreadedExecutor}
 
-_stop_requested = threading.Event()
-
-
-def request_stop(*_) -> None:
-    """Ask this process's loop to stop cleanly (also the SIGINT/SIGTERM handler)."""
-    if _stop_requested.is_set() and _ and _[0] == signal.SIGINT:
-        raise KeyboardInterrupt
-    _stop_requested.set()
-
 
 class StartupError(RuntimeError):
     """A node cannot start with its configuration; the message says what to fix."""
+
+
+# What a wrong command line, parameter or parameter file raises while a node starts.
+_CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException, NameValidationException,
+                         rclpy_implementation.RCLError)
+_stop_requested = threading.Event()
+_starting = threading.Event()  # set while nodes are being built: a signal interrupts that
+_errors: dict = {}  # (exception type, file, line) -> count
+
+
+def request_stop(*_) -> None:
+    """Ask this process's loop to stop cleanly; safe from any callback, and idempotent."""
+    _stop_requested.set()
+
+
+def stop_requested() -> bool:
+    """Whether a stop was requested (a signal, or ``request_stop``)."""
+    return _stop_requested.is_set()
+
+
+def callback_errors() -> int:
+    """How many callbacks raised in this process so far."""
+    return sum(_errors.values())
+
+
+def _on_signal(signum, frame) -> None:
+    first = not _stop_requested.is_set()
+    _stop_requested.set()
+    if first and _starting.is_set():
+        _starting.clear()
+        raise KeyboardInterrupt  # nodes are still being built: no rclpy callback is running
 
 
 def make_executor(kind: str = 'events') -> Executor:
@@ -52,39 +86,68 @@ def make_executor(kind: str = 'events') -> Executor:
 
 
 def spin(executor: Executor, stop: Optional[Future] = None) -> None:
-    """Spin until a stop is requested, ``stop`` completes or the context shuts down."""
+    """Spin until a stop is requested, ``stop`` completes or the context shuts down.
+
+    An exception raised by a callback is logged once per place it comes from and counted.
+    """
     stop = stop or Future()
     while (rclpy.ok(context=executor.context) and not stop.done()
            and not _stop_requested.is_set()):
-        executor.spin_until_future_complete(stop, timeout_sec=SPIN_SLICE)
+        try:
+            executor.spin_until_future_complete(stop, timeout_sec=SPIN_SLICE)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            raise
+        except Exception as error:  # any callback's failure is logged, not fatal
+            _log_once(error)
+
+
+def _log_once(error: Exception) -> None:
+    frames = traceback.extract_tb(error.__traceback__)
+    where = (type(error), frames[-1].filename, frames[-1].lineno) if frames else (type(error),)
+    _errors[where] = _errors.get(where, 0) + 1
+    if _errors[where] == 1:
+        text = ''.join(traceback.format_exception(error)).rstrip()
+        print(f'[ERROR] a callback raised; the node goes on (further ones from the same place '
+              f'are counted, not printed):\n{text}', file=sys.stderr, flush=True)
 
 
 def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
               executor: str = 'events') -> int:
     """Init rclpy, build the nodes, spin them on one executor, and tear down cleanly.
 
-    A node whose configuration is wrong raises ``StartupError`` or ``ValueError`` from its
-    constructor: this prints that one line and returns exit code 2, with nothing left running.
+    A node whose configuration is wrong raises ``StartupError``, ``ValueError`` or an rclpy
+    parameter error from its constructor: this prints that one line and returns exit code 2,
+    with nothing left running. A stop requested at any time returns 0.
     """
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, request_stop)
+        signal.signal(signum, _on_signal)
+    _starting.set()
     nodes = []
     try:
-        try:
-            for factory in factories:
-                nodes.append(factory())
-        except (StartupError, ValueError) as error:
-            print(f'error: {error}', file=sys.stderr, flush=True)
-            return 2
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+        for factory in factories:
+            nodes.append(factory())
+        _starting.clear()
         spinner = make_executor(executor)
         for node in nodes:
             spinner.add_node(node)
         spin(spinner)
+    except _CONFIGURATION_ERRORS as error:
+        print(f'error: {_one_line(error)}', file=sys.stderr, flush=True)
+        return 2
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        _starting.clear()
         for node in nodes:
             node.destroy_node()
         rclpy.try_shutdown()
+        # Python resets its handlers to the default at exit, where a late repeat would then
+        # kill the process with SIGINT; an ignored signal it leaves alone.
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(signum, signal.SIG_IGN)
     return 0
+
+
+def _one_line(error: Exception) -> str:
+    return ' '.join(str(error).split())

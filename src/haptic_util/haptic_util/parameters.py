@@ -6,11 +6,13 @@ are accepted as int or float (YAML writes ``160`` for 160.0, which plain rclpy r
 value stops the node with one line naming the node, the parameter and what is wrong.
 """
 import dataclasses
+import difflib
 import math
 import typing
 from typing import Any, Optional, Sequence, Type, TypeVar
 
 from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 
 from haptic_util.executor import StartupError
@@ -18,6 +20,9 @@ from haptic_util.executor import StartupError
 __all__ = ['parameter', 'declare_parameters']
 
 T = TypeVar('T')
+
+_KINDS = {bool: 'true or false', str: 'a string', int: 'an integer', float: 'a number',
+          tuple: 'a list'}
 
 
 def parameter(default: Any, description: str, *, unit: str = '', low: Optional[float] = None,
@@ -38,14 +43,30 @@ def parameter(default: Any, description: str, *, unit: str = '', low: Optional[f
 def declare_parameters(node: Node, cls: Type[T]) -> T:
     """Declare every field of ``cls`` on ``node`` and return the validated values."""
     hints = typing.get_type_hints(cls)
+    fields = dataclasses.fields(cls)
+    _warn_unknown(node, {field.name for field in fields})
     values = {}
-    for field in dataclasses.fields(cls):
+    for field in fields:
         default = field.default if field.default is not dataclasses.MISSING \
             else field.default_factory()
         descriptor = _descriptor(field, default)
-        raw = node.declare_parameter(field.name, _as_ros(default), descriptor).value
+        try:
+            raw = node.declare_parameter(field.name, _as_ros(default), descriptor).value
+        except ParameterException:  # rclpy's own type check, e.g. passivity:=1
+            raise StartupError(f'{node.get_name()}: parameter {field.name!r} must be '
+                               f'{_KINDS[type(default)]}, got '
+                               f'{node._parameter_overrides[field.name].value!r}') from None
         values[field.name] = _checked(node.get_name(), field, hints[field.name], raw)
     return cls(**values)
+
+
+def _warn_unknown(node: Node, fields: set) -> None:
+    """Log one line per given parameter this node does not have (a typo is otherwise silent)."""
+    for name in sorted(set(node._parameter_overrides) - fields - set(node._parameters)):
+        close = difflib.get_close_matches(name, fields, n=1)
+        hint = f'; did you mean {close[0]!r}?' if close else ''
+        node.get_logger().warn(f'parameter {name!r} is not a parameter of this node, ignored'
+                               f'{hint}')
 
 
 def _descriptor(field: dataclasses.Field, default: Any) -> ParameterDescriptor:
@@ -96,14 +117,12 @@ def _checked(node_name: str, field: dataclasses.Field, hint: Any, raw: Any) -> A
 def _scalar(kind: type, raw: Any, fail) -> Any:
     if kind is float:
         if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-            fail(f'must be a number, got {raw!r}')
+            fail(f'must be {_KINDS[float]}, got {raw!r}')
         if not math.isfinite(raw):
             fail(f'must be finite, got {raw!r}')
         return float(raw)
-    if kind is int and (isinstance(raw, bool) or not isinstance(raw, int)):
-        fail(f'must be an integer, got {raw!r}')
-    if not isinstance(raw, kind):
-        fail(f'must be a {kind.__name__}, got {raw!r}')
+    if (kind is int and isinstance(raw, bool)) or not isinstance(raw, kind):
+        fail(f'must be {_KINDS[kind]}, got {raw!r}')
     return raw
 
 
