@@ -19,6 +19,11 @@ def test_children_discover_on_localhost_only_in_the_chosen_domain(tmp_path, monk
                for p in env['AMENT_PREFIX_PATH'].split(os.pathsep))
 
 
+def test_a_discovery_range_the_user_exported_is_kept(tmp_path, monkeypatch):
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'SUBNET')
+    assert loop_environment(17, tmp_path / 'log')['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'SUBNET'
+
+
 def test_parameters_layer_package_defaults_a_user_file_and_the_options(tmp_path):
     user = tmp_path / 'mine.yaml'
     user.write_text(yaml.safe_dump({'force_renderer': {'ros__parameters': {

@@ -117,3 +117,15 @@ def test_driver_refuses_a_missing_replay_file(tmp_path):
     line = error_line(run_node('haptic_wand_driver.node', tmp_path, 'device:=replay',
                                f'replay_file:={tmp_path / "run.csv"}'))
     assert 'run.csv' in line
+
+
+def test_the_launcher_stops_a_partial_loop_and_fails(tmp_path):
+    """A node that cannot start takes the loop down with it: no idle half-loop, exit 1."""
+    result = subprocess.run(
+        [sys.executable, '-m', 'haptic_bringup.launcher', '--experiment', 'cubiod',
+         '--domain-id', '99', '--run-dir', str(tmp_path)],
+        env=loop_environment(99, tmp_path / 'log'), capture_output=True, text=True, timeout=180)
+    assert result.returncode == 1, result.stderr
+    assert "error: wand_driver: experiment 'cubiod'" in result.stderr
+    assert 'wand_driver exited with code 2' in result.stderr
+    assert 'Traceback' not in result.stderr, result.stderr

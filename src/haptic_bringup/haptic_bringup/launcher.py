@@ -69,10 +69,13 @@ def add_venv_prefix() -> None:
 
 
 def loop_environment(domain_id: int, log_dir: pathlib.Path) -> dict:
-    """Return the children's environment: local discovery, our domain, logs in the build dir."""
+    """Return the children's environment: our domain, logs in the build dir.
+
+    Discovery stays on this machine unless the user exported another range.
+    """
     add_venv_prefix()
     env = dict(os.environ)
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     env['ROS_DOMAIN_ID'] = str(domain_id)
     env['ROS_LOG_DIR'] = str(log_dir)
     env.setdefault('ROS_HOME', str(log_dir.parent / 'ros_home'))
@@ -172,11 +175,11 @@ class Loop:
             watcher.close()
         dead = self.exited()
         if dead is not None:
-            self.stop()
+            self.stop(gently=False)  # the others may still be importing
             raise RuntimeError(f'{dead.name} exited with code {dead.returncode} at start-up '
                                '(its error is printed above)')
         if missing:
-            self.stop()
+            self.stop(gently=False)
             raise RuntimeError('the loop did not close within '
                                f'{DISCOVERY_TIMEOUT:.0f} s; missing: {"; ".join(missing)}')
 
@@ -203,14 +206,17 @@ class Loop:
         """Wait until a child exits (the driver at the end of its experiment) or ``timeout``."""
         return wait_any_exit(self.children, float('inf') if timeout is None else timeout)
 
-    def stop(self) -> dict:
-        """Stop every child (the recorder last, after a drain) and clean shared memory."""
+    def stop(self, *, gently: bool = True) -> dict:
+        """Stop every child (the recorder last, after a drain) and clean shared memory.
+
+        ``gently=False`` for children that may still be starting (see ``stop_children``).
+        """
         recorder = [c for c in self.children if c.name == 'recorder']
         others = [c for c in self.children if c.name != 'recorder']
-        codes = stop_children(others)
+        codes = stop_children(others, gently=gently)
         if recorder:
             time.sleep(RECORDER_DRAIN)
-            codes.update(stop_children(recorder))
+            codes.update(stop_children(recorder, gently=gently))
         self.children = []
         clean_stale_shm()
         return codes
@@ -242,7 +248,7 @@ def main(argv=None) -> int:
     config = LoopConfig(composed=args.composed, scene=args.scene, experiment=args.experiment,
                         duration=args.duration, record=args.record, domain_id=args.domain_id,
                         params_file=args.params_file, run_dir=pathlib.Path(args.run_dir))
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     loop = Loop(config)
     stop = []
     signal.signal(signal.SIGINT, lambda *_: stop.append(True))

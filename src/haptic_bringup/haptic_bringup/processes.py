@@ -58,14 +58,19 @@ def start_child(name: str, argv: list, env: dict) -> Child:
     return Child(name, process, argv, env)
 
 
-def stop_children(children: list, *, timeout: float = 5.0) -> dict:
+def stop_children(children: list, *, timeout: float = 5.0, gently: bool = True) -> dict:
     """Stop children in order: SIGINT, then SIGTERM, then SIGKILL, each after ``timeout``.
+
+    ``gently=False`` starts at SIGTERM: for children that may still be importing, where a
+    SIGINT prints a ``KeyboardInterrupt`` traceback and SIGTERM ends them quietly (a started node
+    stops cleanly on either).
 
     Returns each child's exit code (negative: the signal that ended it).
     """
     codes = {}
+    escalation = (signal.SIGINT, signal.SIGTERM, signal.SIGKILL)[0 if gently else 1:]
     for child in children:
-        for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
+        for signum in escalation:
             if child.returncode is not None:
                 break
             child.signal(signum)

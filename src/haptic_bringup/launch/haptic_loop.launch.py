@@ -6,14 +6,20 @@ Arguments: ``scene:=<path or package://...>``, ``experiment:=cuboid|cylinder|han
 ``composed:=true`` (one process), ``record:=<bag dir>`` (rosbag2 mcap via ``ros2 bag record``),
 ``params_file:=<yaml>`` (overrides on top of each package's config/). The local launcher
 (``haptic_loop``) does the same where launch and ros2cli are not installed.
+
+DDS discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``) unless the user
+exported another range. The loop is all or nothing: when one of its nodes exits, the launch
+stops the others, and exits non-zero if that node failed (a misspelt ``experiment``, say).
 """
 import os
 
 from ament_index_python.packages import get_package_share_directory
 from launch import LaunchDescription
-from launch.actions import (DeclareLaunchArgument, ExecuteProcess, OpaqueFunction,
-                            SetEnvironmentVariable)
-from launch.substitutions import LaunchConfiguration
+from launch.actions import (DeclareLaunchArgument, EmitEvent, ExecuteProcess, OpaqueFunction,
+                            RegisterEventHandler, SetEnvironmentVariable)
+from launch.event_handlers import OnProcessExit
+from launch.events import Shutdown
+from launch.substitutions import EnvironmentVariable, LaunchConfiguration
 from launch_ros.actions import Node
 
 from haptic_bringup.params import LOOP_TOPICS
@@ -27,6 +33,23 @@ def _config(package: str) -> str:
     return os.path.join(get_package_share_directory(package), 'config', f'{package}.yaml')
 
 
+def _end_of_loop(name: str):
+    """Stop the launch when loop node ``name`` exits, and fail it if the node failed."""
+    def on_exit(event, context):
+        if context.is_shutdown:
+            return None
+        if event.returncode != 0:  # launch's exit code is 1 after an error in a handler
+            raise RuntimeError(f'{name} exited with code {event.returncode}; the loop cannot '
+                               'run without it')
+        return [EmitEvent(event=Shutdown(reason=f'{name} finished'))]
+    return on_exit
+
+
+def _stopping_with_the_loop(node: Node, name: str) -> list:
+    return [node, RegisterEventHandler(OnProcessExit(target_action=node,
+                                                     on_exit=_end_of_loop(name)))]
+
+
 def _nodes(context):
     scene = LaunchConfiguration('scene').perform(context)
     experiment = LaunchConfiguration('experiment').perform(context)
@@ -38,14 +61,15 @@ def _nodes(context):
     actions = []
     if LaunchConfiguration('composed').perform(context).lower() == 'true':
         # No name: a name given here would rename all three nodes of the process.
-        actions.append(Node(
+        actions += _stopping_with_the_loop(Node(
             package='haptic_bringup', executable='composed', output='screen',
-            parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides]))
+            parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides]), 'composed')
     else:
         for package, executable, name in NODES:
             values = driver_overrides if name == 'wand_driver' else overrides
-            actions.append(Node(package=package, executable=executable, name=name,
-                                output='screen', parameters=[_config(package), *extra, values]))
+            actions += _stopping_with_the_loop(Node(
+                package=package, executable=executable, name=name, output='screen',
+                parameters=[_config(package), *extra, values]), name)
     if record:
         actions.append(ExecuteProcess(
             cmd=['ros2', 'bag', 'record', '-s', 'mcap', '-o', record, *LOOP_TOPICS],
@@ -57,7 +81,8 @@ def _nodes(context):
 
 def generate_launch_description() -> LaunchDescription:
     return LaunchDescription([
-        SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST'),
+        SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', EnvironmentVariable(
+            'ROS_AUTOMATIC_DISCOVERY_RANGE', default_value='LOCALHOST')),
         DeclareLaunchArgument('scene', default_value='',
                               description='scene YAML (default: each package config)'),
         DeclareLaunchArgument('experiment', default_value='',
