@@ -3,36 +3,48 @@
 Every wrench carries the stamp of the pose it answers, so the driver, which stamped that pose,
 knows the loop's round trip exactly, on one clock, without any extra traffic: poses sent, poses
 answered (a wrench with that pose's stamp), each answer's latency and arrival time. It also notes
-each instant the applied force started (became non-zero) and stopped (dropped to zero, at the
-watchdog deadline when the wrenches stopped), which is what the fail-safe tests measure.
+each instant the applied force started (became non-zero) and stopped.
+
+A driver runs for days, so memory stays flat: the recent latencies live in a ring of
+``RECENT`` entries (what the 1 Hz report takes its percentiles over, at a constant cost), and the
+full record, when one is asked for, goes to a file in chunks as it is made.
 """
 from array import array
+import pathlib
+from typing import Optional
 
 import numpy as np
 
 __all__ = ['LoopStats']
 
+_ANSWER, _FORCE_ON, _FORCE_OFF = 0, 1, 2  # kinds of rows of the full record
+
 
 class LoopStats:
     """Poses sent and answered, and round-trip latencies [s].
 
-    Its memory stays flat in sessions of hours: a pose waits for its answer at most
-    ``ANSWER_WINDOW`` (a wrench later than that could not be applied anyway), and each answer
-    keeps 16 bytes.
+    Parameters
+    ----------
+    record : path or None
+        Where the full record (every answer, every force edge) is spooled while the session
+        runs; ``save`` turns it into an .npz. None keeps only counts and the recent ring.
     """
 
-    ANSWER_WINDOW_NS = 1_000_000_000
+    ANSWER_WINDOW_NS = 1_000_000_000  # a wrench later than this could not be applied anyway
+    RECENT = 10_000  # answers: about the last 10 s at 1 kHz
+    CHUNK = 4096  # rows of the full record buffered before they are written out
 
-    def __init__(self) -> None:
+    def __init__(self, record: Optional[pathlib.Path] = None) -> None:
         self._pending: dict = {}  # stamps of poses awaiting their wrench, oldest first
         self._poses = 0
         self._answers = 0
-        self._latency_ns = array('q')
-        self._arrival_ns = array('q')
-        self._force_on_ns: list = []
-        self._force_off_ns: list = []
+        self._recent = np.zeros(self.RECENT, dtype=np.int64)
         self._first_ns = None
         self._last_ns = None
+        self._record_path = None if record is None else pathlib.Path(record)
+        self._rows = array('q')  # (kind, a, b) triples not yet written out
+        if self._record_path is not None:
+            self._record_path.write_bytes(b'')
 
     def sent(self, stamp_ns: int) -> None:
         pending = self._pending
@@ -47,17 +59,29 @@ class LoopStats:
     def answered(self, stamp_ns: int, received_ns: int) -> None:
         """Record a wrench for the pose stamped ``stamp_ns``; others are not loop answers."""
         if self._pending.pop(stamp_ns, False) is None:
+            self._recent[self._answers % self.RECENT] = received_ns - stamp_ns
             self._answers += 1
-            self._latency_ns.append(received_ns - stamp_ns)
-            self._arrival_ns.append(received_ns)
+            self._note(_ANSWER, received_ns - stamp_ns, received_ns)
 
     def force_on(self, instant_ns: int) -> None:
         """Note that the applied force became non-zero at ``instant_ns``."""
-        self._force_on_ns.append(instant_ns)
+        self._note(_FORCE_ON, instant_ns, 0)
 
     def force_off(self, instant_ns: int) -> None:
         """Note that the applied force dropped to zero at ``instant_ns``."""
-        self._force_off_ns.append(instant_ns)
+        self._note(_FORCE_OFF, instant_ns, 0)
+
+    def _note(self, kind: int, a: int, b: int) -> None:
+        if self._record_path is None:
+            return
+        self._rows.extend((kind, a, b))
+        if len(self._rows) >= 3 * self.CHUNK:
+            self._flush()
+
+    def _flush(self) -> None:
+        with self._record_path.open('ab') as stream:
+            self._rows.tofile(stream)
+        del self._rows[:]
 
     @property
     def poses(self) -> int:
@@ -68,9 +92,10 @@ class LoopStats:
         return self._answers
 
     @property
-    def latencies(self) -> np.ndarray:
-        """(n,) float, s: round trip of each answered pose, in arrival order."""
-        return np.frombuffer(self._latency_ns, dtype=np.int64) * 1e-9
+    def recent_latencies(self) -> np.ndarray:
+        """(n,) float, s: round trips of the last ``RECENT`` answers (in no order), a copy."""
+        count = min(self._answers, self.RECENT)
+        return self._recent[:count] * 1e-9
 
     @property
     def rate(self) -> float:
@@ -79,30 +104,40 @@ class LoopStats:
             return 0.0
         return (self.poses - 1) / ((self._last_ns - self._first_ns) * 1e-9)
 
-    def summary(self, last: int = 0) -> dict:
-        """Rate, share answered, and latency percentiles (s), for logs and benchmarks.
+    def summary(self) -> dict:
+        """Rate, share answered, and the recent answers' latency percentiles (s).
 
-        ``last`` > 0 takes the percentiles over the last answers only (a periodic report stays
-        cheap however long the session); the counts are always the whole session's.
+        The counts are the whole session's; the percentiles cover the last ``RECENT`` answers,
+        so a periodic report costs the same however long the session.
         """
-        latency = self.latencies[-last:] if last else self.latencies
-        percentiles = (np.percentile(latency, [50, 90, 99]) if latency.size
-                       else np.full(3, np.nan))
         return {
             'poses': self.poses,
             'answers': self.answers,
             'answered_percent': 100.0 * self.answers / self.poses if self.poses else 0.0,
             'rate_hz': self.rate,
-            'latency_p50_s': float(percentiles[0]),
-            'latency_p90_s': float(percentiles[1]),
-            'latency_p99_s': float(percentiles[2]),
-            'latency_max_s': float(latency.max()) if latency.size else float('nan'),
+            **_latency_figures(self.recent_latencies),
         }
 
     def save(self, path, **extra) -> None:
-        """Write the raw latencies, the summary and ``extra`` figures to an .npz file."""
-        np.savez(path, latencies=self.latencies,
-                 arrival_ns=np.frombuffer(self._arrival_ns, dtype=np.int64),
-                 force_on_ns=np.asarray(self._force_on_ns, dtype=np.int64),
-                 force_off_ns=np.asarray(self._force_off_ns, dtype=np.int64),
-                 **self.summary(), **extra)
+        """Write the full record, the summary and ``extra`` figures to an .npz file.
+
+        Raises ValueError when the stats were made without a record.
+        """
+        if self._record_path is None:
+            raise ValueError('LoopStats.save needs the full record: make it with record=path')
+        self._flush()
+        rows = np.fromfile(self._record_path, dtype=np.int64).reshape(-1, 3)
+        answers = rows[rows[:, 0] == _ANSWER]
+        latencies = answers[:, 1] * 1e-9
+        whole_session = {**self.summary(), **_latency_figures(latencies)}
+        np.savez(path, latencies=latencies, arrival_ns=answers[:, 2],
+                 force_on_ns=rows[rows[:, 0] == _FORCE_ON, 1],
+                 force_off_ns=rows[rows[:, 0] == _FORCE_OFF, 1], **whole_session, **extra)
+
+
+def _latency_figures(latency: np.ndarray) -> dict:
+    """p50, p90, p99 and max of round trips (s); NaN when there are none."""
+    percentiles = np.percentile(latency, [50, 90, 99]) if latency.size else np.full(3, np.nan)
+    return {'latency_p50_s': float(percentiles[0]), 'latency_p90_s': float(percentiles[1]),
+            'latency_p99_s': float(percentiles[2]),
+            'latency_max_s': float(latency.max()) if latency.size else float('nan')}
