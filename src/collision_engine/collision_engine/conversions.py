@@ -11,24 +11,33 @@ UNIT_QUATERNION_TOLERANCE = 1e-3  # |q| may differ from 1 by this much (float32 
 
 
 class InvalidPose(ValueError):
-    """A pose the engine refuses; the message names the field and what is wrong."""
+    """A pose the engine refuses; the message names the field and what is wrong.
+
+    ``kind`` is a fixed short text of the fault, for counting.
+    """
+
+    def __init__(self, kind: str, message: str) -> None:
+        super().__init__(message)
+        self.kind = kind
 
 
 def tip_position(msg: PoseStamped, frame_id: str) -> tuple:
     """Return the tip position (x, y, z) [m] of a pose in the scene frame, or raise InvalidPose."""
     if msg.header.frame_id != frame_id:
-        raise InvalidPose(f'pose.header.frame_id is {msg.header.frame_id!r}, '
-                          f'not the scene frame {frame_id!r} (no transform is looked up)')
+        raise InvalidPose('pose in an unknown frame',
+                          f'pose.header.frame_id is {msg.header.frame_id!r}, not the scene '
+                          f'frame {frame_id!r} (no transform is looked up)')
     p, q = msg.pose.position, msg.pose.orientation
     for name, value in (('x', p.x), ('y', p.y), ('z', p.z)):
         if not math.isfinite(value):
-            raise InvalidPose(f'pose.position.{name} is {value}')
+            raise InvalidPose('non-finite position', f'pose.position.{name} is {value}')
     for name, value in (('x', q.x), ('y', q.y), ('z', q.z), ('w', q.w)):
         if not math.isfinite(value):
-            raise InvalidPose(f'pose.orientation.{name} is {value}')
+            raise InvalidPose('non-finite orientation', f'pose.orientation.{name} is {value}')
     norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
     if abs(norm - 1.0) > UNIT_QUATERNION_TOLERANCE:
-        raise InvalidPose(f'pose.orientation is not a unit quaternion (|q| = {norm:.6g})')
+        raise InvalidPose('non-unit quaternion',
+                          f'pose.orientation is not a unit quaternion (|q| = {norm:.6g})')
     return (p.x, p.y, p.z)
 
 
@@ -36,7 +45,7 @@ def fill_state(state: CollisionState, header, result, compute_time: float,
                disagreements: int) -> CollisionState:
     """Write one query result into a (reused) CollisionState message."""
     state.header = header
-    state.object = result.object
+    state.object = result.object or ''  # an empty scene has no nearest object
     state.status = result.status
     state.distance = result.distance
     state.in_collision = result.in_collision

@@ -23,10 +23,9 @@ from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS, MARKER_QOS
+from haptic_util.tally import Tally
 
 __all__ = ['CollisionNode', 'main']
-
-ERROR_LOG_PERIOD = 1.0  # [s] throttle of repeated input errors
 
 
 class CollisionNode(Node):
@@ -47,7 +46,7 @@ class CollisionNode(Node):
 
         self._state = CollisionState()
         self._answered = 0
-        self._invalid_poses = 0
+        self._refused = Tally()  # poses answered with an invalid state, by fault
         self._last_result = None
         self._state_pub = self.create_publisher(CollisionState, 'collision/state',
                                                 HAPTIC_STREAM_QOS)
@@ -68,9 +67,7 @@ class CollisionNode(Node):
         try:
             tip = tip_position(msg, self.scene.frame_id)
         except InvalidPose as error:
-            self._invalid_poses += 1
-            self.get_logger().error(f'ignoring pose: {error}',
-                                    throttle_duration_sec=ERROR_LOG_PERIOD)
+            self._refused.add(error.kind, str(error))
             self._state_pub.publish(fill_invalid_state(self._state, msg.header,
                                                        self._disagreements()))
             return
@@ -106,9 +103,11 @@ class CollisionNode(Node):
     def report(self) -> Report:
         """Report counts and the FCL cross-validation totals, for /diagnostics."""
         stats = self.scene.cross_validation_stats
+        self._refused.log_new(lambda line: self.get_logger().error(f'poses refused: {line}'))
         values = {'objects': len(self.scene.objects),
-                  'published': self._answered + self._invalid_poses,
-                  'invalid_poses': self._invalid_poses}
+                  'published': self._answered + self._refused.total(),
+                  'invalid_poses': self._refused.total(),
+                  **{f'refused: {kind}': n for kind, n in self._refused.counts.items()}}
         if stats is None:
             return Report(OK, 'FCL cross-validation off', values)
         values.update(fcl_checks=stats.checks, fcl_disagreements=stats.disagreements,
@@ -120,7 +119,7 @@ class CollisionNode(Node):
     def destroy_node(self) -> bool:
         self.diagnostics.final()
         self.get_logger().info(f'answered {self._answered} poses, refused '
-                               f'{self._invalid_poses}')
+                               f'{self._refused.total()}')
         return super().destroy_node()
 
 
