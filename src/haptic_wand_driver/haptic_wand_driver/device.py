@@ -12,8 +12,9 @@ Threading
     A device is not thread-safe. Call ``read``, ``apply`` and ``close`` from one thread (the node's
     executor thread); a backend that needs its own I/O thread hides it behind these calls.
 Time
-    ``now`` is seconds on the caller's clock, the same clock that stamps the wrenches (ROS time as
-    a float in the node). It must not decrease. The first ``read`` starts the device's clock.
+    ``now`` is seconds on the caller's clock, which must not decrease: the node uses a monotonic
+    clock, so that a step of the system clock cannot move or stall the wand (stamps stay on ROS
+    time; the node converts deadlines). The first ``read`` starts the device's clock.
     ``WandState.time`` is the instant the returned state is valid for, at most ``now``.
 Frame and units
     Everything is in the workspace frame (REP-103: x forward, y left, z up; ``world`` by default)

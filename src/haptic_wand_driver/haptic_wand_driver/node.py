@@ -7,17 +7,20 @@ it answers, so the driver measures the loop's round trip (``stats_file``).
 """
 import enum
 import math
+import pathlib
+import time
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
-from haptic_util.diagnostics import Diagnostics, OK, Report
+from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
 from haptic_util.stamps import to_nanoseconds
+from haptic_util.tally import Tally
 from haptic_wand_driver.device import DeviceLimits, make_device
 from haptic_wand_driver.experiments import make_script, needs_scene
 from haptic_wand_driver.loop_stats import LoopStats
@@ -25,14 +28,14 @@ from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
 from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.simulated import SimulatedWandConfig
-from haptic_wand_driver.wrench_input import WrenchCommand
+from haptic_wand_driver.wrench_input import Refusal, WrenchCommand
 
 __all__ = ['WandDriverNode', 'main']
 
-WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
 DIAGNOSTICS_PERIOD = 1.0  # [s]
-DIAGNOSTICS_WINDOW = 10_000  # latencies in a report's percentiles: about the last 10 s
 IN_FLIGHT_GRACE = 0.05  # [s] after the last pose, for its answer to arrive
+BEHIND_RATE = 0.95  # of the set rate: below it, the loop is reported behind
+BEHIND_ANSWERED = 99.0  # [%] of the poses since the last report: below it, behind too
 
 
 class Phase(enum.Enum):
@@ -58,7 +61,9 @@ class WandDriverNode(Node):
         self.wrench = WrenchCommand(force_limit=limits.force_limit,
                                     torque_limit=limits.torque_limit,
                                     timeout=params.wrench_timeout)
-        self.stats = LoopStats()
+        self._record = (pathlib.Path(f'{params.stats_file}.part') if params.stats_file
+                        else None)
+        self.stats = LoopStats(record=self._record)
         # The observer always runs (its books are the port's energy figures); the controller acts
         # only when enabled.
         self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
@@ -68,6 +73,8 @@ class WandDriverNode(Node):
         self._probe_start = self._device_offset = 0.0
         self._last_probe_ns = -1
         self._published = 0
+        self._refused = Tally()  # wrenches not taken, by fault
+        self._reported = (time.monotonic(), 0, 0)  # when, poses and answers at the last report
         self._recorder_ready = False
         self._pushing = False
         self._deadline = -math.inf  # [s] when the wrench applied to the device goes stale
@@ -116,19 +123,19 @@ class WandDriverNode(Node):
         if self._phase is Phase.WAITING:
             if not self.ready():
                 return
-            self._state = self.device.read(now)
-            self._probe_start = now
+            self._probe_start = time.monotonic()
+            self._state = self.device.read(self._probe_start)
             if not self.params.wait_for_wrench:
-                self._run(now)
+                self._run()
             else:
                 self._phase = Phase.PROBING
                 self.get_logger().info('loop connected: probing it end to end')
         if self._phase is Phase.PROBING:
             self._publish(self._state, now_ns)  # the device at rest where it starts
         elif self._phase is Phase.RUNNING:
-            device_now = now - self._device_offset
+            device_now = self._device_time()
             state = self._state = self.device.read(device_now)
-            self._apply(now, state)
+            self._apply(now, device_now, state)
             self._publish(state, now_ns)
             self.stats.sent(now_ns)
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
@@ -137,10 +144,17 @@ class WandDriverNode(Node):
                 # The last poses are still on their way round: let their wrenches come back.
                 self.create_timer(IN_FLIGHT_GRACE, request_stop)
 
-    def _run(self, now: float) -> None:
+    def _device_time(self) -> float:
+        """Return the device's clock [s]: monotonic, and skipping the probing.
+
+        A step of the system clock (NTP, a user) must not move or stall the wand.
+        """
+        return time.monotonic() - self._device_offset
+
+    def _run(self) -> None:
         """Start the session: once a wrench answered a probe, or at once when open loop."""
         self._phase = Phase.RUNNING
-        self._device_offset = now - self._probe_start  # the device's clock skips the probing
+        self._device_offset = time.monotonic() - self._probe_start
         self.get_logger().info('loop closed: experiment started')
 
     def _publish(self, state, now_ns: int) -> None:
@@ -165,19 +179,23 @@ class WandDriverNode(Node):
         stamp_ns = to_nanoseconds(msg.header.stamp)
         if self._phase is Phase.PROBING:
             if stamp_ns <= self._last_probe_ns:  # it answers a probe: the loop is closed
-                self._run(now)
+                self._run()
             return
         self.stats.answered(stamp_ns, now_ns)
         if self._phase is not Phase.RUNNING:
             return
-        state = self._state = self.device.read(now - self._device_offset)  # acts from now on
-        reason = self._take(msg, stamp_ns * 1e-9, now)
-        if reason is not None:
-            self.get_logger().warn(reason, throttle_duration_sec=WARN_PERIOD)
-        self._apply(now, state)
+        device_now = self._device_time()
+        state = self._state = self.device.read(device_now)  # acts from now on
+        refusal = self._take(msg, stamp_ns * 1e-9, now)
+        if refusal is not None:
+            self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
+        self._apply(now, device_now, state)
 
-    def _apply(self, now: float, state) -> None:
-        """Apply the held wrench, kept passive, armed with its deadline as the device watchdog."""
+    def _apply(self, now: float, device_now: float, state) -> None:
+        """Apply the held wrench, kept passive, armed with its deadline as the device watchdog.
+
+        ``now`` is ROS time, the clock of the stamps; ``device_now`` the device's clock.
+        """
         wrench = self.wrench
         force, torque = wrench.current(now, state.yaw)
         force = self.passivity.control(force, state.position, state.linear_velocity,
@@ -191,14 +209,14 @@ class WandDriverNode(Node):
             self.stats.force_on(round(1e9 * now))
         self._pushing = pushing
         self._deadline = wrench.expiry
-        self.device.apply(force, torque, until=self._deadline - self._device_offset)
+        self.device.apply(force, torque, until=device_now + (self._deadline - now))
 
-    def _take(self, msg: WrenchStamped, stamp: float, now: float):
+    def _take(self, msg: WrenchStamped, stamp: float, now: float) -> Refusal | None:
         """Hand a received wrench to the command; return why it was refused, or None."""
         if msg.header.frame_id != self.params.frame_id:
             self.wrench.clear()
-            return (f'wrench ignored and force zeroed: frame_id {msg.header.frame_id!r} is not '
-                    f'{self.params.frame_id!r}')
+            return Refusal('wrench in an unknown frame', f'wrench ignored and force zeroed: '
+                           f'frame_id {msg.header.frame_id!r} is not {self.params.frame_id!r}')
         f, t = msg.wrench.force, msg.wrench.torque
         return self.wrench.update((f.x, f.y, f.z), (t.x, t.y, t.z), stamp, now)
 
@@ -206,20 +224,37 @@ class WandDriverNode(Node):
         self._recorder_ready = msg.data
 
     def report(self) -> Report:
-        """Report the session's phase, counts and round trip so far, for /diagnostics."""
-        summary = self.stats.summary(last=DIAGNOSTICS_WINDOW)
+        """Report the session's phase, counts and round trip, for /diagnostics.
+
+        WARN when, since the last report, the loop fell behind: poses went out below 95 % of the
+        rate, or fewer than 99 % of them were answered.
+        """
+        self._refused.log_new(lambda line: self.get_logger().warn(f'wrenches refused: {line}'))
+        summary = self.stats.summary()
+        then, poses_then, answers_then = self._reported
+        self._reported = (time.monotonic(), self.stats.poses, self.stats.answers)
+        poses, answers = self.stats.poses - poses_then, self.stats.answers - answers_then
+        rate = poses / max(self._reported[0] - then, 1e-9)
+        answered = 100.0 * answers / poses if poses else 100.0
+        behind = self._phase is Phase.RUNNING and (rate < BEHIND_RATE * self.params.rate
+                                                   or answered < BEHIND_ANSWERED)
         values = {'phase': self._phase.value, 'published': self._published,
+                  'recent_rate_hz': rate, 'recent_answered_percent': answered,
+                  'refused': self._refused.total(),
+                  **{f'refused: {kind}': n for kind, n in self._refused.counts.items()},
                   'port_net_work_j': self.passivity.net_work, **summary}
-        return Report(OK, f'{self._phase.value}: {summary["answered_percent"]:.1f} % of '
-                      f'{summary["poses"]} poses answered, recent p99 '
+        return Report(WARN if behind else OK,
+                      f'{self._phase.value}{": behind" if behind else ""}: {rate:.0f} Hz, '
+                      f'{answered:.1f} % answered since the last report, recent p99 '
                       f'{1e3 * summary["latency_p99_s"]:.2f} ms', values)
 
     def destroy_node(self) -> bool:
         self.diagnostics.final()
         self.device.close()
-        if self.params.stats_file:
+        if self._record is not None:
             self.stats.save(self.params.stats_file, published=self._published,
                             port_net_work_j=self.passivity.net_work)
+            self._record.unlink()
         self.get_logger().info(f'published {self._published} poses; experiment loop: '
                                f'{self.stats.summary()}')
         return super().destroy_node()

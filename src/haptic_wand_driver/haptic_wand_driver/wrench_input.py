@@ -17,7 +17,7 @@ import numpy as np
 from haptic_wand_driver._checks import checked_number, finite_components
 from haptic_wand_driver.orientation import roll_axis
 
-__all__ = ['WrenchCommand', 'saturate', 'saturate_components']
+__all__ = ['Refusal', 'WrenchCommand', 'saturate', 'saturate_components']
 
 _ZERO = (0.0, 0.0, 0.0)
 
@@ -48,6 +48,15 @@ def saturate(vector: np.ndarray, limit: float) -> np.ndarray:
     return np.array(saturate_components(np.array(vector, dtype=np.float64).tolist(), limit))
 
 
+class Refusal(str):
+    """Why a wrench was not taken: the sentence itself, and ``kind``, its fixed short class."""
+
+    def __new__(cls, kind: str, sentence: str) -> 'Refusal':
+        refusal = super().__new__(cls, sentence)
+        refusal.kind = kind
+        return refusal
+
+
 class WrenchCommand:
     """The latest rendered wrench, as the device should apply it now.
 
@@ -69,7 +78,7 @@ class WrenchCommand:
         self._force = self._torque = _ZERO
         self._stamp: float | None = None
 
-    def update(self, force, torque, stamp: float, now: float) -> str | None:
+    def update(self, force, torque, stamp: float, now: float) -> Refusal | None:
         """Take a received wrench; return None if it is held, else why it was ignored.
 
         A wrench with NaN/Inf or the wrong shape also clears the held wrench, so the force goes
@@ -88,24 +97,25 @@ class WrenchCommand:
 
         Returns
         -------
-        reason : str or None
-            A sentence for a (throttled) warning, or None when the wrench was accepted.
+        reason : Refusal or None
+            Why the wrench was not taken, or None when it was.
         """
         try:
             force_components = finite_components(force, 3, 'force')
             torque_components = finite_components(torque, 3, 'torque')
         except ValueError as error:
             self.clear()
-            return f'wrench ignored and force zeroed: {error}'
+            return Refusal('non-finite wrench', f'wrench ignored and force zeroed: {error}')
         if not (math.isfinite(stamp) and math.isfinite(now)):
             self.clear()
-            return f'wrench ignored and force zeroed: stamp {stamp!r} or now {now!r} is not finite'
+            return Refusal('non-finite stamp', f'wrench ignored and force zeroed: stamp '
+                           f'{stamp!r} or now {now!r} is not finite')
         if self._stamp is not None and stamp < self._stamp:
-            return (f'wrench ignored: stamp {stamp:.6f} s is older than the held wrench '
-                    f'({self._stamp:.6f} s)')
+            return Refusal('older than the held wrench', f'wrench ignored: stamp {stamp:.6f} s '
+                           f'is older than the held wrench ({self._stamp:.6f} s)')
         if stamp > now + self._timeout:
-            return (f'wrench ignored: stamp {stamp:.6f} s is {stamp - now:.6f} s ahead of now; '
-                    f'the clocks disagree')
+            return Refusal('stamped ahead of now', f'wrench ignored: stamp {stamp:.6f} s is '
+                           f'{stamp - now:.6f} s ahead of now; the clocks disagree')
         self._force, self._torque, self._stamp = force_components, torque_components, float(stamp)
         return None
 
