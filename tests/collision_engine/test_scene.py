@@ -157,6 +157,16 @@ def test_result_fields_inside_and_outside():
     assert outside.lower_bound == pytest.approx(outside.distance, abs=ATOL)
 
 
+@pytest.mark.parametrize('centre_height', [0.0005, 0.0, -0.0005])  # sphere depths 0.5, 1, 1.5 mm
+def test_a_sphere_tip_s_penetration_is_its_depth_along_the_normal(centre_height):
+    box = SceneObject('box', Box([0.2, 0.2, 0.2]), Pose.from_rpy([0, 0, -0.1]))
+    result = Scene([box], tip_radius=0.001).query((0.01, 0.02, centre_height))
+    depth = 0.001 - centre_height
+    assert result.distance == pytest.approx(-depth, abs=ATOL)
+    np.testing.assert_allclose(result.penetration, [0.0, 0.0, depth], atol=ATOL)
+    np.testing.assert_allclose(result.point, [0.01, 0.02, 0.0], atol=ATOL)
+
+
 def test_empty_scene_reports_no_object():
     scene = Scene([])
     result = scene.query((0.0, 0.0, 0.0))

@@ -6,7 +6,7 @@ inside, like the collision engine's query. `closest_point` gives the matching su
 
 import numpy as np
 
-__all__ = ['Box', 'Sphere', 'Union', 'closest_point']
+__all__ = ['Box', 'Sphere', 'Union', 'closest_point', 'contact_with', 'inflated']
 
 
 class Box:
@@ -57,3 +57,21 @@ def closest_point(field, point) -> np.ndarray:
     """Surface point nearest `point` (3,) m, from the field's distance and normal."""
     distance, normal = field(point)
     return np.asarray(point, dtype=float) - distance * normal
+
+
+def inflated(field, radius: float):
+    """Return the field a sphere tip of ``radius`` (m) sees: the distance of its surface."""
+    def distance(point) -> tuple[float, np.ndarray]:
+        d, normal = field(point)
+        return d - radius, normal
+    return distance
+
+
+def contact_with(field, tip, *, radius: float = 0.0, name: str = 'object', stamp: float = 0.0):
+    """Return the Contact the engine reports for a tip (a sphere of ``radius``) at ``tip``.
+
+    ``point`` stays the surface point nearest the centre, as in the engine.
+    """
+    from force_renderer.contact import Contact
+    distance, normal = field(tip)
+    return Contact(distance - radius, closest_point(field, tip), normal, tip, name, stamp)

@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 import numpy as np
 import pytest
 
-from force_renderer.contact import Contact
+from force_renderer.contact import (Contact, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
+                                    STATUS_NOT_CONVERGED)
 from force_renderer.errors import ForceRendererError
 from force_renderer.pipeline import ForcePipeline, PipelineConfig
 from force_renderer.spring_damper import SpringDamper
@@ -172,3 +173,26 @@ def test_extreme_cases_stay_bounded_and_finite(name, stiffness):
         # measured there: 13 mJ generated with 5 ms periods (they would need K·T/2 = 250 N·s/m,
         # max_damping is 100), 2.6 mJ leaving deep penetration, 1.5 mJ with dropped messages.
         assert -run.port_energy[-1] <= 0.0
+
+
+@pytest.mark.parametrize('status, reason', [
+    (STATUS_NO_OBJECT, Reason.NO_OBJECT),
+    (STATUS_INVALID_INPUT, Reason.REFUSED),
+])
+def test_a_state_the_engine_could_not_answer_gives_zero_force(status, reason):
+    pipeline = ForcePipeline(SpringDamper(1000.0, 0.0))
+    pipeline.step(wall_contact(-0.003, 1.0), None, 1.0)
+    contact = Contact(-0.003, (0.0, 0.0, 0.0), UP, (0.0, 0.0, -0.003), 'wall', 1.001, status)
+    np.testing.assert_array_equal(pipeline.step(contact, None, 1.001), np.zeros(3))
+    assert pipeline.last_reason is reason
+    np.testing.assert_allclose(pipeline.step(wall_contact(-0.003, 1.002), None, 1.002),
+                               [0.0, 0.0, 3.0], rtol=1e-9)  # the next answered state renders
+
+
+def test_an_unconverged_distance_is_rendered_as_the_upper_bound_it_is():
+    """The bound is above the true distance, so the depth and the force are never larger."""
+    pipeline = ForcePipeline(SpringDamper(1000.0, 0.0), PipelineConfig(passivity=False))
+    contact = Contact(-0.002, (0.0, 0.0, 0.0), UP, (0.0, 0.0, -0.002), 'wall', 1.0,
+                      STATUS_NOT_CONVERGED)
+    np.testing.assert_allclose(pipeline.step(contact, None, 1.0), [0.0, 0.0, 2.0], rtol=1e-9)
+    assert pipeline.last_reason is Reason.OK

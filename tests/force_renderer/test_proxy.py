@@ -1,11 +1,10 @@
 """God-object proxy: it stays on the surface it entered, so the force never flips."""
 
-from analytic_fields import Box, closest_point, Sphere, Union
+from analytic_fields import Box, contact_with, Sphere, Union
 from ground_truth import angle_between
 import numpy as np
 import pytest
 
-from force_renderer.contact import Contact
 from force_renderer.errors import ForceRendererError
 from force_renderer.pipeline import ForcePipeline
 from force_renderer.proxy import GodObjectProxy
@@ -17,11 +16,6 @@ PLATE = Box([-0.05, -0.05, -0.001], [0.05, 0.05, 0.001])              # 2 mm thi
 FINGER_A = Box([-0.011, -0.05, -0.010], [-0.001, 0.05, 0.0])           # 10 mm wide, 10 mm tall
 FINGER_B = Box([0.001, -0.05, -0.010], [0.011, 0.05, 0.0])             # 2 mm gap between them
 FINGERS = Union(FINGER_A, FINGER_B)
-
-
-def contact_with(field, tip, stamp=0.0):
-    distance, normal = field(tip)
-    return Contact(distance, closest_point(field, tip), normal, tip, 'object', stamp)
 
 
 def forces_along(field, path, law):

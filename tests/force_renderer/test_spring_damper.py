@@ -2,7 +2,7 @@
 
 import itertools
 
-from analytic_fields import Box, closest_point
+from analytic_fields import Box, contact_with
 from fuzzing import examples
 from ground_truth import angle_between
 from hypothesis import given, settings
@@ -18,11 +18,6 @@ from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 CENTRE = np.array([0.0, 0.0, -0.075])
 HALF = np.array([0.05, 0.05, 0.1])
 CUBOID = Box(CENTRE - HALF, CENTRE + HALF)
-
-
-def contact_with(field, tip, stamp=0.0):
-    distance, normal = field(tip)
-    return Contact(distance, closest_point(field, tip), normal, tip, 'cuboid', stamp)
 
 
 def inside_point(depths):

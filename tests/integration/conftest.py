@@ -7,9 +7,12 @@ import pytest
 from haptic_bringup.launcher import Loop, LoopConfig
 
 
-def session_domain_id() -> int:
-    """Pick a domain per test session, so parallel runs on one machine do not interfere."""
-    return 1 + os.getpid() % 100
+def session_domain_id(second: bool = False) -> int:
+    """Pick a domain per test session, so parallel runs on one machine do not interfere.
+
+    ``second`` gives another domain of the session's, for a loop that runs beside the first.
+    """
+    return 1 + os.getpid() % 100 + (100 if second else 0)
 
 
 @pytest.fixture(scope='module')

@@ -6,6 +6,7 @@ import struct
 import time
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
+import numpy as np
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -18,6 +19,10 @@ from haptic_util.stamps import to_stamp
 
 STAMP_OFFSET = 4  # [bytes] header.stamp in a CDR message, after the encapsulation header
 ANSWER_TIMEOUT = 5.0  # [s] for one pose's answer: ample on a machine busy with other work
+FORCE_LIMIT = 10.0  # [N] the force node's default force_limit
+WATCHDOG = 0.010  # [s] the force node's default watchdog_timeout
+TIMELY = 20  # answers back within WATCHDOG that each press checks
+MAX_POSES = 2000  # per press: a machine too busy to answer 20 in time fails with a clear line
 
 
 class LoopClient:
@@ -121,3 +126,32 @@ class LoopClient:
     def close(self) -> None:
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
+
+
+def press(client, position, expected, label='', **kwargs) -> None:
+    """Drive the loop in lockstep (one pose, then its answer) until TIMELY timely answers.
+
+    Every pose must be answered. An answer back within the force node's watchdog timeout was
+    rendered from a fresh state, so it must carry the law's force ``expected`` (3,) N, along a
+    face normal. A later one may be the watchdog's zero (its state went stale on the way), or
+    carry damping from an estimated velocity (its twist came too late), but never a force off
+    the normal or over the limit.
+    """
+    expected = np.asarray(expected, dtype=float)
+    normal = expected != 0.0 if expected.any() else np.ones(3, dtype=bool)
+    timely = 0
+    for _ in range(MAX_POSES):
+        stamp, wrench, latency = client.exchange(position, **kwargs)
+        assert wrench is not None, f'{label}: the pose stamped {stamp} got no answer'
+        force = np.array([wrench.wrench.force.x, wrench.wrench.force.y, wrench.wrench.force.z])
+        if latency <= WATCHDOG:
+            np.testing.assert_allclose(force, expected, rtol=1e-9, atol=1e-9, err_msg=label)
+            timely += 1
+            if timely == TIMELY:
+                return
+        else:
+            assert (np.all(np.abs(force[~normal]) <= 1e-9)
+                    and np.linalg.norm(force) <= FORCE_LIMIT), \
+                f'{label}: a late answer ({latency:.3f} s) pushes {force} N'
+    raise AssertionError(f'{label}: only {timely} of {MAX_POSES} answers came back within '
+                         f'{WATCHDOG} s')

@@ -6,6 +6,7 @@ the toolkit's code.
 """
 import math
 
+from loop_client import press
 import numpy as np
 import pytest
 
@@ -16,42 +17,10 @@ CENTRE = np.array([0.0, 0.0, -0.075])
 HALF = np.array([0.1, 0.05, 0.05])
 TOP = CENTRE[2] + HALF[2]  # z of the top face
 LEFT = CENTRE[0] - HALF[0]  # x of the -x end face
-FORCE_LIMIT = 10.0  # [N] the force node's default force_limit
-WATCHDOG = 0.010  # [s] the force node's default watchdog_timeout
-TIMELY = 20  # answers back within WATCHDOG that each press checks
-MAX_POSES = 2000  # per press: a machine too busy to answer 20 in time fails with a clear line
 POSES = 20  # per check of refused poses
 LOOP_RATE = 1000.0  # [Hz] the rate the loop is built for
 FLOOD_POSES = 20000
 FLOOD_FACTOR = 10.0  # a flood sends at least this many times the loop's rate
-
-
-def press(client, position, expected, label='', **kwargs) -> None:
-    """Drive the loop in lockstep (one pose, then its answer) until TIMELY timely answers.
-
-    Every pose must be answered. An answer back within the force node's watchdog timeout was
-    rendered from a fresh state, so it must carry the law's force ``expected`` (3,) N, along a
-    face normal. A later one may be the watchdog's zero (its state went stale on the way), or
-    carry damping from an estimated velocity (its twist came too late), but never a force off
-    the normal or over the limit.
-    """
-    expected = np.asarray(expected, dtype=float)
-    normal = expected != 0.0 if expected.any() else np.ones(3, dtype=bool)
-    timely = 0
-    for _ in range(MAX_POSES):
-        stamp, wrench, latency = client.exchange(position, **kwargs)
-        assert wrench is not None, f'{label}: the pose stamped {stamp} got no answer'
-        force = np.array([wrench.wrench.force.x, wrench.wrench.force.y, wrench.wrench.force.z])
-        if latency <= WATCHDOG:
-            np.testing.assert_allclose(force, expected, rtol=1e-9, atol=1e-9, err_msg=label)
-            timely += 1
-            if timely == TIMELY:
-                return
-        else:
-            assert np.all(force[~normal] == 0.0) and np.linalg.norm(force) <= FORCE_LIMIT, \
-                f'{label}: a late answer ({latency:.3f} s) pushes {force} N'
-    raise AssertionError(f'{label}: only {timely} of {MAX_POSES} answers came back within '
-                         f'{WATCHDOG} s')
 
 
 def refused(client, position, **kwargs) -> list:

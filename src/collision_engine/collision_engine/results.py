@@ -100,9 +100,12 @@ class QueryResult:
 
     @property
     def penetration(self) -> np.ndarray:
-        """(3,) ``point - tip`` when in collision, else zero, m."""
+        """(3,) depth times the outward normal when in collision, else zero, m.
+
+        The depth is ``-distance``: for a sphere tip, r minus the centre's distance.
+        """
         if self._row[0] <= 0.0:
-            return np.array(self._row[1:4]) - np.array(self._row[10:13])
+            return -self._row[0] * np.array(self._row[4:7])
         return np.zeros(3)
 
     def __repr__(self) -> str:

@@ -1,8 +1,10 @@
 """One collision state, as the renderer sees it.
 
 Sign rule: `distance` is negative inside the object, so the tip penetrates when distance < 0; the
-penetration vector then points from the tip to the closest surface point, along the outward
-normal, and its length is -distance.
+penetration vector is then the depth -distance along the outward normal. For a point tip that is
+the vector from the tip to the closest surface point; for a sphere tip (the scene's
+``tip_radius``) the closest point lies beyond the sphere's centre by r - depth, while the depth is
+what the spring must push back.
 """
 
 from dataclasses import dataclass
@@ -11,7 +13,14 @@ import numpy as np
 
 from force_renderer._checks import vector3
 
-__all__ = ['Contact']
+__all__ = ['Contact', 'STATUS_OK', 'STATUS_NOT_CONVERGED', 'STATUS_NO_OBJECT',
+           'STATUS_INVALID_INPUT']
+
+# The collision engine's status codes, as haptic_msgs/CollisionState defines them.
+STATUS_OK = 0
+STATUS_NOT_CONVERGED = 1  # the distance is an upper bound: the force from it is never stronger
+STATUS_NO_OBJECT = 2
+STATUS_INVALID_INPUT = 3
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,6 +44,8 @@ class Contact:
         Name of the nearest object, as in the scene file.
     stamp : float, s
         Stamp of the pose the state answers; carried through to the wrench.
+    status : int
+        The engine's status (``STATUS_*``).
     """
 
     distance: float
@@ -43,10 +54,12 @@ class Contact:
     tip: np.ndarray
     object: str = ''
     stamp: float = 0.0
+    status: int = STATUS_OK
 
     def __post_init__(self) -> None:
         object.__setattr__(self, 'distance', float(self.distance))
         object.__setattr__(self, 'stamp', float(self.stamp))
+        object.__setattr__(self, 'status', int(self.status))
         for name in ('point', 'normal', 'tip'):
             object.__setattr__(self, name, vector3(getattr(self, name), f'Contact.{name}'))
 
@@ -57,7 +70,7 @@ class Contact:
 
     @property
     def penetration(self) -> np.ndarray:
-        """(3,) float, m: `point - tip` in contact, zero outside."""
+        """(3,) float, m: ``-distance * normal`` in contact, zero outside."""
         if self.in_contact:
-            return self.point - self.tip
+            return -self.distance * self.normal
         return np.zeros(3)

@@ -24,10 +24,10 @@ from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS, MARKER_QOS
 from haptic_util.stamps import to_nanoseconds
+from haptic_util.tally import Tally
 
 __all__ = ['ForceNode', 'main']
 
-WARN_PERIOD = 1.0  # [s] throttle of repeated warnings
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 
@@ -55,7 +55,8 @@ class ForceNode(Node):
         self._header = None
         self._twist = None
         self._published = 0
-        self._zeroed = 0
+        self._zeroed = Tally()  # zero forces sent, by reason
+        self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
         self._wrench = WrenchStamped()
         self._wrench_pub = self.create_publisher(WrenchStamped, 'wand/wrench', HAPTIC_STREAM_QOS)
         self.create_subscription(CollisionState, 'collision/state', self.on_state,
@@ -109,9 +110,10 @@ class ForceNode(Node):
 
     def on_state(self, msg: CollisionState) -> None:
         stamp_ns = to_nanoseconds(msg.header.stamp)
+        self._approximate += msg.status == CollisionState.STATUS_NOT_CONVERGED
         p, n, t = msg.closest_point, msg.normal, msg.tip
         self._contact = Contact(msg.distance, (p.x, p.y, p.z), (n.x, n.y, n.z), (t.x, t.y, t.z),
-                                msg.object, stamp_ns * 1e-9)
+                                msg.object, stamp_ns * 1e-9, msg.status)
         self._header = msg.header
         self.render(self._velocity(stamp_ns))
 
@@ -127,9 +129,7 @@ class ForceNode(Node):
         force = self.pipeline.step(self._contact, velocity, now)
         reason = self.pipeline.last_reason
         if reason is not Reason.OK:
-            self._zeroed += 1
-            self.get_logger().warn(f'force zeroed: {reason.value}',
-                                   throttle_duration_sec=WARN_PERIOD)
+            self._zeroed.add(reason.value)  # logged at 1 Hz: nothing costly per tick here
         wrench = self._wrench
         # Even the watchdog's zero carries the stamp of the state it judged, so it never
         # supersedes an answer to a newer pose still on its way to the driver.
@@ -165,10 +165,13 @@ class ForceNode(Node):
         self._marker_pub.publish(marker)
 
     def report(self) -> Report:
-        """Report counts, the watchdog's last word and the passivity energy."""
+        """Report counts, the watchdog's last word and the passivity energy; log new zeroes."""
+        self._zeroed.log_new(lambda line: self.get_logger().warn(f'force zeroed: {line}'))
         reason = self.pipeline.last_reason
         values = {'law': self.params.law, 'published': self._published,
-                  'zeroed': self._zeroed, 'last_reason': reason.value}
+                  'zeroed': self._zeroed.total(), 'approximate': self._approximate,
+                  'last_reason': reason.value,
+                  **{f'zeroed: {kind}': n for kind, n in self._zeroed.counts.items()}}
         if self.pipeline.passivity is not None:
             values['passivity_energy_j'] = self.pipeline.passivity.energy
         level = OK if reason in (Reason.OK, Reason.NO_STATE) else WARN

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from force_renderer._checks import floats3, non_negative, positive
-from force_renderer.contact import Contact
+from force_renderer.contact import Contact, STATUS_INVALID_INPUT, STATUS_NO_OBJECT
 from force_renderer.passivity import PassivityController
 from force_renderer.saturation import saturate_components
 from force_renderer.spring_damper import ForceLaw
@@ -20,6 +20,7 @@ from force_renderer.watchdog import Reason, Watchdog
 __all__ = ['ForcePipeline', 'PipelineConfig']
 
 _ZERO = (0.0, 0.0, 0.0)
+_UNANSWERED = {STATUS_NO_OBJECT: Reason.NO_OBJECT, STATUS_INVALID_INPUT: Reason.REFUSED}
 
 
 @dataclass(frozen=True)
@@ -127,10 +128,18 @@ class ForcePipeline:
         return np.array(force)
 
     def _screen(self, contact: Contact | None, twist, now: float) -> Reason:
-        """Ask the watchdog about this step's input (None is no state at all)."""
+        """Ask the watchdog about this step's input (None is no state at all).
+
+        A state the engine could not answer (no object, a refused pose) gives zero force, once
+        the watchdog has judged its stamp; a NOT_CONVERGED one is rendered: its distance is an
+        upper bound, so the force is at most the exact one.
+        """
         if contact is None:
             return Reason.NO_STATE
-        return self.watchdog.check(contact.stamp, now, _finite(contact, twist))
+        unanswered = _UNANSWERED.get(contact.status)
+        reason = self.watchdog.check(contact.stamp, now,
+                                     unanswered is not None or _finite(contact, twist))
+        return unanswered if reason is Reason.OK and unanswered is not None else reason
 
 
 def _finite(contact: Contact, velocity: tuple[float, float, float] | None) -> bool:

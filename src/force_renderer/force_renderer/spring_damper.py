@@ -60,7 +60,7 @@ def unilateral_spring_damper(displacement: Vector3, normal: Vector3, velocity: V
 
 
 class SpringDamper:
-    """F = K⊙x − C⊙v in contact (x = penetration vector), never attractive; zero outside.
+    """F = K⊙x − C⊙v in contact (x = depth × outward normal), never attractive; zero outside.
 
     Parameters
     ----------
@@ -80,10 +80,8 @@ class SpringDamper:
         """Force on the tip, (3,) float, N; see `ForceLaw.force`."""
         if not contact.in_contact:
             return np.zeros(3)
-        px, py, pz = contact.point.tolist()
-        tx, ty, tz = contact.tip.tolist()
         return np.array(unilateral_spring_damper(
-            (px - tx, py - ty, pz - tz), contact.normal.tolist(), floats3(velocity),
+            contact.penetration.tolist(), contact.normal.tolist(), floats3(velocity),
             self._stiffness, self._damping))
 
 

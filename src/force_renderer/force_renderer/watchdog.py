@@ -22,6 +22,8 @@ class Reason(str, enum.Enum):
     FUTURE = 'input stamped in the future'
     OUT_OF_ORDER = 'input stamp went backwards'
     STALE = 'input older than the timeout'
+    NO_OBJECT = 'the scene has no object'
+    REFUSED = 'the collision engine refused the pose'
 
 
 class Watchdog:
