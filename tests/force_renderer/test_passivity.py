@@ -2,13 +2,13 @@
 
 import numpy as np
 import pytest
+from virtual_wall import Device, HalfSpace, OperatorHand, simulate
 
 from force_renderer.contact import Contact
 from force_renderer.errors import ForceRendererError
 from force_renderer.passivity import passivity_bound, passivity_warning, PassivityController
 from force_renderer.pipeline import ForcePipeline, PipelineConfig
 from force_renderer.spring_damper import SpringDamper
-from force_renderer.virtual_wall import Device, HalfSpace, OperatorHand, simulate
 
 PERIOD = 0.001
 

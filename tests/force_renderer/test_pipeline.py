@@ -8,14 +8,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
+from virtual_wall import Device, HalfSpace, OperatorHand, ServoTiming, simulate
 
 from force_renderer.contact import (Contact, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
                                     STATUS_NOT_CONVERGED)
 from force_renderer.errors import ForceRendererError
 from force_renderer.pipeline import ForcePipeline, PipelineConfig
 from force_renderer.spring_damper import SpringDamper
-from force_renderer.virtual_wall import (Device, HalfSpace, OperatorHand, ServoTiming,
-                                         simulate)
 from force_renderer.watchdog import Reason
 
 UP = (0.0, 0.0, 1.0)

@@ -4,12 +4,12 @@ from analytic_fields import Box, contact_with, Sphere, Union
 from ground_truth import angle_between
 import numpy as np
 import pytest
+from virtual_wall import Device, OperatorHand, simulate
 
 from force_renderer.errors import ForceRendererError
 from force_renderer.pipeline import ForcePipeline
 from force_renderer.proxy import GodObjectProxy
 from force_renderer.spring_damper import SpringDamper
-from force_renderer.virtual_wall import Device, OperatorHand, simulate
 
 STIFFNESS = 1000.0
 PLATE = Box([-0.05, -0.05, -0.001], [0.05, 0.05, 0.001])              # 2 mm thick, top z = 1 mm

@@ -2,10 +2,9 @@
 
 import numpy as np
 import pytest
+from virtual_wall import Device, HalfSpace, OperatorHand, ServoTiming, simulate
 
 from force_renderer.errors import ForceRendererError
-from force_renderer.virtual_wall import (Device, HalfSpace, OperatorHand, ServoTiming,
-                                         simulate)
 
 FAR_WALL = HalfSpace(origin=(0.0, 0.0, -10.0))
 

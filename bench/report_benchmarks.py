@@ -1,0 +1,184 @@
+"""What the report measures live on this machine, beside the bags: times, trade-offs, loops.
+
+Error against run time for every method, our GJK's tolerance and iteration-cap trade-off, the
+loop latency over ROS 2 at 0.5, 1 and 2 kHz, and the stiff wall over the real loop; each
+builds on a bench script (``bench_collision``, ``bench_loop``, ``stiff_wall_loop``), so the
+report times things as those scripts do.
+"""
+
+import math
+
+import bench_collision
+import numpy as np
+from paper_method import PaperMethod
+from report_experiments import Experiment, EXPERIMENTS
+from report_metrics import error_summary, false_samples
+from report_paper_replay import paper_rows
+import stiff_wall_loop
+import stiffness_sweep
+
+from collision_engine import ConvexMesh, DistanceRequest, load_scene, Scene, STATUS_NOT_CONVERGED
+from collision_engine.scene import SceneObject
+
+__all__ = ['ITERATION_CAPS', 'LOOP_LAYOUTS', 'LOOP_RATES', 'STIFF_WALLS', 'TOLERANCES',
+           'colgate_bound', 'error_time_rows', 'loop_rows', 'stiff_wall_rows', 'tradeoff_rows']
+
+STIFF_WALLS = (160.0, 5000.0, 20000.0)  # [N/m] over the real loop
+LOOP_RATES = (500.0, 1000.0, 2000.0)  # [Hz]
+LOOP_LAYOUTS = ('separate', 'composed')
+TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+ITERATION_CAPS = (1, 2, 3, 4, 6, 8, 12, 16, 100)
+
+
+def _paper_function(rows: np.ndarray):
+    method = PaperMethod(rows)
+    return (lambda point: method.query(point).signed_distance), list
+
+
+def _trimesh_function(experiment: Experiment):
+    import trimesh
+    import trimesh.proximity
+
+    rows, _ = paper_rows(experiment)
+    mesh = trimesh.Trimesh(rows, np.arange(len(rows)).reshape(-1, 3))
+    mesh.merge_vertices()
+    trimesh.proximity.signed_distance(mesh, rows[:1])  # raises now if rtree is missing
+
+    def signed_distance(point):
+        return -float(trimesh.proximity.signed_distance(mesh, point[None])[0])
+
+    return signed_distance, list
+
+
+def _hull_object(experiment: Experiment, exact: SceneObject) -> SceneObject:
+    """Our GJK on the convex hull of the paper's STL, placed as the exact object."""
+    if experiment.paper_scene != experiment.scene:
+        return load_scene(experiment.paper_scene_file).objects[0]
+    return SceneObject(f'{exact.name} hull', ConvexMesh(exact.shape.vertices), exact.pose)
+
+
+def _methods(experiment: Experiment, exact: SceneObject) -> list:
+    """List (method, geometry, factory) for every method on one object."""
+    exact_kind = type(exact.shape).__name__
+    ours_exact = ('ours: exact mesh (BVH + pseudonormals)' if exact_kind == 'TriangleMesh'
+                  else 'ours: GJK, exact primitive')
+    methods = bench_collision.METHODS
+    return [
+        (ours_exact, exact_kind, lambda: methods['ours'](exact)),
+        ('ours: GJK on the STL\'s convex hull', 'ConvexMesh',
+         lambda: methods['ours'](_hull_object(experiment, exact))),
+        ('paper\'s method (re-implemented)', 'STL vertex rows',
+         lambda: _paper_function(paper_rows(experiment)[0])),
+        ('python-fcl', exact_kind, lambda: methods['python-fcl'](exact)),
+        ('coal', exact_kind, lambda: methods['coal'](exact)),
+        ('trimesh signed_distance', 'STL mesh', lambda: _trimesh_function(experiment)),
+    ]
+
+
+def error_time_rows(*, random: int, near: int, tapping: float, slow_points: int,
+                    seed: int = 0) -> list[dict]:
+    """Per object and method: per-query time and error against exact truth.
+
+    Every method answers the same points (``bench_collision.point_sets``: random in twice the
+    bounding box, within +-2 mm of the surface, a 1 kHz tapping path), one Python call each,
+    timed as ``bench_collision`` times its methods; trimesh answers every k-th point only, for
+    ``slow_points`` in all. A method that cannot run says why.
+    """
+    rows = []
+    for experiment in EXPERIMENTS.values():
+        exact = load_scene(experiment.scene_file).objects[0]
+        sets = bench_collision.point_sets(exact, random=random, near=near, tapping=tapping,
+                                          seed=seed)
+        points = np.vstack([p for p, _ in sets.values()])
+        truth = np.concatenate([d for _, d in sets.values()])
+        for method, geometry, factory in _methods(experiment, exact):
+            row = {'object': experiment.name, 'method': method, 'geometry': geometry}
+            try:
+                function, convert = factory()
+            except ImportError as error:
+                rows.append({**row, 'unavailable': f'{type(error).__name__}: {error}'})
+                continue
+            pick = slice(None, None, max(1, len(points) // slow_points)) if method.startswith(
+                'trimesh') else slice(None)
+            durations, answers = bench_collision._time_calls(function, convert(points[pick]))
+            rows.append({**row, 'n': len(answers), 'median_us': float(np.median(durations)),
+                         'p99_us': float(np.percentile(durations, 99)),
+                         **error_summary(answers, truth[pick]),
+                         'sign_errors': int(np.count_nonzero(
+                             false_samples(answers, truth[pick], threshold=math.inf)))})
+    return rows
+
+
+def tradeoff_rows(points: int, seed: int = 0) -> list[dict]:
+    """Error and time of our GJK as its tolerance and iteration cap vary.
+
+    On the true cylinder (analytic support) and the hand's convex hull (hundreds of vertices),
+    one ``Scene.query`` per point as the collision node makes them, in a scene built with the
+    ``DistanceRequest`` of each setting, over the same points per shape (random, near the
+    surface, tapping); truth as elsewhere.
+    """
+    cylinder = load_scene(EXPERIMENTS['cylinder'].scene_file).objects[0]
+    hand = load_scene(EXPERIMENTS['hand'].scene_file).objects[0]
+    shapes = {'cylinder (exact)': cylinder,
+              'hand\'s convex hull': _hull_object(EXPERIMENTS['hand'], hand)}
+    settings = ([('tolerance', t, DistanceRequest(rel_tol=t, abs_tol=t)) for t in TOLERANCES]
+                + [('iteration cap', k, DistanceRequest(max_iterations=k))
+                   for k in ITERATION_CAPS])
+    rows = []
+    for label, scene_object in shapes.items():
+        sets = bench_collision.point_sets(scene_object, random=points // 2, near=points // 2,
+                                          tapping=0.1, seed=seed)
+        world = np.vstack([p for p, _ in sets.values()])
+        inputs = [tuple(point) for point in world]
+        truth = np.concatenate([d for _, d in sets.values()])
+        for sweep, value, request in settings:
+            scene = Scene([scene_object], request=request)
+            scene.warm_up()
+            durations, answers = bench_collision._time_calls(
+                lambda p, query=scene.query: query(p).distance, inputs)
+            results = [scene.query(p) for p in inputs]
+            rows.append({'shape': label, 'sweep': sweep, 'value': value,
+                         'median_us': float(np.median(durations)),
+                         'p99_us': float(np.percentile(durations, 99)),
+                         **error_summary(answers, truth),
+                         'iterations': float(np.mean([r.iterations for r in results])),
+                         'not_converged': int(sum(r.status == STATUS_NOT_CONVERGED
+                                                  for r in results)),
+                         'n': len(inputs)})
+    return rows
+
+
+def loop_rows(duration: float, domain_id: int) -> list[dict]:
+    """One ``bench_loop.run_once`` per layout and pose rate (0.5, 1 and 2 kHz)."""
+    import bench_loop
+
+    rows = []
+    for layout in LOOP_LAYOUTS:
+        for rate in LOOP_RATES:
+            row = {'layout': layout, 'rate': rate, 'duration': duration}
+            try:
+                record = bench_loop.run_once(layout, rate, duration, domain_id)
+            except RuntimeError as error:
+                rows.append({**row, 'failed': str(error)})
+                continue
+            latency = np.asarray(record['latencies'], dtype=float)
+            rows.append({**row, 'achieved': float(record['rate_hz']),
+                         'answered': float(record['answered_percent']),
+                         'cpu': float(record['cpu_percent']), 'n': int(latency.size),
+                         **{f'p{q}': float(np.percentile(latency, q)) for q in (50, 90, 99)},
+                         'max': float(latency.max())})
+    return rows
+
+
+def stiff_wall_rows(duration: float, domain_id: int) -> list[dict]:
+    """One ``stiff_wall_loop.run`` per wall stiffness, the device-port controller on and off."""
+    return [stiff_wall_loop.run(k, port, duration=duration, domain_id=domain_id)
+            for k in STIFF_WALLS for port in (True, False)]
+
+
+def colgate_bound() -> float:
+    """Return the Colgate passivity bound on K for the stiffness sweep's device and wall, N/m."""
+    from force_renderer import passivity_bound, PipelineConfig
+
+    return passivity_bound(stiffness_sweep.DEVICE.damping, PipelineConfig().servo_period,
+                           stiffness_sweep.WALL_DAMPING)

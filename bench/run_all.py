@@ -1,0 +1,102 @@
+"""Run every benchmark in ``bench/`` in turn, each in a process of its own, and summarise.
+
+    .venv/bin/python bench/run_all.py [--quick] [--only NAME [NAME ...]]
+    make bench [ARGS='--quick --only loop stiff_wall']
+
+Each script runs as ``python bench/<script>`` with this interpreter (``make bench`` uses the
+venv's), its output printed as it comes; a script that fails is reported and the rest still
+run. The last lines say, per script, ok or failed (with the exit code) and how long it took;
+the exit code is 1 if any failed. ``--quick`` gives each script its own smaller sizes (fewer
+points, repeats, runs or seconds: ``Benchmark.quick``); none of the scripts has a ``--quick``
+of its own. ``BENCHMARKS`` must list every script in ``bench/`` that runs as a benchmark
+(``tests/bench/test_run_all.py`` checks it), so a new one cannot be left out.
+"""
+
+import argparse
+from dataclasses import dataclass
+import os
+from pathlib import Path
+import subprocess
+import sys
+import time
+
+__all__ = ['BENCHMARKS', 'Benchmark', 'Outcome', 'main', 'run', 'summary']
+
+BENCH = Path(__file__).resolve().parent
+
+
+@dataclass(frozen=True)
+class Benchmark:
+    """One benchmark script in ``bench/``, and the arguments that make it quick."""
+
+    name: str
+    script: str
+    quick: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """How one script's run ended: its exit code (0 is ok) and its duration, s."""
+
+    benchmark: Benchmark
+    returncode: int
+    duration: float
+
+
+BENCHMARKS = (
+    Benchmark('collision', 'bench_collision.py', ('--random', '200', '--near', '200',
+                                                  '--tapping', '1')),
+    Benchmark('wand_driver', 'bench_wand_driver.py', ('--repeats', '2', '--seconds', '2')),
+    Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--duration', '3')),
+    Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5')),
+    Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4')),
+    Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60')),
+)
+
+
+def run(benchmarks, *, quick: bool = False, folder: Path = BENCH) -> list[Outcome]:
+    """Run each benchmark's script from ``folder`` in turn; one failure does not stop the rest."""
+    environment = dict(os.environ)
+    environment.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    outcomes = []
+    for count, benchmark in enumerate(benchmarks, 1):
+        command = [sys.executable, str(folder / benchmark.script),
+                   *(benchmark.quick if quick else ())]
+        print(f'[bench] {count}/{len(benchmarks)} {benchmark.name}: {" ".join(command)}',
+              flush=True)
+        started = time.monotonic()
+        returncode = subprocess.run(command, env=environment).returncode
+        outcomes.append(Outcome(benchmark, returncode, time.monotonic() - started))
+        print(f'[bench]     {benchmark.name}: {_verdict(outcomes[-1])}', flush=True)
+    return outcomes
+
+
+def _verdict(outcome: Outcome) -> str:
+    state = 'ok' if outcome.returncode == 0 else f'failed (exit {outcome.returncode})'
+    return f'{state}, {outcome.duration:.1f} s'
+
+
+def summary(outcomes: list[Outcome]) -> str:
+    """Return one line per script: its name, its file, ok or failed, and its duration."""
+    width = max((len(o.benchmark.name) for o in outcomes), default=0)
+    return '\n'.join(f'{o.benchmark.name:<{width}}  {o.benchmark.script:<22} {_verdict(o)}'
+                     for o in outcomes)
+
+
+def main(argv=None) -> int:
+    """Run the benchmarks asked for, then print the summary; 1 if any failed."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--quick', action='store_true',
+                        help='smaller sizes for every script (a smoke run, not figures)')
+    parser.add_argument('--only', nargs='+', metavar='NAME',
+                        choices=[b.name for b in BENCHMARKS],
+                        help='run only these, in the usual order')
+    args = parser.parse_args(argv)
+    chosen = [b for b in BENCHMARKS if not args.only or b.name in args.only]
+    outcomes = run(chosen, quick=args.quick)
+    print('[bench] summary:', summary(outcomes), sep='\n', flush=True)
+    return 0 if all(o.returncode == 0 for o in outcomes) else 1
+
+
+if __name__ == '__main__':
+    sys.exit(main())
