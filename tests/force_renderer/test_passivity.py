@@ -6,11 +6,13 @@ from virtual_wall import Device, HalfSpace, OperatorHand, simulate
 
 from force_renderer.contact import Contact
 from force_renderer.errors import ForceRendererError
-from force_renderer.passivity import passivity_bound, passivity_warning, PassivityController
+from force_renderer.passivity import (BOOKS_CLOSE_AFTER, passivity_bound, passivity_warning,
+                                      PassivityController)
 from force_renderer.pipeline import ForcePipeline, PipelineConfig
 from force_renderer.spring_damper import SpringDamper
 
 PERIOD = 0.001
+UP = (0.0, 0.0, 1.0)  # the axis of a wall below z = 0
 
 
 @pytest.mark.parametrize('b, period, c, expected', [
@@ -45,7 +47,8 @@ def test_observer_books_the_held_force_times_the_displacement():
     heights = [-0.001, -0.0015, -0.0012, -0.0020, 0.0005, 0.0010]
     applied = [(0.3, -0.1, 2.0), (0.0, 0.0, 3.0), (1.0, 1.0, 1.0), (0.0, 0.0, 4.0), (0, 0, 0)]
     for step, height in enumerate(heights):
-        controller.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, height), step * PERIOD)
+        controller.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, height), step * PERIOD,
+                           UP)
         if step < len(applied):
             controller.record(applied[step])
     expected = -sum(force[2] * (after - before)
@@ -62,7 +65,7 @@ def test_sampled_spring_generates_half_k_dx_squared_per_interval(speed):
     for step, height in enumerate(heights):
         force = spring_force(height, stiffness)
         controller.record(controller.control(force, (0.0, 0.0, speed), (0.0, 0.0, height),
-                                             step * PERIOD))
+                                             step * PERIOD, UP))
     assert controller.deficit == pytest.approx(steps * 0.5 * stiffness * (speed * PERIOD) ** 2,
                                                rel=1e-9)
 
@@ -76,7 +79,8 @@ def test_controller_adds_exactly_the_damping_the_hold_removes(speed):
     controller = PassivityController(max_damping=1e3, servo_period=PERIOD)
     for step, height in enumerate(-0.005 + speed * PERIOD * np.arange(10)):
         force = spring_force(height, stiffness)
-        sent = controller.control(force, (0.0, 0.0, speed), (0.0, 0.0, height), step * PERIOD)
+        sent = controller.control(force, (0.0, 0.0, speed), (0.0, 0.0, height), step * PERIOD,
+                                  UP)
         controller.record(sent)
         if step >= 2:
             assert controller.damping == pytest.approx(stiffness * PERIOD / 2, rel=1e-9)
@@ -86,21 +90,49 @@ def test_controller_adds_exactly_the_damping_the_hold_removes(speed):
 
 def test_controller_never_reverses_the_force_and_respects_its_bound():
     controller = PassivityController(max_damping=5.0)
-    controller.control((0.0, 0.0, 1.0), (0.0, 0.0, 2.0), (0.0, 0.0, -0.001), 0.0)
+    controller.control((0.0, 0.0, 1.0), (0.0, 0.0, 2.0), (0.0, 0.0, -0.001), 0.0, UP)
     controller.record((0.0, 0.0, 10.0))   # 10 N held over 10 mm: far more than the law's 1 N
-    sent = controller.control((0.0, 0.0, 0.9), (0.0, 0.0, 2.0), (0.0, 0.0, 0.009), PERIOD)
+    sent = controller.control((0.0, 0.0, 0.9), (0.0, 0.0, 2.0), (0.0, 0.0, 0.009), PERIOD, UP)
     assert controller.damping == 5.0
     assert sent == (0.0, 0.0, 0.0)
 
 
+def test_the_damping_acts_on_the_push_along_the_axis_and_leaves_a_residue_alone():
+    """A contact ending: the tip leaves at 0.063 m/s while the law leaves a sideways residue.
+
+    Damping along the whole force scaled that residue up into a sideways kick; along the axis,
+    the residue passes unchanged and the push only drops.
+    """
+    controller = PassivityController(max_damping=100.0)
+    controller.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.063), (0.0, 0.0, -0.001), 0.0, UP)
+    controller.record((0.0, 0.0, 3.0))  # more than the law: a deficit to pay
+    residue = (-0.005, 0.0, 0.0002)
+    sent = controller.control(residue, (0.03, 0.0, 0.063), (0.0, 0.0, 0.0), PERIOD, UP)
+    assert controller.deficit > 0.0
+    assert sent[:2] == residue[:2]
+    assert 0.0 <= sent[2] <= residue[2]
+
+
+def test_the_books_close_after_a_break_in_contact_not_at_a_bounce():
+    controller = PassivityController()
+    controller.control((0.0, 0.0, 5.0), (0.0, 0.0, 1.0), (0.0, 0.0, -0.002), 0.0, UP)
+    controller.record((0.0, 0.0, 5.0))
+    steps = round(BOOKS_CLOSE_AFTER / PERIOD)
+    for step in range(1, steps + 2):
+        controller.control((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.0, 0.001), step * PERIOD)
+        if step == 1:
+            assert controller.deficit > 0.0  # a bounce: carried
+    assert controller.deficit == 0.0  # a break: the next touch is another contact
+
+
 def test_nothing_is_added_in_free_space_or_without_velocity():
     controller = PassivityController()
-    controller.control((0.0, 0.0, 5.0), (0.0, 0.0, 1.0), (0.0, 0.0, -0.002), 0.0)
+    controller.control((0.0, 0.0, 5.0), (0.0, 0.0, 1.0), (0.0, 0.0, -0.002), 0.0, UP)
     controller.record((0.0, 0.0, 5.0))
     assert controller.control((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.0, 0.001), PERIOD) \
         == (0.0, 0.0, 0.0)
     assert controller.deficit > 0.0 and controller.damping == 0.0
-    assert controller.control((0.0, 0.0, 2.0), None, None, 2 * PERIOD) == (0.0, 0.0, 2.0)
+    assert controller.control((0.0, 0.0, 2.0), None, None, 2 * PERIOD, UP) == (0.0, 0.0, 2.0)
 
 
 # Closed loop: a 0.15 kg device with 1 N·s/m of damping, pressed by the hand 10 mm into the wall,

@@ -29,4 +29,11 @@ class PerObjectLaw:
 
     def force(self, contact: Contact, velocity) -> np.ndarray:
         """Force on the tip, (3,) float, N, by the law of the contact's object."""
-        return self.laws.get(contact.object, self.default).force(contact, velocity)
+        return self._law(contact).force(contact, velocity)
+
+    def axis(self, contact: Contact):
+        """The axis of the contact's object's law; see `ForceLaw.axis`."""
+        return self._law(contact).axis(contact)
+
+    def _law(self, contact: Contact) -> ForceLaw:
+        return self.laws.get(contact.object, self.default)

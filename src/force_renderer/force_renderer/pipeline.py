@@ -112,7 +112,7 @@ class ForcePipeline:
         reason = self._screen(contact, twist, now)
         self.last_reason = reason
         self.last_stamp = math.nan if contact is None else contact.stamp
-        position, force = None, _ZERO
+        position, force, axis = None, _ZERO, None
         if reason is Reason.OK or reason is Reason.STALE:
             position = floats3(contact.tip)
         else:
@@ -121,9 +121,10 @@ class ForcePipeline:
             estimate = self.velocity_estimator.update_components(contact.stamp, position)
             twist = estimate if twist is None else twist
             force = saturate_components(*floats3(self.law.force(contact, twist)), limit)
+            axis = self.law.axis(contact)
         if self.passivity is not None:
-            force = saturate_components(*self.passivity.control(force, twist, position, now),
-                                        limit)
+            force = saturate_components(
+                *self.passivity.control(force, twist, position, now, axis), limit)
             self.passivity.record(force)
         return np.array(force)
 

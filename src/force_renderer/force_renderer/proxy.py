@@ -101,6 +101,13 @@ class GodObjectProxy:
             stretch.tolist(), (stretch / length).tolist(), floats3(velocity),
             self.stiffness.tolist(), self.damping.tolist()))
 
+    def axis(self, contact: Contact) -> tuple[float, float, float] | None:
+        """From the tip to the proxy while touching; see `ForceLaw.axis`."""
+        if not self._touching:
+            return None
+        stretch = self._proxy - contact.tip
+        return tuple((stretch / float(np.linalg.norm(stretch))).tolist())
+
     def update(self, tip) -> np.ndarray:
         """Move the proxy towards `tip` (3,) m and return its new position (3,) m."""
         tip = vector3(tip, 'tip')

@@ -29,6 +29,12 @@ class ForceLaw(Protocol):
         `velocity` is the tip velocity, (3,) float, m/s, same frame.
         """
 
+    def axis(self, contact: Contact) -> Vector3 | None:
+        """Unit direction its spring pushes the tip along, for the last `force`; None if none.
+
+        The passivity controller damps along it only (see `passivity`).
+        """
+
 
 def unilateral_spring_damper(displacement: Vector3, normal: Vector3, velocity: Vector3,
                              stiffness: Vector3, damping: Vector3) -> Vector3:
@@ -84,6 +90,10 @@ class SpringDamper:
             contact.penetration.tolist(), contact.normal.tolist(), floats3(velocity),
             self._stiffness, self._damping))
 
+    def axis(self, contact: Contact) -> Vector3 | None:
+        """The outward surface normal in contact; see `ForceLaw.axis`."""
+        return tuple(contact.normal.tolist()) if contact.in_contact else None
+
 
 class CentroidSpringDamper:
     """The paper's law: F = (r/|r|)⊙k·|d| − kd⊙v with r = tip − centroid, in contact only.
@@ -116,3 +126,11 @@ class CentroidSpringDamper:
         length = math.sqrt(float(radial @ radial))
         spring = radial * (-contact.distance / length) if length > 0.0 else np.zeros(3)
         return self.stiffness * spring - self.damping * np.asarray(velocity, dtype=np.float64)
+
+    def axis(self, contact: Contact) -> Vector3 | None:
+        """Away from the centroid in contact; see `ForceLaw.axis`."""
+        radial = contact.tip - self.centroid
+        length = math.sqrt(float(radial @ radial))
+        if not contact.in_contact or length == 0.0:
+            return None
+        return tuple((radial / length).tolist())

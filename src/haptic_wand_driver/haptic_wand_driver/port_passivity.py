@@ -9,18 +9,20 @@ motion it did work on, so only here can that energy be observed and removed.
 Sign rule: ``energy`` is what the environment has absorbed through the port, the negative of the
 work its force did on the tip (a spring's stored energy counts as absorbed). A passive
 environment keeps it >= 0. Each period the controller predicts the energy left once the force
-has done its work at the present velocity; if that would be negative, it adds a damping force,
-opposed to the velocity, just large enough to keep it at zero, capped at ``max_damping``. The
-added damping may cancel the force but never reverse it: the wall never pulls the tip in.
+has done its work at the present velocity; if that would be negative, it adds a damping along
+the applied force's own axis, on the tip's speed along it, just large enough to keep the energy
+at zero and capped at ``max_damping``. It only ever lowers that force, at most to zero: it
+creates no direction the force did not have (damping along the velocity pushed sideways on a
+tip sliding off a wall), amplifies nothing, and never pulls the tip in.
 
-The books are closed whenever the force is zero: out of contact the environment holds no
-energy, and dissipation in one contact may not pay for the next. (Carrying a deficit into the
-next contact was tried: the controller then cancels the wall's push until the deficit is paid,
-and the tip sinks into a soft wall.)
+The books close once the force has been zero for ``BOOKS_CLOSE_AFTER``, the same policy as the
+renderer's controller; ``force_renderer.passivity`` says why.
 """
 import math
 
-__all__ = ['PortPassivity']
+__all__ = ['BOOKS_CLOSE_AFTER', 'PortPassivity']
+
+BOOKS_CLOSE_AFTER = 0.05  # [s] of zero force that ends a contact's books (a bounce is shorter)
 
 Vector3 = tuple
 
@@ -43,6 +45,7 @@ class PortPassivity:
         self.net_work = 0.0  # [J] done on the tip by the applied force since the start
         self._force = (0.0, 0.0, 0.0)
         self._position = None
+        self._free = 0.0  # [s] since the force went to zero
 
     def control(self, force: Vector3, position: Vector3, velocity: Vector3,
                 period: float) -> Vector3:
@@ -60,21 +63,23 @@ class PortPassivity:
             Time until the next call (the servo period).
         """
         self._observe(position)
-        if not any(force):
-            self.energy = 0.0
+        magnitude = math.sqrt(force[0] ** 2 + force[1] ** 2 + force[2] ** 2)
+        if magnitude == 0.0:
+            self._free += period
+            if self._free >= BOOKS_CLOSE_AFTER:
+                self.energy = 0.0
             self._force = (0.0, 0.0, 0.0)
             return self._force
-        speed2 = velocity[0] ** 2 + velocity[1] ** 2 + velocity[2] ** 2
-        along = force[0] * velocity[0] + force[1] * velocity[1] + force[2] * velocity[2]
-        alpha = 0.0
+        self._free = 0.0
+        speed = (force[0] * velocity[0] + force[1] * velocity[1]
+                 + force[2] * velocity[2]) / magnitude  # along the force
         # The energy left after the coming period if the force did its work at this velocity.
-        predicted = self.energy - along * period
-        if predicted < 0.0 and speed2 > 0.0 and period > 0.0:
-            alpha = min(-predicted / (period * speed2), self.max_damping)
-            if along > 0.0:  # at most cancel the force along itself, never turn it round
-                alpha = min(alpha, (force[0] ** 2 + force[1] ** 2 + force[2] ** 2) / along)
-        self._force = (force[0] - alpha * velocity[0], force[1] - alpha * velocity[1],
-                       force[2] - alpha * velocity[2])
+        predicted = self.energy - magnitude * speed * period
+        scale = 1.0
+        if predicted < 0.0 and speed > 0.0 and period > 0.0:
+            alpha = min(-predicted / (period * speed * speed), self.max_damping)
+            scale = max(0.0, 1.0 - alpha * speed / magnitude)  # lowered, never turned round
+        self._force = (force[0] * scale, force[1] * scale, force[2] * scale)
         return self._force
 
     def _observe(self, position: Vector3) -> None:
