@@ -32,7 +32,7 @@ class PerObjectLaw:
         return self._law(contact).force(contact, velocity)
 
     def axis(self, contact: Contact):
-        """The axis of the contact's object's law; see `ForceLaw.axis`."""
+        """Return the axis of the contact's object's law; see `ForceLaw.axis`."""
         return self._law(contact).axis(contact)
 
     def _law(self, contact: Contact) -> ForceLaw:

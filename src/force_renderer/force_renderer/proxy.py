@@ -102,7 +102,7 @@ class GodObjectProxy:
             self.stiffness.tolist(), self.damping.tolist()))
 
     def axis(self, contact: Contact) -> tuple[float, float, float] | None:
-        """From the tip to the proxy while touching; see `ForceLaw.axis`."""
+        """Return the direction from the tip to the proxy while touching; see `ForceLaw.axis`."""
         if not self._touching:
             return None
         stretch = self._proxy - contact.tip

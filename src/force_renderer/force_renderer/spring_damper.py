@@ -30,7 +30,7 @@ class ForceLaw(Protocol):
         """
 
     def axis(self, contact: Contact) -> Vector3 | None:
-        """Unit direction its spring pushes the tip along, for the last `force`; None if none.
+        """Return the unit direction its spring pushes the tip along (last `force`), or None.
 
         The passivity controller damps along it only (see `passivity`).
         """
@@ -91,7 +91,7 @@ class SpringDamper:
             self._stiffness, self._damping))
 
     def axis(self, contact: Contact) -> Vector3 | None:
-        """The outward surface normal in contact; see `ForceLaw.axis`."""
+        """Return the outward surface normal in contact; see `ForceLaw.axis`."""
         return tuple(contact.normal.tolist()) if contact.in_contact else None
 
 
@@ -128,7 +128,7 @@ class CentroidSpringDamper:
         return self.stiffness * spring - self.damping * np.asarray(velocity, dtype=np.float64)
 
     def axis(self, contact: Contact) -> Vector3 | None:
-        """Away from the centroid in contact; see `ForceLaw.axis`."""
+        """Return the direction away from the centroid in contact; see `ForceLaw.axis`."""
         radial = contact.tip - self.centroid
         length = math.sqrt(float(radial @ radial))
         if not contact.in_contact or length == 0.0:
