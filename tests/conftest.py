@@ -10,8 +10,10 @@ import pathlib
 import sys
 
 from hypothesis import HealthCheck, settings
+import pytest
 
 TESTS = pathlib.Path(__file__).resolve().parent
+_SEGMENTS_BEFORE = pytest.StashKey[set]()
 sys.path.insert(0, str(TESTS))
 
 # Anything a test starts that speaks DDS stays on this machine, in a domain of its own.
@@ -27,7 +29,16 @@ settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE')
                       or ('ci' if os.environ.get('CI') else 'dev'))
 
 
+def pytest_sessionstart(session):
+    """Note the Fast DDS segments there are before the tests start: only later ones are ours."""
+    from haptic_bringup.processes import shm_segments
+    session.config.stash[_SEGMENTS_BEFORE] = shm_segments()
+
+
 def pytest_sessionfinish(session, exitstatus):
-    """Leave no Fast DDS shared memory behind: nodes killed on purpose, and this process's own."""
+    """Leave no Fast DDS shared memory of ours behind (nodes killed on purpose, and our own)."""
     from haptic_bringup.processes import clean_stale_shm
-    clean_stale_shm()
+    from domains import session_domain_id
+    clean_stale_shm(domains=[int(os.environ['ROS_DOMAIN_ID']), session_domain_id(),
+                             session_domain_id(second=True)],
+                    existing=session.config.stash[_SEGMENTS_BEFORE])

@@ -7,7 +7,7 @@ import time
 
 import psutil
 
-from haptic_bringup.processes import clean_stale_shm, start_child, stop_children
+from haptic_bringup.processes import clean_stale_shm, shm_segments, start_child, stop_children
 
 STUBBORN = """
 import signal, subprocess, sys, time
@@ -54,18 +54,27 @@ def _group_of(process):
         return None
 
 
-def test_only_segments_no_live_process_holds_are_removed(tmp_path):
-    for name in ('fastrtps_dead', 'fastrtps_live'):
+def test_only_our_own_dead_segments_are_removed(tmp_path):
+    """Ours: made after the snapshot, and for a port, in one of our domains (7400 + 250 d + k)."""
+    def segment(name, age=60.0, lock=True):
         (tmp_path / name).write_bytes(b'segment')
-        (tmp_path / f'{name}_el').write_bytes(b'')
-    (tmp_path / 'sem.fastrtps_dead_mutex').write_bytes(b'')
-    for name, age in (('fastrtps_port7411', 60.0), ('fastrtps_port7413', 0.0)):
-        (tmp_path / name).write_bytes(b'port without a lock file')
         (tmp_path / f'sem.{name}_mutex').write_bytes(b'')
+        if lock:
+            (tmp_path / f'{name}_el').write_bytes(b'')
         os.utime(tmp_path / name, (time.time() - age, time.time() - age))
+
+    segment('fastrtps_someone_elses')  # dead, but there before us: not ours
+    before = shm_segments(tmp_path)
+    segment('fastrtps_dead')
+    segment('fastrtps_live')
+    segment('fastrtps_young', age=0.0)  # its creator may not have locked it yet
+    segment('fastrtps_port7411', lock=False)  # domain 0: ours
+    segment('fastrtps_port17661')  # domain 41, not ours: stays though nobody holds it
     with open(tmp_path / 'fastrtps_live_el', 'rb') as held:
         fcntl.flock(held, fcntl.LOCK_SH)  # a live participant holds its lock
-        assert clean_stale_shm(tmp_path) == ['fastrtps_dead', 'fastrtps_port7411']
-    # The live one stays, and so does a fresh lock-less one (its creator may be making the lock).
-    assert sorted(p.name for p in tmp_path.iterdir()) == [
-        'fastrtps_live', 'fastrtps_live_el', 'fastrtps_port7413', 'sem.fastrtps_port7413_mutex']
+        removed = clean_stale_shm(tmp_path, domains=[0, 42], existing=before)
+    assert removed == ['fastrtps_dead', 'fastrtps_port7411']
+    assert {p.name for p in tmp_path.iterdir() if not p.name.startswith('sem.')} == {
+        'fastrtps_someone_elses', 'fastrtps_someone_elses_el', 'fastrtps_live',
+        'fastrtps_live_el', 'fastrtps_young', 'fastrtps_young_el', 'fastrtps_port17661',
+        'fastrtps_port17661_el'}

@@ -1,18 +1,9 @@
 """Integration fixtures: the loop's nodes as real processes, in a DDS domain of the test's own."""
-import os
-
+from domains import session_domain_id
 from loop_client import LoopClient
 import pytest
 
 from haptic_bringup.launcher import Loop, LoopConfig
-
-
-def session_domain_id(second: bool = False) -> int:
-    """Pick a domain per test session, so parallel runs on one machine do not interfere.
-
-    ``second`` gives another domain of the session's, for a loop that runs beside the first.
-    """
-    return 1 + os.getpid() % 100 + (100 if second else 0)
 
 
 @pytest.fixture(scope='module')

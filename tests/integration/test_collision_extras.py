@@ -1,7 +1,7 @@
 """What the collision and force nodes publish beside the loop: nearby objects and RViz markers."""
 import time
 
-from conftest import session_domain_id
+from domains import session_domain_id
 from loop_client import LoopClient
 import pytest
 from visualization_msgs.msg import Marker, MarkerArray

@@ -32,7 +32,7 @@ waypoints:
 @pytest.fixture(scope='module')
 def pressing_loop(tmp_path_factory):
     """The full loop, the wand pressing on the cuboid; yields (loop, client, stats file)."""
-    from conftest import session_domain_id
+    from domains import session_domain_id
     folder = tmp_path_factory.mktemp('fail_safe')
     script = folder / 'press.yaml'
     script.write_text(PRESSING)

@@ -3,7 +3,7 @@ import os
 import signal
 import time
 
-from conftest import session_domain_id
+from domains import session_domain_id
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 import numpy as np

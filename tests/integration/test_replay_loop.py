@@ -1,7 +1,7 @@
 """The driver replays a recorded trajectory open loop, and the collision node answers it."""
 import time
 
-from conftest import session_domain_id
+from domains import session_domain_id
 from loop_client import LoopClient
 import numpy as np
 

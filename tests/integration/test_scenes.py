@@ -3,7 +3,7 @@
 Expected forces are worked here from the cuboid's geometry (top face at z = -0.025 m), not by the
 toolkit's code.
 """
-from conftest import session_domain_id
+from domains import session_domain_id
 from loop_client import LoopClient, press
 import pytest
 

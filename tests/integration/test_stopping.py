@@ -12,7 +12,7 @@ import signal
 import subprocess
 import time
 
-from conftest import session_domain_id
+from domains import session_domain_id
 from loop_client import LoopClient
 import pytest
 import yaml

@@ -22,8 +22,8 @@ from ament_index_python.packages import get_package_share_directory
 import yaml
 
 from haptic_bringup.discovery import GraphWatcher
-from haptic_bringup.processes import (clean_stale_shm, start_child, stop_children,
-                                      wait_any_exit)
+from haptic_bringup.processes import (clean_stale_shm, shm_segments, start_child,
+                                      stop_children, wait_any_exit)
 
 __all__ = ['LoopConfig', 'Loop', 'main', 'loop_environment', 'NODES']
 
@@ -136,6 +136,7 @@ class Loop:
         self.run_dir = pathlib.Path(config.run_dir).resolve() / f'{stamp}-{os.getpid()}'
         self.children = []
         self.startup_time = None
+        self._segments_before = shm_segments()
 
     def __enter__(self) -> 'Loop':
         self.start()
@@ -218,7 +219,7 @@ class Loop:
             time.sleep(RECORDER_DRAIN)
             codes.update(stop_children(recorder, gently=gently))
         self.children = []
-        clean_stale_shm()
+        clean_stale_shm(domains=[self.config.domain_id], existing=self._segments_before)
         return codes
 
 

@@ -4,7 +4,7 @@ Each node runs in its own session, so a Ctrl-C in the terminal reaches only the 
 then stops the nodes in a chosen order (the recorder last, so it loses nothing). A child also
 receives SIGTERM if the launcher itself dies (``PR_SET_PDEATHSIG``), so even a killed launcher
 leaves no orphans. Fast DDS leaves shared-memory segments behind a SIGKILLed process; those no
-live process holds are removed at the end, as ``fastdds shm clean`` does.
+live process holds, among those the launcher's own processes made, are removed at the end.
 """
 import ctypes
 import fcntl
@@ -13,13 +13,15 @@ import pathlib
 import signal
 import subprocess
 import time
-from typing import Optional
+from typing import Iterable, Optional
 
-__all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'wait_any_exit']
+__all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'shm_segments',
+           'wait_any_exit']
 
 PR_SET_PDEATHSIG = 1
 SHM_DIR = pathlib.Path('/dev/shm')
-UNLOCKED_SEGMENT_AGE = 1.0  # [s] a segment without a lock file this old has no owner
+CREATION_GRACE = 2.0  # [s] a segment this young may still be being locked by its creator
+PORT_BASE, DOMAIN_GAIN = 7400, 250  # Fast DDS (RTPS) well-known port mapping
 
 
 class Child:
@@ -82,30 +84,49 @@ def stop_children(children: list, *, timeout: float = 5.0, gently: bool = True) 
     return codes
 
 
-def clean_stale_shm(directory: pathlib.Path = SHM_DIR) -> list:
-    """Remove Fast DDS segments no live process holds; return their names.
+def shm_segments(directory: pathlib.Path = SHM_DIR) -> set:
+    """Names of the Fast DDS segments now in ``directory`` (a snapshot for ``clean_stale_shm``)."""
+    return {path.name for path in directory.glob('fastrtps_*') if not path.name.endswith('_el')}
 
-    A segment is held through its ``_el`` lock file: one nobody has locked is stale, and so is a
-    segment left without a lock file at all (once older than a creator needs to make one).
+
+def clean_stale_shm(directory: pathlib.Path = SHM_DIR, *, domains: Iterable[int],
+                    existing: set) -> list:
+    """Remove Fast DDS segments our own processes left behind; return their names.
+
+    A segment is ours when it was not in the ``existing`` snapshot (taken before our processes
+    started) and, for a port segment, when its port belongs to one of our ``domains``. Of those,
+    a segment is stale when no live process holds its ``_el`` lock file; one younger than
+    ``CREATION_GRACE`` is left alone, as its creator may not have locked it yet. Segments of
+    other users of this machine are never touched, stale or not.
     """
+    domains = set(domains)
     removed = []
-    for lock in sorted(directory.glob('fastrtps_*_el')):
-        try:
-            with lock.open('rb') as handle:
-                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except (BlockingIOError, FileNotFoundError):
-            continue  # a live participant holds it, or it is already gone
-        removed.append(_remove_segment(directory, lock.name[:-len('_el')]))
     now = time.time()
-    for segment in sorted(directory.glob('fastrtps_*')):
-        if segment.name.endswith('_el') or (directory / f'{segment.name}_el').exists():
+    for name in sorted(shm_segments(directory) - set(existing)):
+        port = _port(name)
+        if port is not None and _domain_of_port(port) not in domains:
             continue
         try:
-            if now - segment.stat().st_mtime > UNLOCKED_SEGMENT_AGE:
-                removed.append(_remove_segment(directory, segment.name))
+            if now - (directory / name).stat().st_mtime < CREATION_GRACE:
+                continue
+            with (directory / f'{name}_el').open('rb') as handle:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            continue  # a live participant holds it
         except FileNotFoundError:
-            pass
+            pass  # no lock file: nobody can hold it
+        removed.append(_remove_segment(directory, name))
     return removed
+
+
+def _port(segment: str) -> Optional[int]:
+    suffix = segment[len('fastrtps_port'):]
+    return int(suffix) if segment.startswith('fastrtps_port') and suffix.isdigit() else None
+
+
+def _domain_of_port(port: int) -> int:
+    """Fast DDS's default port mapping: 7400 + 250 x domain + offsets below 250."""
+    return (port - PORT_BASE) // DOMAIN_GAIN
 
 
 def _remove_segment(directory: pathlib.Path, segment: str) -> str:
