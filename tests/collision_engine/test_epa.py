@@ -21,10 +21,12 @@ def penetration(shape: ConvexMesh, point: np.ndarray):
     kind, floats, ints = pack_convex(shape)
     W = np.zeros(12)
     direction = point - shape.vertices.mean(axis=0)
-    _, contact, count, *_ = gjk(kind, floats, 0, ints, 0, *point, *direction, TOL, TOL, 100, W)
+    size = shape.bounding_sphere()[1]
+    _, contact, count, *_, inv = gjk(kind, floats, 0, ints, 0, *point, *direction, size, TOL,
+                                     TOL, 100, W)
     assert contact
     status, depth, bound, x, y, z, nx, ny, nz, _ = epa(kind, floats, 0, ints, 0, tuple(point),
-                                                       W, count, TOL, TOL, 128)
+                                                       W, count, inv, TOL, TOL, 128)
     assert depth <= bound + 1e-15
     return status, depth, np.array([x, y, z]), np.array([nx, ny, nz])
 

@@ -34,6 +34,7 @@ from collision_engine._jit import jit
 from collision_engine.epa import epa
 from collision_engine.gjk import (gjk, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
                                   STATUS_NOT_CONVERGED, STATUS_OK)
+from collision_engine.norms import norm3, unit3
 from collision_engine.support import (CAPSULE, CONVEX_MESH, CYLINDER, interior, pack_convex,
                                       TRIANGLE_MESH)
 
@@ -102,13 +103,13 @@ def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
 
 
 @jit
-def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy, gz,
+def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, radius, gx, gy, gz,
                      rel_tol, abs_tol, max_iter, max_epa_iter, W):
     """Signed distance to a convex shape: GJK outside, exact interior or EPA inside.
 
-    (cx, cy, cz) is the shape's centre, (gx, gy, gz) a first search direction (zero: from the
-    shape's core toward q). Returns (status, distance, lower bound, x, y, z, nx, ny, nz,
-    iterations), local frame.
+    (cx, cy, cz) and ``radius`` are the shape's bounding sphere, (gx, gy, gz) a first search
+    direction (zero: from the shape's core toward q). Returns (status, distance, lower bound,
+    x, y, z, nx, ny, nz, iterations), local frame.
     """
     s, x, y, z, nx, ny, nz = 0.0, qx, qy, qz, 1.0, 0.0, 0.0
     if kind != CONVEX_MESH:
@@ -119,17 +120,19 @@ def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy,
         gx, gy, gz = qx - cx, qy - cy, qz - cz
         if kind == CYLINDER or kind == CAPSULE:
             gz = qz - min(max(qz, -floats[fo + 1]), floats[fo + 1])
-    status, contact, count, vx, vy, vz, lower, iterations = gjk(
-        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, rel_tol, abs_tol, max_iter, W)
+    status, contact, count, vx, vy, vz, lower, iterations, inv = gjk(
+        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, radius, rel_tol, abs_tol, max_iter,
+        W)
     if not contact:
-        distance = math.sqrt(vx * vx + vy * vy + vz * vz)
-        return (status, distance, lower, qx + vx, qy + vy, qz + vz,
-                -vx / distance, -vy / distance, -vz / distance, iterations)
+        ux, uy, uz = unit3(vx, vy, vz)
+        return (status, norm3(vx, vy, vz), lower, qx + vx, qy + vy, qz + vz, -ux, -uy, -uz,
+                iterations)
     if kind != CONVEX_MESH:
         # Within rounding of a primitive's surface: its exact interior formula holds there.
         return STATUS_OK, s, s, x, y, z, nx, ny, nz, iterations
     status, depth, bound, x, y, z, nx, ny, nz, more = epa(
-        kind, floats, fo, ints, io, (qx, qy, qz), W, count, rel_tol, abs_tol, max_epa_iter)
+        kind, floats, fo, ints, io, (qx, qy, qz), W, count, inv, rel_tol, abs_tol,
+        max_epa_iter)
     return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
 
 
@@ -157,7 +160,7 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2
         lz = floats[r + 2] * gx + floats[r + 5] * gy + floats[r + 8] * gz
         status, distance, lower, x, y, z, nx, ny, nz, iterations = _convex_distance(
             kind, floats, fo, ints, io, qx, qy, qz,
-            floats[r + 12], floats[r + 13], floats[r + 14], lx, ly, lz,
+            floats[r + 12], floats[r + 13], floats[r + 14], floats[r + 18], lx, ly, lz,
             floats[1], floats[2], ints[1], ints[2], W)
     wx = floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9]
     wy = floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10]
@@ -205,8 +208,8 @@ def _nearest(floats, ints, out, row, px, py, pz, W, stack, stack_d2):
     unsure = np.inf
     for k in range(ints[0]):
         r = ints[_HEADER_INTS + _OBJECT_INTS * k + 1]
-        cx, cy, cz = px - floats[r + 15], py - floats[r + 16], pz - floats[r + 17]
-        if math.sqrt(cx * cx + cy * cy + cz * cz) - floats[r + 18] >= best:
+        reach = norm3(px - floats[r + 15], py - floats[r + 16], pz - floats[r + 17])
+        if reach - floats[r + 18] >= best:
             continue
         status, d, lower, ox, oy, oz, mx, my, mz, iterations, t = _object_distance(
             floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, stack, stack_d2)

@@ -20,18 +20,18 @@ triangles in tree-leaf order:
   first child (-1 for a leaf), first triangle, triangle count.
 """
 
-import math
-
 import numpy as np
 
 from collision_engine._jit import jit
 from collision_engine.gjk import nearest_on_triangle
+from collision_engine.norms import norm3, unit3
 from collision_engine.pseudonormals import pseudonormals
 
-__all__ = ['LEAF_SIZE', 'STACK_SIZE', 'build_tree', 'pack_triangle_mesh', 'mesh_distance']
+__all__ = ['FAR', 'LEAF_SIZE', 'STACK_SIZE', 'build_tree', 'pack_triangle_mesh', 'mesh_distance']
 
 LEAF_SIZE = 4
 STACK_SIZE = 128
+FAR = 2.0 ** 26  # mesh radii: beyond, a query is answered from a nearer point on its ray
 
 
 def build_tree(corners: np.ndarray, leaf_size: int = LEAF_SIZE):
@@ -133,6 +133,13 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     level plus one, and a median-split tree over t triangles has ceil(log2(t)) levels, so 128
     entries never fill.
 
+    A point farther than ``FAR`` mesh radii R from the mesh's centre is outside, and is searched
+    from the point moved toward the mesh to ``FAR`` radii on the same ray: far off, the rounding
+    of q - corner (eps |q|) would exceed the triangles and garble their features, and beyond
+    1e154 m the squares overflow. The nearest point found is farther from q than q's own nearest
+    point by at most R^2 / (2 FAR R) (second order in R / distance), under half an ulp of the
+    distance; the distance and the normal are then measured from q itself.
+
     Returns (distance, closest x, y, z, outward normal x, y, z, triangle in leaf order,
     original triangle index, triangles tested), m; the distance is negative inside.
     """
@@ -145,9 +152,51 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     boxes = vertex_normals + 3 * n_vert
     faces = io + 4
     face_edges = faces + 3 * n_tri
-    original = face_edges + 3 * n_tri
-    nodes = original + n_tri
+    nodes = face_edges + 3 * n_tri + n_tri
 
+    cx, cy, cz = (0.5 * (floats[boxes] + floats[boxes + 3]),
+                  0.5 * (floats[boxes + 1] + floats[boxes + 4]),
+                  0.5 * (floats[boxes + 2] + floats[boxes + 5]))
+    reach = max(abs(qx - cx), abs(qy - cy), abs(qz - cz))
+    sx, sy, sz = qx, qy, qz
+    if reach > FAR * scale:
+        pull = FAR * scale / reach
+        sx, sy, sz = cx + (qx - cx) * pull, cy + (qy - cy) * pull, cz + (qz - cz) * pull
+    best_d2, best_t, feature, which, vx, vy, vz, tested = _nearest_triangle(
+        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2)
+    original = face_edges + 3 * n_tri
+    if reach > FAR * scale:
+        x, y, z = sx + vx, sy + vy, sz + vz
+        nx, ny, nz = unit3(qx - x, qy - y, qz - z)
+        return (norm3(qx - x, qy - y, qz - z), x, y, z, nx, ny, nz, best_t,
+                ints[original + best_t], tested)
+
+    if feature == 3:
+        p = face_normals + 3 * best_t
+    elif feature == 2:
+        p = edge_normals + 3 * ints[face_edges + 3 * best_t + which]
+    else:
+        p = vertex_normals + 3 * ints[faces + 3 * best_t + which]
+    px, py, pz = floats[p], floats[p + 1], floats[p + 2]
+    distance = norm3(vx, vy, vz)
+    inside = vx * px + vy * py + vz * pz > 0.0
+    sign = -1.0 if inside else 1.0
+    nx, ny, nz = px, py, pz
+    if feature != 3 and distance > 1e-9 * scale:
+        ux, uy, uz = unit3(vx, vy, vz)
+        nx, ny, nz = -sign * ux, -sign * uy, -sign * uz
+    return (sign * distance, qx + vx, qy + vy, qz + vz, nx, ny, nz,
+            best_t, ints[original + best_t], tested)
+
+
+@jit
+def _nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
+                      stack_d2):
+    """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
+
+    Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
+    tested) with v from q to the nearest point and the feature as ``nearest_on_triangle``'s.
+    """
     best_d2 = np.inf
     best_t, feature, which = -1, 0, 0
     vx = vy = vz = 0.0
@@ -187,19 +236,4 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
             stack[top] = near
             stack_d2[top] = near_d2
             top += 1
-
-    if feature == 3:
-        p = face_normals + 3 * best_t
-    elif feature == 2:
-        p = edge_normals + 3 * ints[face_edges + 3 * best_t + which]
-    else:
-        p = vertex_normals + 3 * ints[faces + 3 * best_t + which]
-    px, py, pz = floats[p], floats[p + 1], floats[p + 2]
-    distance = math.sqrt(best_d2)
-    inside = vx * px + vy * py + vz * pz > 0.0
-    sign = -1.0 if inside else 1.0
-    nx, ny, nz = px, py, pz
-    if feature != 3 and distance > 1e-9 * scale:
-        nx, ny, nz = -sign * vx / distance, -sign * vy / distance, -sign * vz / distance
-    return (sign * distance, qx + vx, qy + vy, qz + vz, nx, ny, nz,
-            best_t, ints[original + best_t], tested)
+    return best_d2, best_t, feature, which, vx, vy, vz, tested
