@@ -9,11 +9,14 @@ Packed scene layout
 ``floats``: ``[tip radius, rel_tol, abs_tol, scratch offset]``, then per object a record of
 ``OBJECT_FLOATS`` values: rotation (9, row-major, local to world), translation (3),
 bounding-sphere centre in the local frame (3) and in the world frame (3), bounding-sphere radius
-(1); then the shapes' float blocks; then scratch space (GJK simplex, search stack).
+(1); then the shapes' float blocks; then scratch space: GJK's simplex (12), the search
+stack's box distances (s).
 ``ints``: ``[object count, GJK iteration cap, EPA iteration cap, scratch offset]``, then per
 object ``[kind, object float record offset, shape float offset, shape int offset, hint]``
 (``hint`` is the last nearest triangle of a mesh, rewritten by every query as a warm start),
-then the shapes' int blocks (layouts in ``support`` and ``bvh``), then the search stack.
+then the shapes' int blocks (layouts in ``support`` and ``bvh``), then scratch space: the
+search stack's length s, sized for the deepest mesh tree of the scene
+(``bvh.search_stack_size``), and its nodes (s).
 
 The scratch space lives in the packed arrays because allocating it costs as much as a
 primitive's query; so does the hint. Hence one packed scene must not serve two threads at once.
@@ -45,7 +48,6 @@ OUT_SIZE = 15
 OBJECT_FLOATS = 19
 _HEADER_FLOATS = 4
 _HEADER_INTS = 4
-_SCRATCH_FLOATS = 12 + bvh.STACK_SIZE
 _OBJECT_INTS = 5
 
 
@@ -76,10 +78,12 @@ def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, 
         int_blocks.append(shape_ints)
         float_at += len(shape_floats)
         int_at += len(shape_ints)
+    stack = max([bvh.search_stack_size(block) for (kind, *_), block in zip(table, int_blocks)
+                 if kind == TRIANGLE_MESH], default=1)
     floats = np.concatenate([[tip_radius, rel_tol, abs_tol, float_at], *records, *float_blocks,
-                             np.zeros(_SCRATCH_FLOATS)])
+                             np.zeros(12 + stack)])
     ints = np.concatenate([[n, max_iterations, max_epa_iterations, int_at], *table, *int_blocks,
-                           np.zeros(bvh.STACK_SIZE)])
+                           [stack], np.zeros(stack)])
     return floats.astype(np.float64), ints.astype(np.int64)
 
 
@@ -228,11 +232,11 @@ def _nearest(floats, ints, out, row, px, py, pz, W, stack, stack_d2):
 
 @jit
 def _scratch(floats, ints):
-    """View the scratch space: simplex (12,), search stack and its bounds."""
+    """View the scratch space: simplex (12,), search stack and its box distances (s,) each."""
     f = int(floats[3])
     i = ints[3]
-    return (floats[f:f + 12], ints[i:i + bvh.STACK_SIZE],
-            floats[f + 12:f + 12 + bvh.STACK_SIZE])
+    stack = ints[i]
+    return floats[f:f + 12], ints[i + 1:i + 1 + stack], floats[f + 12:f + 12 + stack]
 
 
 @jit
