@@ -159,7 +159,7 @@ def test_a_deep_tree_gets_a_search_stack_as_deep(hand, monkeypatch):
     depth = len(hand.faces) // LEAF_SIZE - (len(hand.faces) % LEAF_SIZE == 0)
     assert search_stack_size(ints) == depth + 1 > 2000
     scene = Scene([SceneObject('hand', hand, POSE)])
-    assert len(scene._ints) - scene._ints[3] - 1 == depth + 1  # the stack, after its length
+    assert scene._ints[scene._ints[3]] == depth + 1  # the stack's length, heading the scratch
     rng = np.random.default_rng(14)
     low, high = hand.vertices.min(axis=0), hand.vertices.max(axis=0)
     local = np.concatenate([

@@ -10,13 +10,13 @@ Packed scene layout
 ``OBJECT_FLOATS`` values: rotation (9, row-major, local to world), translation (3),
 bounding-sphere centre in the local frame (3) and in the world frame (3), bounding-sphere radius
 (1); then the shapes' float blocks; then scratch space: GJK's simplex (12), the search
-stack's box distances (s).
+stack's box distances (s), EPA's floats (``epa.scratch_size``).
 ``ints``: ``[object count, GJK iteration cap, EPA iteration cap, scratch offset]``, then per
 object ``[kind, object float record offset, shape float offset, shape int offset, hint]``
 (``hint`` is the last nearest triangle of a mesh, rewritten by every query as a warm start),
 then the shapes' int blocks (layouts in ``support`` and ``bvh``), then scratch space: the
 search stack's length s, sized for the deepest mesh tree of the scene
-(``bvh.search_stack_size``), and its nodes (s).
+(``bvh.search_stack_size``), its nodes (s), EPA's ints.
 
 The scratch space lives in the packed arrays because allocating it costs as much as a
 primitive's query; so does the hint. Hence one packed scene must not serve two threads at once.
@@ -34,7 +34,7 @@ import numpy as np
 
 from collision_engine import bvh
 from collision_engine._jit import jit
-from collision_engine.epa import epa
+from collision_engine.epa import epa, scratch_size
 from collision_engine.gjk import (gjk, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
                                   STATUS_NOT_CONVERGED, STATUS_OK)
 from collision_engine.norms import norm3, unit3
@@ -80,10 +80,11 @@ def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, 
         int_at += len(shape_ints)
     stack = max([bvh.search_stack_size(block) for (kind, *_), block in zip(table, int_blocks)
                  if kind == TRIANGLE_MESH], default=1)
+    epa_floats, epa_ints = scratch_size(max_epa_iterations)
     floats = np.concatenate([[tip_radius, rel_tol, abs_tol, float_at], *records, *float_blocks,
-                             np.zeros(12 + stack)])
+                             np.zeros(12 + stack + epa_floats)])
     ints = np.concatenate([[n, max_iterations, max_epa_iterations, int_at], *table, *int_blocks,
-                           [stack], np.zeros(stack)])
+                           [stack], np.zeros(stack + epa_ints)])
     return floats.astype(np.float64), ints.astype(np.int64)
 
 
@@ -134,9 +135,10 @@ def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, radius,
     if kind != CONVEX_MESH:
         # Within rounding of a primitive's surface: its exact interior formula holds there.
         return STATUS_OK, s, s, x, y, z, nx, ny, nz, iterations
+    epa_floats, epa_ints = _epa_scratch(floats, ints)
     status, depth, bound, x, y, z, nx, ny, nz, more = epa(
         kind, floats, fo, ints, io, (qx, qy, qz), W, count, inv, rel_tol, abs_tol,
-        max_epa_iter)
+        max_epa_iter, epa_floats, epa_ints)
     return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
 
 
@@ -237,6 +239,17 @@ def _scratch(floats, ints):
     i = ints[3]
     stack = ints[i]
     return floats[f:f + 12], ints[i + 1:i + 1 + stack], floats[f + 12:f + 12 + stack]
+
+
+@jit
+def _epa_scratch(floats, ints):
+    """View EPA's scratch space, for the scene's EPA iteration cap: (floats, ints)."""
+    f = int(floats[3])
+    i = ints[3]
+    stack = ints[i]
+    n_floats, n_ints = scratch_size(ints[2])
+    return (floats[f + 12 + stack:f + 12 + stack + n_floats],
+            ints[i + 1 + stack:i + 1 + stack + n_ints])
 
 
 @jit

@@ -19,7 +19,7 @@ from collision_engine.gjk import STATUS_NOT_CONVERGED, STATUS_OK
 from collision_engine.norms import norm3, unit3
 from collision_engine.support import support
 
-__all__ = ['epa']
+__all__ = ['epa', 'scratch_size']
 
 _EPS = float(np.finfo(np.float64).eps)
 _FLOOR = 16.0 * _EPS
@@ -116,7 +116,20 @@ def _tetrahedron(V, F, N, D):
 
 
 @jit
-def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter):
+def scratch_size(max_iter):
+    """Scratch lengths ``epa`` needs for ``max_iter`` iterations: (floats, ints).
+
+    With m = max_iter + 4 vertices at most (the tetrahedron, then one a step): floats hold the
+    vertices (m, 3), face normals (2m, 3) and face offsets (2m,); ints hold the faces (2m, 3),
+    their alive flags (2m,) and the horizon's edge ends (6m,) twice.
+    """
+    m = max_iter + 4
+    return 11 * m, 20 * m
+
+
+@jit
+def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter,
+        scratch_floats, scratch_ints):
     """Penetration of the point q inside a convex shape, from GJK's contact simplex.
 
     Parameters
@@ -127,6 +140,9 @@ def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter
         array), which contains the origin.
     inv : float
         GJK's power-of-two unit (``gjk.power_of_two_inverse``): EPA works in it too.
+    scratch_floats, scratch_ints : float64 and int64 arrays
+        Preallocated work space, at least ``scratch_size(max_iter)`` long: allocating it costs
+        more than a short EPA run.
 
     Returns
     -------
@@ -135,11 +151,14 @@ def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter
     converged), and the closest point is q moved by ``depth`` along the normal.
     """
     max_vertices = max_iter + 4
-    V = np.empty((max_vertices, 3))
-    F = np.empty((2 * max_vertices, 3), dtype=np.int64)
-    N = np.empty((2 * max_vertices, 3))
-    D = np.empty(2 * max_vertices)
-    alive = np.zeros(2 * max_vertices, dtype=np.bool_)
+    m = max_vertices
+    V = scratch_floats[:3 * m].reshape((m, 3))
+    N = scratch_floats[3 * m:9 * m].reshape((2 * m, 3))
+    D = scratch_floats[9 * m:11 * m]
+    F = scratch_ints[:6 * m].reshape((2 * m, 3))
+    alive = scratch_ints[6 * m:8 * m]  # only faces below n_faces, each set when made, are read
+    edge_a = scratch_ints[8 * m:14 * m]
+    edge_b = scratch_ints[14 * m:20 * m]
     V[:count] = W[:3 * count].reshape((count, 3))
     abs_tol = abs_tol * inv
     scale = 0.0
@@ -151,17 +170,15 @@ def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter
     count = _blow_up(kind, floats, fo, ints, io, q, inv, V, count, 1e-9 * scale)
     if count < 4 or not _tetrahedron(V, F, N, D):
         return STATUS_NOT_CONVERGED, 0.0, np.inf, q[0], q[1], q[2], 1.0, 0.0, 0.0, 0
-    alive[:4] = True
+    alive[:4] = 1
     n_vertices, n_faces = 4, 4
-    edge_a = np.empty(6 * max_vertices, dtype=np.int64)
-    edge_b = np.empty(6 * max_vertices, dtype=np.int64)
     status = STATUS_NOT_CONVERGED
     bound = np.inf
     iteration = 0
     while True:
         best = -1
         for f in range(n_faces):
-            if alive[f] and (best < 0 or D[f] < D[best]):
+            if alive[f] == 1 and (best < 0 or D[f] < D[best]):
                 best = f
         nx, ny, nz, depth = N[best, 0], N[best, 1], N[best, 2], D[best]
         if iteration >= max_iter or n_vertices >= max_vertices:
@@ -179,12 +196,12 @@ def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter
         # Faces the new point sees go; the edges they do not share form the horizon.
         n_edges = 0
         for f in range(n_faces):
-            if not alive[f]:
+            if alive[f] == 0:
                 continue
             a = F[f, 0]
             if (N[f, 0] * (wx - V[a, 0]) + N[f, 1] * (wy - V[a, 1])
                     + N[f, 2] * (wz - V[a, 2])) > _FLOOR * scale:
-                alive[f] = False
+                alive[f] = 0
                 for e in range(3):
                     edge_a[n_edges] = F[f, e]
                     edge_b[n_edges] = F[f, (e + 1) % 3]
@@ -201,7 +218,7 @@ def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter
             if n_faces >= len(D) or not _set_face(V, F, N, D, n_faces, edge_a[e], edge_b[e], w):
                 degenerate = True
                 break
-            alive[n_faces] = True
+            alive[n_faces] = 1
             n_faces += 1
         if degenerate:
             break
