@@ -3,11 +3,13 @@
     .venv/bin/python bench/bench_collision.py [--objects cuboid cylinder cylinder_stl hand]
                                               [--methods ours ours-kernel python-fcl coal]
                                               [--random 2000] [--near 2000] [--tapping 10]
+                                              [--inside 2000]
 
 One call per point, from a Python loop, as a haptic loop makes them, after a warm-up. For each
 object (the paper's, centred at (0, 0, -0.075) m) and point set (random in twice the bounding
-box, within +-2 mm of the surface half inside, and a 1 kHz tapping trajectory that goes 1 mm
-deep at 20 sites), every method answers the same points: printed are the median and p99 time of
+box, within +-2 mm of the surface half inside, a 1 kHz tapping trajectory that goes 1 mm deep
+at 20 sites, and uniform inside the object: the penetration depth, by EPA on a convex mesh),
+every method answers the same points: printed are the median and p99 time of
 a call (the timer's own cost is printed apart: it is included in every figure) and the largest
 error against exact ground truth (``tests/ground_truth.py``: analytic for the primitives, brute
 force with a winding-number sign for meshes), with the number of sign errors.
@@ -22,6 +24,7 @@ rows as dicts.
 """
 
 import argparse
+import math
 from pathlib import Path
 import sys
 import time
@@ -31,8 +34,12 @@ import numpy as np
 
 import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
 from collision_engine import _kernels
+from collision_engine._jit import jit
+from collision_engine.epa import epa, scratch_size as epa_scratch_size
+from collision_engine.gjk import gjk
 from collision_engine.scene import load_scene, Scene, SceneObject
 from collision_engine.shapes import Box, ConvexMesh, Cylinder, TriangleMesh
+from collision_engine.support import pack_convex
 
 sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
 import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
@@ -100,8 +107,20 @@ def _tapping(truth, near_points, seconds, rng):
     return points, truth(points)
 
 
-def point_sets(scene_object, *, random: int, near: int, tapping: float, seed: int = 0) -> dict:
-    """Make the three point sets of one object, world frame, with exact signed distances.
+def _inside(scene_object, truth, low, high, count, rng):
+    """Uniform points inside the object, by rejection from its local bounding box."""
+    points = np.empty((0, 3))
+    while len(points) < count:
+        candidates = scene_object.pose.to_world(rng.uniform(low, high, (2 * count, 3)))
+        points = np.vstack((points, candidates[truth(candidates) < 0.0]))
+    return points[:count]
+
+
+def point_sets(scene_object, *, random: int, near: int, tapping: float, inside: int = 0,
+               seed: int = 0) -> dict:
+    """Make the point sets of one object, world frame, with exact signed distances.
+
+    ``inside`` points (none by default) make a fourth set, ``inside``.
 
     Returns
     -------
@@ -118,9 +137,13 @@ def point_sets(scene_object, *, random: int, near: int, tapping: float, seed: in
     random_points = scene_object.pose.to_world(mid + rng.uniform(-2 * half, 2 * half,
                                                                  (random, 3)))
     near_points, near_truth = _near_surface(scene_object, truth, near, rng)
-    return {'random': (random_points, truth(random_points)),
+    sets = {'random': (random_points, truth(random_points)),
             'near': (near_points, near_truth),
             'tapping': _tapping(truth, near_points, tapping, rng)}
+    if inside:
+        inside_points = _inside(scene_object, truth, low, high, inside, rng)
+        sets['inside'] = (inside_points, truth(inside_points))
+    return sets
 
 
 def _ours(scene_object):
@@ -230,7 +253,7 @@ def timer_overhead(count: int = 20000) -> float:
 
 
 def run(objects=tuple(OBJECTS), *, random: int = 2000, near: int = 2000, tapping: float = 10.0,
-        methods=tuple(METHODS), seed: int = 0) -> list[dict]:
+        inside: int = 2000, methods=tuple(METHODS), seed: int = 0) -> list[dict]:
     """Benchmark every method on every object and point set.
 
     Returns
@@ -242,7 +265,8 @@ def run(objects=tuple(OBJECTS), *, random: int = 2000, near: int = 2000, tapping
     rows = []
     for name in objects:
         scene_object = load_scene(ground_truth.scene_path(OBJECTS[name])).objects[0]
-        sets = point_sets(scene_object, random=random, near=near, tapping=tapping, seed=seed)
+        sets = point_sets(scene_object, random=random, near=near, tapping=tapping,
+                          inside=inside, seed=seed)
         for method in methods:
             try:
                 function, convert = METHODS[method](scene_object)
@@ -262,15 +286,72 @@ def run(objects=tuple(OBJECTS), *, random: int = 2000, near: int = 2000, tapping
     return rows
 
 
-def format_rows(rows: list[dict]) -> str:
-    """Format the rows as a fixed-width table."""
+def format_rows(rows: list[dict], peer: str = 'coal') -> str:
+    """Format the rows as a fixed-width table, each median also as a ratio to ``peer``'s."""
+    peers = {(r['object'], r['points']): r['median_us'] for r in rows if r['method'] == peer}
     lines = [f'{"object":13s} {"points":8s} {"method":11s} {"n":>6s} {"median us":>10s} '
-             f'{"p99 us":>8s} {"max error m":>12s} {"sign err":>8s}']
+             f'{"/ " + peer:>8s} {"p99 us":>8s} {"max error m":>12s} {"sign err":>8s}']
     for r in rows:
+        ratio = r['median_us'] / peers.get((r['object'], r['points']), math.nan)
         lines.append(f'{r["object"]:13s} {r["points"]:8s} {r["method"]:11s} {r["n"]:6d} '
-                     f'{r["median_us"]:10.2f} {r["p99_us"]:8.2f} {r["max_error_m"]:12.2e} '
-                     f'{r["sign_errors"]:8d}')
+                     f'{r["median_us"]:10.2f} {ratio:8.2f} {r["p99_us"]:8.2f} '
+                     f'{r["max_error_m"]:12.2e} {r["sign_errors"]:8d}')
     return '\n'.join(lines)
+
+
+@jit
+def _epa_batch(kind, floats, ints, points, simplices, counts, invs, max_iter, scratch_floats,
+               scratch_ints, allocate):
+    """Run EPA on every prepared contact; ``allocate`` adds the 7 arrays it once allocated."""
+    total = 0.0
+    m = max_iter + 4
+    for k in range(len(points)):
+        if allocate:  # the sizes and kinds of the arrays EPA allocated per call until 2026-11
+            arrays = (np.empty((m, 3)), np.empty((2 * m, 3)), np.empty(2 * m))
+            edges = (np.empty(6 * m, dtype=np.int64), np.empty(6 * m, dtype=np.int64))
+            flags = np.zeros(2 * m, dtype=np.bool_)
+            faces = np.empty((2 * m, 3), dtype=np.int64)
+            total += arrays[0][0, 0] * 0.0 + flags[0] + (faces[0, 0] + edges[0][0]) * 0
+        q = (points[k, 0], points[k, 1], points[k, 2])
+        total += epa(kind, floats, 0, ints, 0, q, simplices[k], counts[k], invs[k], 1e-12,
+                     1e-12, max_iter, scratch_floats, scratch_ints)[1]
+    return total
+
+
+def epa_scratch_figures(name: str = 'cylinder_stl', count: int = 2000, rounds: int = 7,
+                        seed: int = 0) -> dict:
+    """Time EPA alone per call, with its preallocated scratch and with the 7 per-call arrays.
+
+    The same contacts (points inside the object, GJK run beforehand) in one compiled batch per
+    timing, the two variants alternated ``rounds`` times; returns the medians in us a call.
+    """
+    scene_object = load_scene(ground_truth.scene_path(OBJECTS[name])).objects[0]
+    shape = scene_object.shape
+    sets = point_sets(scene_object, random=1, near=TAP_SITES, tapping=0.02, inside=count,
+                      seed=seed)
+    points = scene_object.pose.to_local(sets['inside'][0])
+    kind, floats, ints = pack_convex(shape)
+    radius = shape.bounding_sphere()[1]
+    simplices, counts, invs = np.zeros((count, 12)), np.zeros(count, np.int64), np.ones(count)
+    for k, point in enumerate(points):
+        direction = point - shape.vertices.mean(axis=0)
+        contact = gjk(kind, floats, 0, ints, 0, *point, *direction, radius, 1e-12, 1e-12, 100,
+                      simplices[k])
+        counts[k], invs[k] = contact[2], contact[8]
+    max_iter = 128
+    scratch = tuple(np.zeros(n, dtype) for n, dtype in zip(epa_scratch_size(max_iter),
+                                                           (np.float64, np.int64)))
+    times = {False: [], True: []}
+    for _ in range(rounds):
+        for allocate in (False, True):
+            arguments = (kind, floats, ints, points, simplices.copy(), counts, invs, max_iter,
+                         *scratch, allocate)
+            _epa_batch(*arguments)  # compiled, and warm
+            start = time.perf_counter_ns()
+            _epa_batch(*arguments)
+            times[allocate].append((time.perf_counter_ns() - start) / 1e3 / count)
+    return {'preallocated_us': float(np.median(times[False])),
+            'allocating_us': float(np.median(times[True]))}
 
 
 def main(argv=None) -> None:
@@ -281,16 +362,23 @@ def main(argv=None) -> None:
     parser.add_argument('--random', type=int, default=2000, help='random points per object')
     parser.add_argument('--near', type=int, default=2000, help='near-surface points per object')
     parser.add_argument('--tapping', type=float, default=10.0, help='tapping seconds at 1 kHz')
+    parser.add_argument('--inside', type=int, default=2000, help='points inside each object')
     parser.add_argument('--seed', type=int, default=0)
     args = parser.parse_args(argv)
     print('machine:', machine.line('numpy', 'numba', 'scipy', 'python-fcl', 'coal'))
     print(f'timer overhead (empty call, included below): {timer_overhead():.2f} us median')
     started = time.perf_counter()
     rows = run(args.objects, random=args.random, near=args.near, tapping=args.tapping,
-               methods=args.methods, seed=args.seed)
+               inside=args.inside, methods=args.methods, seed=args.seed)
     print(format_rows(rows))
     print(f'({time.perf_counter() - started:.0f} s; sign errors count points farther than '
           '1e-9 m from the surface; a BVH in FCL or coal is unsigned)')
+    if args.inside and 'cylinder_stl' in args.objects:
+        epa_times = epa_scratch_figures(count=args.inside, seed=args.seed)
+        print(f'EPA alone inside the convex cylinder_stl, per call (compiled batch, median of 7):'
+              f' preallocated scratch {epa_times["preallocated_us"]:.2f} us, allocating its 7 '
+              f'arrays per call as before {epa_times["allocating_us"]:.2f} us '
+              f'(ratio {epa_times["preallocated_us"] / epa_times["allocating_us"]:.2f})')
 
 
 if __name__ == '__main__':

@@ -6,6 +6,7 @@ sign rule is the engine's: negative inside, zero on the surface, positive outsid
 """
 
 from collections.abc import Iterator
+from decimal import Decimal, localcontext
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,8 @@ __all__ = [
     'box_signed_distance',
     'capsule_signed_distance',
     'cylinder_signed_distance',
+    'exact_norm',
+    'exact_unit',
     'hand_mesh_path',
     'mesh_signed_distance',
     'sample_near_surface',
@@ -53,13 +56,44 @@ def _positive(name: str, value: float) -> float:
     return value
 
 
+def _length(vectors: np.ndarray) -> np.ndarray:
+    """Euclidean norms over the last axis by C ``hypot``, exact at any magnitude.
+
+    ``np.linalg.norm`` squares the components, which underflow below 1e-154 and overflow above
+    1e154; ``hypot`` scales, so the truths hold for subnormal and 1e300-sized offsets too.
+    """
+    vectors = np.asarray(vectors, dtype=np.float64)
+    if vectors.shape[-1] == 2:
+        return np.hypot(vectors[..., 0], vectors[..., 1])
+    return np.hypot(np.hypot(vectors[..., 0], vectors[..., 1]), vectors[..., 2])
+
+
+def exact_norm(vector) -> Decimal:
+    """Euclidean norm of a float vector in 60-digit decimal arithmetic.
+
+    Decimal exponents reach far beyond float64's, so no square underflows or overflows: the
+    reference for norms of subnormal and 1e300-sized vectors.
+    """
+    with localcontext() as context:
+        context.prec = 60
+        return sum(Decimal(float(c)) ** 2 for c in vector).sqrt()
+
+
+def exact_unit(vector) -> np.ndarray:
+    """Return the unit vector of a non-zero float vector, in 60-digit decimal, as float64."""
+    with localcontext() as context:
+        context.prec = 60
+        norm = exact_norm(vector)
+        return np.array([float(Decimal(float(c)) / norm) for c in vector])
+
+
 def _rounded_box(excess: np.ndarray) -> np.ndarray:
     """Signed distance from per-axis excesses over the faces (last axis), exact for boxes.
 
     Outside, the distance is the norm of the positive excesses; inside, it is the least negative
     excess (the nearest face).
     """
-    outside = np.linalg.norm(np.maximum(excess, 0.0), axis=-1)
+    outside = _length(np.maximum(excess, 0.0))
     inside = np.minimum(np.max(excess, axis=-1), 0.0)
     return outside + inside
 
@@ -99,7 +133,7 @@ def sphere_signed_distance(points: np.ndarray, radius: float) -> np.ndarray:
     distance : (...) float, m, negative inside
     """
     points = _as_points(points)
-    return np.linalg.norm(points, axis=-1) - _positive('radius', radius)
+    return _length(points) - _positive('radius', radius)
 
 
 def cylinder_signed_distance(points: np.ndarray, radius: float, height: float) -> np.ndarray:
@@ -141,7 +175,7 @@ def capsule_signed_distance(points: np.ndarray, radius: float, length: float) ->
     half = 0.5 * _positive('length', length)
     on_segment = np.zeros_like(points)
     on_segment[..., 2] = np.clip(points[..., 2], -half, half)
-    return np.linalg.norm(points - on_segment, axis=-1) - _positive('radius', radius)
+    return _length(points - on_segment) - _positive('radius', radius)
 
 
 def _triangle_corners(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

@@ -8,10 +8,12 @@ from ground_truth import hand_mesh_path, mesh_signed_distance, sample_near_surfa
 import numpy as np
 import pytest
 
-from collision_engine.bvh import build_tree, LEAF_SIZE, STACK_SIZE
+from collision_engine import bvh
+from collision_engine.bvh import build_tree, LEAF_SIZE, search_stack_size, tree_depth
 from collision_engine.distance import distance
 from collision_engine.gjk import STATUS_OK
 from collision_engine.mesh_io import load_mesh
+from collision_engine.scene import Scene, SceneObject
 from collision_engine.shapes import TriangleMesh
 from collision_engine.transforms import Pose
 
@@ -110,9 +112,60 @@ def test_tree_covers_every_triangle_once_in_nested_boxes(hand):
             for c in (child, child + 1):
                 assert np.all(boxes[c, :3] >= box[:3]) and np.all(boxes[c, 3:] <= box[3:])
     assert np.all(covered == 1)
-    # Median splits keep it balanced, so the kernel's fixed search stack cannot overflow.
-    depth, level = 0, [0]
+    assert tree_depth(nodes) == levels(nodes) - 1
+
+
+def levels(nodes):
+    """Levels of a tree, counted breadth first (the root alone is one level)."""
+    count, level = 0, [0]
     while level:
-        depth += 1
+        count += 1
         level = [c for n in level if nodes[n, 0] >= 0 for c in (nodes[n, 0], nodes[n, 0] + 1)]
-    assert depth <= np.ceil(np.log2(len(hand.faces))) + 1 < STACK_SIZE
+    return count
+
+
+@pytest.mark.parametrize('count', [1, 4, 5, 1000, 4097])
+def test_median_splits_stay_balanced_even_on_a_degenerate_mesh(count):
+    # Every triangle the same, so every centroid coincides: the split is by count alone.
+    corners = np.tile(np.eye(3), (count, 1, 1))
+    _, _, nodes = build_tree(corners)
+    assert tree_depth(nodes) == levels(nodes) - 1 == np.ceil(np.log2(np.ceil(count / LEAF_SIZE)))
+
+
+def peeling_tree(corners, leaf_size=LEAF_SIZE):
+    """The most unbalanced tree: each node splits one leaf off and keeps the rest (along x)."""
+    order = np.argsort(corners.mean(axis=1)[:, 0], kind='stable')
+    lows, highs = corners.min(axis=1), corners.max(axis=1)
+
+    def box(members):
+        return np.concatenate((lows[members].min(axis=0), highs[members].max(axis=0)))
+
+    boxes, nodes, start = [box(order)], [None], 0
+    while len(order) - start > leaf_size:
+        child = len(nodes)
+        nodes[-1] = (child, start, len(order) - start)
+        boxes += [box(order[start:start + leaf_size]), box(order[start + leaf_size:])]
+        nodes += [(-1, start, leaf_size), None]
+        start += leaf_size
+    nodes[-1] = (-1, start, len(order) - start)
+    return order, np.array(boxes), np.array(nodes, dtype=np.int64)
+
+
+def test_a_deep_tree_gets_a_search_stack_as_deep(hand, monkeypatch):
+    # The search stack used to be 128 entries, unchecked: a tree deeper than that (possible with
+    # any split but a median one) would have written past it. It is sized from the depth now.
+    monkeypatch.setattr(bvh, 'build_tree', peeling_tree)
+    floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces)
+    depth = len(hand.faces) // LEAF_SIZE - (len(hand.faces) % LEAF_SIZE == 0)
+    assert search_stack_size(ints) == depth + 1 > 2000
+    scene = Scene([SceneObject('hand', hand, POSE)])
+    assert scene._ints[scene._ints[3]] == depth + 1  # the stack's length, heading the scratch
+    rng = np.random.default_rng(14)
+    low, high = hand.vertices.min(axis=0), hand.vertices.max(axis=0)
+    local = np.concatenate([
+        rng.uniform(2 * low - high, 2 * high - low, size=(150, 3)),
+        sample_near_surface(hand.vertices, hand.faces, 150, 0.002, rng)[0]])
+    truth, _ = mesh_signed_distance(local, hand.vertices, hand.faces)
+    found = scene.query_many(POSE.to_world(local))
+    np.testing.assert_allclose(found.distance, truth, rtol=0, atol=1e-14)
+    assert np.all(found.status == STATUS_OK)

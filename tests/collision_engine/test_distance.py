@@ -5,9 +5,13 @@ frame, with the world-to-local transform done here by scipy's ``Rotation``. The 
 1e-6 m; the engine is exact to rounding, so these tests hold it to 1e-12 of the object's size.
 """
 
+from fuzzing import examples
 from ground_truth import (box_signed_distance, capsule_signed_distance,
-                          cylinder_signed_distance, mesh_signed_distance, outward_hull,
-                          sphere_signed_distance)
+                          cylinder_signed_distance, exact_norm, mesh_signed_distance,
+                          outward_hull, sphere_signed_distance)
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -186,6 +190,57 @@ def test_tiny_and_huge_objects_near_and_far(name, scale, distance_from_origin):
     atol = max(request.abs_tol, request.rel_tol * 2 * scale, 1e-12 * scale,
                4 * np.spacing(distance_from_origin + scale))
     np.testing.assert_allclose(found, expected, rtol=0, atol=atol)
+
+
+EXACT_REQUEST = DistanceRequest(abs_tol=0.0)  # an absolute tolerance has a unit; 0 has none
+HULL_CLOUD = np.random.default_rng(7).normal(size=(30, 3)) * [0.03, 0.02, 0.05]
+HULL_FACES, _ = outward_hull(HULL_CLOUD)
+SHAPES_AND_TRUTHS = {
+    **{name: (shape, truth) for name, (shape, truth, _) in PRIMITIVES.items()},
+    'hull': (ConvexMesh(HULL_CLOUD),
+             lambda p: mesh_signed_distance(p, HULL_CLOUD, HULL_FACES)[0]),
+}
+
+
+def scaled_shape(name, factor):
+    """The shape of ``name`` with every length times ``factor``."""
+    return {'box': lambda: Box(np.array([0.2, 0.1, 0.1]) * factor),
+            'sphere': lambda: Sphere(0.05 * factor),
+            'cylinder': lambda: Cylinder(0.025 * factor, 0.1 * factor),
+            'capsule': lambda: Capsule(0.025 * factor, 0.1 * factor),
+            'hull': lambda: ConvexMesh(HULL_CLOUD * factor)}[name]()
+
+
+@settings(max_examples=examples(150), deadline=None)
+@given(name=st.sampled_from(list(SHAPES_AND_TRUTHS)), exponent=st.integers(-1000, 1000),
+       local=arrays(np.float64, 3, elements=st.floats(-0.3, 0.3)))
+@example(name='sphere', exponent=-1000, local=np.array([0.0, 0.0, 0.0]))
+@example(name='cylinder', exponent=-1000, local=np.array([1e-300, 0.0, 0.01]))
+@example(name='box', exponent=1000, local=np.array([0.3, 0.2, -0.1]))
+@example(name='box', exponent=0, local=np.array([1.59237617e-09, 0.125, 0.0]))  # a stall
+def test_the_answer_scales_with_the_unit(name, exponent, local):
+    # Shapes 1e-301 m and 1e300 m across: their squared lengths would underflow or overflow,
+    # but GJK works in a power-of-two unit of the problem's size.
+    if name == 'hull':
+        exponent = exponent // 10  # qhull itself squares coordinates
+    factor = 2.0 ** exponent
+    shape, truth = SHAPES_AND_TRUTHS[name]
+    base = distance(shape, POSE, to_world(local), EXACT_REQUEST)
+    position = np.array(POSITION) * factor
+    query_point = to_world(local) * factor
+    found = distance(scaled_shape(name, factor), Pose.from_rpy(position, RPY), query_point,
+                     EXACT_REQUEST)
+    assert found.status == base.status == STATUS_OK
+    tolerance = 1e-12 * 0.25 * factor
+    assert found.distance == pytest.approx(base.distance * factor, rel=1e-12, abs=tolerance)
+    # A closest point and an outward normal (at the centre of a sphere any is right): on the
+    # surface, |d| from the query point, and the normal from the surface toward a point outside.
+    surface = ROTATION.inv().apply(found.point - position) / factor
+    assert abs(truth(surface)) * factor <= tolerance
+    offset = query_point - found.point
+    assert float(exact_norm(offset)) == pytest.approx(abs(found.distance), abs=tolerance)
+    assert float(exact_norm(found.normal)) == pytest.approx(1.0, abs=1e-15)
+    assert float(offset @ found.normal) == pytest.approx(found.distance, abs=tolerance)
 
 
 def test_box_with_aspect_ratio_one_million():

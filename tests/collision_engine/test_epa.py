@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.spatial import QhullError
 
-from collision_engine.epa import epa
+from collision_engine.epa import epa, scratch_size
 from collision_engine.gjk import gjk, STATUS_OK
 from collision_engine.shapes import ConvexMesh
 from collision_engine.support import pack_convex
@@ -17,15 +17,24 @@ from collision_engine.support import pack_convex
 TOL = 1e-12
 
 
-def penetration(shape: ConvexMesh, point: np.ndarray):
+def fresh_scratch(max_iter=128):
+    """EPA's work space, filled with garbage: answers must not depend on what it held."""
+    n_floats, n_ints = scratch_size(max_iter)
+    return np.full(n_floats, np.nan), np.full(n_ints, -7)
+
+
+def penetration(shape: ConvexMesh, point: np.ndarray, scratch=None):
     """GJK to contact, then EPA: (status, depth, closest point, normal)."""
     kind, floats, ints = pack_convex(shape)
     W = np.zeros(12)
     direction = point - shape.vertices.mean(axis=0)
-    _, contact, count, *_ = gjk(kind, floats, 0, ints, 0, *point, *direction, TOL, TOL, 100, W)
+    size = shape.bounding_sphere()[1]
+    _, contact, count, *_, inv = gjk(kind, floats, 0, ints, 0, *point, *direction, size, TOL,
+                                     TOL, 100, W)
     assert contact
-    status, depth, bound, x, y, z, nx, ny, nz, _ = epa(kind, floats, 0, ints, 0, tuple(point),
-                                                       W, count, TOL, TOL, 128)
+    status, depth, bound, x, y, z, nx, ny, nz, _ = epa(
+        kind, floats, 0, ints, 0, tuple(point), W, count, inv, TOL, TOL, 128,
+        *(scratch or fresh_scratch()))
     assert depth <= bound + 1e-15
     return status, depth, np.array([x, y, z]), np.array([nx, ny, nz])
 
@@ -88,3 +97,19 @@ def test_depth_on_and_just_inside_the_surface(point, depth):
     axis = int(np.argmax(np.abs(normal)))
     assert abs(normal[axis]) == pytest.approx(1.0)
     assert closest[axis] == pytest.approx(np.sign(normal[axis]))
+
+
+def test_reused_scratch_gives_the_answers_of_fresh_scratch():
+    # The scene keeps one work space for every query: what an earlier EPA left in it (more
+    # faces, other vertices) must not leak into the next answer.
+    rng = np.random.default_rng(8)
+    shape = ConvexMesh(rng.normal(size=(300, 3)) * [0.03, 0.02, 0.05])
+    points = rng.uniform(-0.3, 0.3, size=(200, 3)) * shape.vertices.std(axis=0)
+    shared = fresh_scratch()
+    for order in (points, points[::-1]):
+        for point in order:
+            reused = penetration(shape, point, shared)
+            fresh = penetration(shape, point)
+            assert reused[:2] == fresh[:2]
+            np.testing.assert_array_equal(reused[2], fresh[2])
+            np.testing.assert_array_equal(reused[3], fresh[3])

@@ -48,8 +48,9 @@ def brute_nearest(points: np.ndarray) -> float:
 def run_gjk(shape, point, direction=None, max_iterations=100):
     kind, floats, ints = pack_convex(shape)
     direction = point if direction is None else direction
-    status, contact, count, vx, vy, vz, lower, iterations = gjk(
-        kind, floats, 0, ints, 0, *point, *direction, REL_TOL, ABS_TOL, max_iterations,
+    size = shape.bounding_sphere()[1]
+    status, contact, count, vx, vy, vz, lower, iterations, _ = gjk(
+        kind, floats, 0, ints, 0, *point, *direction, size, REL_TOL, ABS_TOL, max_iterations,
         np.zeros(12))
     return status, contact, np.array([vx, vy, vz]), lower, iterations
 

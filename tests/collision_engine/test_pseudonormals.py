@@ -54,3 +54,12 @@ def test_regular_tetrahedron_corner_points_away_from_the_centre():
             midpoint = 0.5 * (vertices[a] + vertices[b])
             np.testing.assert_allclose(normals.edge[normals.face_edges[f, k]],
                                        midpoint / np.linalg.norm(midpoint), atol=1e-15)
+
+
+def test_normals_of_a_cube_1e_160_across_are_those_of_the_unit_cube():
+    # Its cross products are ~1e-320: their squares underflow unless rows are scaled first.
+    tiny = pseudonormals(CUBE_VERTICES * 1e-160, CUBE_FACES)
+    unit = pseudonormals(CUBE_VERTICES, CUBE_FACES)
+    for found, expected in ((tiny.face, unit.face), (tiny.edge, unit.edge),
+                            (tiny.vertex, unit.vertex)):
+        np.testing.assert_allclose(found, expected, rtol=0, atol=1e-15)

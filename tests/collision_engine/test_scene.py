@@ -1,12 +1,15 @@
 """Scenes end to end: the shipped scene files against ground truth, and the query API."""
 
+from itertools import product
+import math
 import subprocess
 import sys
 import textwrap
 
 from ground_truth import (box_signed_distance, capsule_signed_distance,
-                          cylinder_signed_distance, mesh_signed_distance, sample_near_surface,
-                          scene_path, sphere_signed_distance)
+                          cylinder_signed_distance, exact_norm, exact_unit, hand_mesh_path,
+                          mesh_signed_distance, sample_near_surface, scene_path,
+                          sphere_signed_distance)
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -236,3 +239,99 @@ def test_public_api():
         print(issubclass(SceneError, ValueError), issubclass(MeshError, ValueError))
     ''')
     assert output == 'True True'
+
+
+EPS = float(np.finfo(np.float64).eps)
+TINY_OFFSETS = [tuple(sign * m for sign, m in zip(signs, magnitudes))
+                for magnitudes in product((5e-324, 1e-300), repeat=3)
+                for signs in product((1.0, -1.0), repeat=3)]
+
+
+def assert_unit(normal):
+    assert float(exact_norm(normal)) == pytest.approx(1.0, abs=4 * EPS)
+
+
+@pytest.mark.parametrize('offset', TINY_OFFSETS)
+def test_tiny_offsets_from_a_centre_or_an_axis_give_the_exact_depth_and_normal(offset):
+    x, y, z = offset
+    r = 0.025
+    cases = [  # (shape, expected outward normal, depth)
+        (Sphere(r), exact_unit(offset), r),
+        (Cylinder(r, 0.1), [*exact_unit((x, y)), 0.0], r),
+        (Capsule(r, 0.1), [*exact_unit((x, y)), 0.0], r),
+        (Box([0.2, 2 * r, 0.3]), [0.0, math.copysign(1.0, y), 0.0], r),
+    ]
+    for shape, normal, depth in cases:
+        result = Scene([SceneObject('shape', shape, Pose())]).query(offset)
+        assert result.distance == -depth, shape
+        np.testing.assert_allclose(result.normal, normal, rtol=0, atol=4 * EPS)
+        assert_unit(result.normal)
+        # The surface point is the depth along the normal from the (practically central) point.
+        np.testing.assert_allclose(result.point, depth * np.array(normal), rtol=0,
+                                   atol=4 * EPS * depth)
+
+
+TETRAHEDRON = np.array([[0.0, 0.0, 0.0], [0.05, 0.0, 0.0], [0.0, 0.05, 0.0], [0.0, 0.0, 0.05]])
+TETRAHEDRON_FACES = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+
+
+@pytest.mark.parametrize('magnitudes', list(product((5e-324, 1e-300), repeat=3)))
+def test_tiny_offsets_from_a_mesh_vertex_give_the_exact_distance(magnitudes):
+    # Just outside the tetrahedron's corner at the origin: the nearest point is that corner.
+    point = -np.array(magnitudes)
+    scene = Scene([SceneObject('corner', TriangleMesh(TETRAHEDRON, TETRAHEDRON_FACES), Pose())])
+    result = scene.query(point)
+    # Exact to rounding, or to the spacing of subnormals (5e-324) where it is subnormal.
+    assert abs(result.distance - float(exact_norm(point))) <= 4 * EPS * result.distance + 1e-323
+    assert result.distance > 0.0
+    assert_unit(result.normal)
+    assert result.normal @ [-1.0, -1.0, -1.0] > 0.0
+    # A convex hull is exact to GJK's rounding of its size instead (about 1e-17 m here).
+    hull = Scene([SceneObject('corner', ConvexMesh(TETRAHEDRON), Pose())]).query(point)
+    assert abs(hull.distance - result.distance) <= 4 * EPS * 0.05
+    assert_unit(hull.normal)
+
+
+HAND = load_mesh(hand_mesh_path(), scale=0.001, check_self_intersection=False)
+FAR_OBJECTS = [*OBJECTS,
+               SceneObject('hand', TriangleMesh(HAND.vertices, HAND.faces),
+                           Pose.from_rpy([0.0, 0.0, -0.075], [0.3, -0.2, 0.1])),
+               SceneObject('hull', ConvexMesh(HAND.vertices),
+                           Pose.from_rpy([0.2, 0.0, -0.075], [0.0, 0.4, 0.0]))]
+
+
+@pytest.mark.parametrize('reach', [1e20, 1e154, 1e155, 1e300])
+@pytest.mark.parametrize('index', range(len(FAR_OBJECTS)), ids=[o.name for o in FAR_OBJECTS])
+def test_huge_offsets_give_the_exact_distance_and_a_unit_normal(index, reach):
+    scene_object = FAR_OBJECTS[index]
+    scene = Scene([scene_object])
+    rng = np.random.default_rng(26)
+    centre, radius = scene_object.shape.bounding_sphere()
+    centre = scene_object.pose.to_world(centre)
+    for direction in rng.normal(size=(20, 3)):
+        u = exact_unit(direction)
+        point = centre + reach * u
+        result = scene.query(point)
+        if index < len(OBJECTS):
+            truth = every_distance(point[None])[0, index]
+        else:
+            # Every point of a mesh is within its radius of the centre: at 1e20 radii, the
+            # distance from the centre is the distance to the mesh to rounding.
+            truth = float(exact_norm(point - centre))
+            assert radius / truth < EPS / 1e4
+        assert result.distance == pytest.approx(truth, rel=4 * EPS)
+        assert_unit(result.normal)
+        assert result.normal @ u == pytest.approx(1.0, abs=4 * EPS)
+
+
+def test_points_far_from_a_mesh_keep_their_sign_and_exact_distance():
+    # Near 1e17 m the rounding of q - corner (~10 m) used to garble the hand's features and
+    # flip the sign; beyond 2^26 radii the search starts from a point pulled in on the ray.
+    scene = Scene([FAR_OBJECTS[-2]])
+    mesh, pose = FAR_OBJECTS[-2].shape, FAR_OBJECTS[-2].pose
+    rng = np.random.default_rng(27)
+    for exponent in range(0, 18):
+        points = rng.normal(size=(10, 3)) * 10.0 ** exponent
+        truth, _ = mesh_signed_distance(pose.to_local(points), mesh.vertices, mesh.faces)
+        batch = scene.query_many(points)
+        np.testing.assert_allclose(batch.distance, truth, rtol=4 * EPS, atol=ATOL)

@@ -9,11 +9,14 @@ Packed scene layout
 ``floats``: ``[tip radius, rel_tol, abs_tol, scratch offset]``, then per object a record of
 ``OBJECT_FLOATS`` values: rotation (9, row-major, local to world), translation (3),
 bounding-sphere centre in the local frame (3) and in the world frame (3), bounding-sphere radius
-(1); then the shapes' float blocks; then scratch space (GJK simplex, search stack).
+(1); then the shapes' float blocks; then scratch space: GJK's simplex (12), the search
+stack's box distances (s), EPA's floats (``epa.scratch_size``).
 ``ints``: ``[object count, GJK iteration cap, EPA iteration cap, scratch offset]``, then per
 object ``[kind, object float record offset, shape float offset, shape int offset, hint]``
 (``hint`` is the last nearest triangle of a mesh, rewritten by every query as a warm start),
-then the shapes' int blocks (layouts in ``support`` and ``bvh``), then the search stack.
+then the shapes' int blocks (layouts in ``support`` and ``bvh``), then scratch space: the
+search stack's length s, sized for the deepest mesh tree of the scene
+(``bvh.search_stack_size``), its nodes (s), EPA's ints.
 
 The scratch space lives in the packed arrays because allocating it costs as much as a
 primitive's query; so does the hint. Hence one packed scene must not serve two threads at once.
@@ -31,9 +34,10 @@ import numpy as np
 
 from collision_engine import bvh
 from collision_engine._jit import jit
-from collision_engine.epa import epa
+from collision_engine.epa import epa, scratch_size
 from collision_engine.gjk import (gjk, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
                                   STATUS_NOT_CONVERGED, STATUS_OK)
+from collision_engine.norms import norm3, unit3
 from collision_engine.support import (CAPSULE, CONVEX_MESH, CYLINDER, interior, pack_convex,
                                       TRIANGLE_MESH)
 
@@ -44,7 +48,6 @@ OUT_SIZE = 15
 OBJECT_FLOATS = 19
 _HEADER_FLOATS = 4
 _HEADER_INTS = 4
-_SCRATCH_FLOATS = 12 + bvh.STACK_SIZE
 _OBJECT_INTS = 5
 
 
@@ -75,10 +78,13 @@ def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, 
         int_blocks.append(shape_ints)
         float_at += len(shape_floats)
         int_at += len(shape_ints)
+    stack = max([bvh.search_stack_size(block) for (kind, *_), block in zip(table, int_blocks)
+                 if kind == TRIANGLE_MESH], default=1)
+    epa_floats, epa_ints = scratch_size(max_epa_iterations)
     floats = np.concatenate([[tip_radius, rel_tol, abs_tol, float_at], *records, *float_blocks,
-                             np.zeros(_SCRATCH_FLOATS)])
+                             np.zeros(12 + stack + epa_floats)])
     ints = np.concatenate([[n, max_iterations, max_epa_iterations, int_at], *table, *int_blocks,
-                           np.zeros(bvh.STACK_SIZE)])
+                           [stack], np.zeros(stack + epa_ints)])
     return floats.astype(np.float64), ints.astype(np.int64)
 
 
@@ -102,13 +108,13 @@ def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
 
 
 @jit
-def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy, gz,
+def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, radius, gx, gy, gz,
                      rel_tol, abs_tol, max_iter, max_epa_iter, W):
     """Signed distance to a convex shape: GJK outside, exact interior or EPA inside.
 
-    (cx, cy, cz) is the shape's centre, (gx, gy, gz) a first search direction (zero: from the
-    shape's core toward q). Returns (status, distance, lower bound, x, y, z, nx, ny, nz,
-    iterations), local frame.
+    (cx, cy, cz) and ``radius`` are the shape's bounding sphere, (gx, gy, gz) a first search
+    direction (zero: from the shape's core toward q). Returns (status, distance, lower bound,
+    x, y, z, nx, ny, nz, iterations), local frame.
     """
     s, x, y, z, nx, ny, nz = 0.0, qx, qy, qz, 1.0, 0.0, 0.0
     if kind != CONVEX_MESH:
@@ -119,17 +125,20 @@ def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, gx, gy,
         gx, gy, gz = qx - cx, qy - cy, qz - cz
         if kind == CYLINDER or kind == CAPSULE:
             gz = qz - min(max(qz, -floats[fo + 1]), floats[fo + 1])
-    status, contact, count, vx, vy, vz, lower, iterations = gjk(
-        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, rel_tol, abs_tol, max_iter, W)
+    status, contact, count, vx, vy, vz, lower, iterations, inv = gjk(
+        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, radius, rel_tol, abs_tol, max_iter,
+        W)
     if not contact:
-        distance = math.sqrt(vx * vx + vy * vy + vz * vz)
-        return (status, distance, lower, qx + vx, qy + vy, qz + vz,
-                -vx / distance, -vy / distance, -vz / distance, iterations)
+        ux, uy, uz = unit3(vx, vy, vz)
+        return (status, norm3(vx, vy, vz), lower, qx + vx, qy + vy, qz + vz, -ux, -uy, -uz,
+                iterations)
     if kind != CONVEX_MESH:
         # Within rounding of a primitive's surface: its exact interior formula holds there.
         return STATUS_OK, s, s, x, y, z, nx, ny, nz, iterations
+    epa_floats, epa_ints = _epa_scratch(floats, ints)
     status, depth, bound, x, y, z, nx, ny, nz, more = epa(
-        kind, floats, fo, ints, io, (qx, qy, qz), W, count, rel_tol, abs_tol, max_epa_iter)
+        kind, floats, fo, ints, io, (qx, qy, qz), W, count, inv, rel_tol, abs_tol,
+        max_epa_iter, epa_floats, epa_ints)
     return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
 
 
@@ -157,7 +166,7 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2
         lz = floats[r + 2] * gx + floats[r + 5] * gy + floats[r + 8] * gz
         status, distance, lower, x, y, z, nx, ny, nz, iterations = _convex_distance(
             kind, floats, fo, ints, io, qx, qy, qz,
-            floats[r + 12], floats[r + 13], floats[r + 14], lx, ly, lz,
+            floats[r + 12], floats[r + 13], floats[r + 14], floats[r + 18], lx, ly, lz,
             floats[1], floats[2], ints[1], ints[2], W)
     wx = floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9]
     wy = floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10]
@@ -205,8 +214,8 @@ def _nearest(floats, ints, out, row, px, py, pz, W, stack, stack_d2):
     unsure = np.inf
     for k in range(ints[0]):
         r = ints[_HEADER_INTS + _OBJECT_INTS * k + 1]
-        cx, cy, cz = px - floats[r + 15], py - floats[r + 16], pz - floats[r + 17]
-        if math.sqrt(cx * cx + cy * cy + cz * cz) - floats[r + 18] >= best:
+        reach = norm3(px - floats[r + 15], py - floats[r + 16], pz - floats[r + 17])
+        if reach - floats[r + 18] >= best:
             continue
         status, d, lower, ox, oy, oz, mx, my, mz, iterations, t = _object_distance(
             floats, ints, k, px, py, pz, 0.0, 0.0, 0.0, W, stack, stack_d2)
@@ -225,11 +234,22 @@ def _nearest(floats, ints, out, row, px, py, pz, W, stack, stack_d2):
 
 @jit
 def _scratch(floats, ints):
-    """View the scratch space: simplex (12,), search stack and its bounds."""
+    """View the scratch space: simplex (12,), search stack and its box distances (s,) each."""
     f = int(floats[3])
     i = ints[3]
-    return (floats[f:f + 12], ints[i:i + bvh.STACK_SIZE],
-            floats[f + 12:f + 12 + bvh.STACK_SIZE])
+    stack = ints[i]
+    return floats[f:f + 12], ints[i + 1:i + 1 + stack], floats[f + 12:f + 12 + stack]
+
+
+@jit
+def _epa_scratch(floats, ints):
+    """View EPA's scratch space, for the scene's EPA iteration cap: (floats, ints)."""
+    f = int(floats[3])
+    i = ints[3]
+    stack = ints[i]
+    n_floats, n_ints = scratch_size(ints[2])
+    return (floats[f + 12 + stack:f + 12 + stack + n_floats],
+            ints[i + 1 + stack:i + 1 + stack + n_ints])
 
 
 @jit

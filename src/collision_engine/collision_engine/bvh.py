@@ -16,22 +16,29 @@ triangles in tree-leaf order:
 
 * floats: scale (bounding radius, m); corners (t, 9); face normals (t, 3); edge normals (e, 3);
   vertex normals (n, 3); node boxes (b, 6) as min xyz, max xyz.
-* ints: t, e, n, b; faces (t, 3); face edges (t, 3); original face index (t,); nodes (b, 3) as
-  first child (-1 for a leaf), first triangle, triangle count.
-"""
+* ints: t, e, n, b, tree depth; faces (t, 3); face edges (t, 3); original face index (t,);
+  nodes (b, 3) as first child (-1 for a leaf), first triangle, triangle count.
 
-import math
+The search keeps its pending nodes on a stack that the scene preallocates: a depth-first search
+holds at most one pending sibling per level above the node it expands, plus that node's two
+children, so a tree of depth L (edges from the root to its deepest leaf) needs L + 1 entries
+(``search_stack_size``). The depth is measured when the tree is built, so that any tree, however
+unbalanced, gets a stack that cannot overflow. (A median split, as here, gives
+L = ceil(log2(t / LEAF_SIZE)) for any mesh, degenerate or not.)
+"""
 
 import numpy as np
 
 from collision_engine._jit import jit
 from collision_engine.gjk import nearest_on_triangle
+from collision_engine.norms import norm3, unit3
 from collision_engine.pseudonormals import pseudonormals
 
-__all__ = ['LEAF_SIZE', 'STACK_SIZE', 'build_tree', 'pack_triangle_mesh', 'mesh_distance']
+__all__ = ['FAR', 'LEAF_SIZE', 'build_tree', 'mesh_distance', 'pack_triangle_mesh',
+           'search_stack_size', 'tree_depth']
 
 LEAF_SIZE = 4
-STACK_SIZE = 128
+FAR = 2.0 ** 26  # mesh radii: beyond, a query is answered from a nearer point on its ray
 
 
 def build_tree(corners: np.ndarray, leaf_size: int = LEAF_SIZE):
@@ -79,6 +86,27 @@ def build_tree(corners: np.ndarray, leaf_size: int = LEAF_SIZE):
     return order, np.array(boxes), np.array(nodes, dtype=np.int64)
 
 
+def tree_depth(nodes: np.ndarray) -> int:
+    """Edges from the root to the deepest leaf of a tree as ``build_tree`` returns it.
+
+    Parameters
+    ----------
+    nodes : (b, 3) int
+        First child (its sibling follows it; -1 for a leaf), first triangle, triangle count.
+    """
+    depth = np.zeros(len(nodes), dtype=np.int64)
+    for node in range(len(nodes)):  # children always come after their parent
+        child = nodes[node, 0]
+        if child >= 0:
+            depth[child] = depth[child + 1] = depth[node] + 1
+    return int(depth.max())
+
+
+def search_stack_size(ints: np.ndarray) -> int:
+    """Stack entries the search of one packed mesh (its ``ints`` block) can fill: depth + 1."""
+    return int(ints[4]) + 1
+
+
 def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Build the tree and pseudonormals of a mesh and pack them in the layout above.
 
@@ -101,7 +129,8 @@ def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndar
         [scale], vertices[faces_sorted].ravel(), normals.face[order].ravel(),
         normals.edge.ravel(), normals.vertex.ravel(), boxes.ravel()))
     ints = np.concatenate((
-        [len(faces), len(normals.edge), len(vertices), len(nodes)], faces_sorted.ravel(),
+        [len(faces), len(normals.edge), len(vertices), len(nodes), tree_depth(nodes)],
+        faces_sorted.ravel(),
         normals.face_edges[order].ravel(), order, nodes.ravel()))
     return floats.astype(np.float64), ints.astype(np.int64)
 
@@ -129,9 +158,14 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     """Signed distance from q to a packed triangle mesh, local frame.
 
     ``hint`` is a triangle (leaf order) to try first, or -1. ``stack`` (int) and ``stack_d2``
-    (float), (``STACK_SIZE``,) each, are scratch: a depth-first search holds at most one node per
-    level plus one, and a median-split tree over t triangles has ceil(log2(t)) levels, so 128
-    entries never fill.
+    (float) are scratch, each at least ``search_stack_size`` long (module docstring).
+
+    A point farther than ``FAR`` mesh radii R from the mesh's centre is outside, and is searched
+    from the point moved toward the mesh to ``FAR`` radii on the same ray: far off, the rounding
+    of q - corner (eps |q|) would exceed the triangles and garble their features, and beyond
+    1e154 m the squares overflow. The nearest point found is farther from q than q's own nearest
+    point by at most R^2 / (2 FAR R) (second order in R / distance), under half an ulp of the
+    distance; the distance and the normal are then measured from q itself.
 
     Returns (distance, closest x, y, z, outward normal x, y, z, triangle in leaf order,
     original triangle index, triangles tested), m; the distance is negative inside.
@@ -143,11 +177,53 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     edge_normals = face_normals + 3 * n_tri
     vertex_normals = edge_normals + 3 * n_edge
     boxes = vertex_normals + 3 * n_vert
-    faces = io + 4
+    faces = io + 5
     face_edges = faces + 3 * n_tri
-    original = face_edges + 3 * n_tri
-    nodes = original + n_tri
+    nodes = face_edges + 3 * n_tri + n_tri
 
+    cx, cy, cz = (0.5 * (floats[boxes] + floats[boxes + 3]),
+                  0.5 * (floats[boxes + 1] + floats[boxes + 4]),
+                  0.5 * (floats[boxes + 2] + floats[boxes + 5]))
+    reach = max(abs(qx - cx), abs(qy - cy), abs(qz - cz))
+    sx, sy, sz = qx, qy, qz
+    if reach > FAR * scale:
+        pull = FAR * scale / reach
+        sx, sy, sz = cx + (qx - cx) * pull, cy + (qy - cy) * pull, cz + (qz - cz) * pull
+    best_d2, best_t, feature, which, vx, vy, vz, tested = _nearest_triangle(
+        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2)
+    original = face_edges + 3 * n_tri
+    if reach > FAR * scale:
+        x, y, z = sx + vx, sy + vy, sz + vz
+        nx, ny, nz = unit3(qx - x, qy - y, qz - z)
+        return (norm3(qx - x, qy - y, qz - z), x, y, z, nx, ny, nz, best_t,
+                ints[original + best_t], tested)
+
+    if feature == 3:
+        p = face_normals + 3 * best_t
+    elif feature == 2:
+        p = edge_normals + 3 * ints[face_edges + 3 * best_t + which]
+    else:
+        p = vertex_normals + 3 * ints[faces + 3 * best_t + which]
+    px, py, pz = floats[p], floats[p + 1], floats[p + 2]
+    distance = norm3(vx, vy, vz)
+    inside = vx * px + vy * py + vz * pz > 0.0
+    sign = -1.0 if inside else 1.0
+    nx, ny, nz = px, py, pz
+    if feature != 3 and distance > 1e-9 * scale:
+        ux, uy, uz = unit3(vx, vy, vz)
+        nx, ny, nz = -sign * ux, -sign * uy, -sign * uz
+    return (sign * distance, qx + vx, qy + vy, qz + vz, nx, ny, nz,
+            best_t, ints[original + best_t], tested)
+
+
+@jit
+def _nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
+                      stack_d2):
+    """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
+
+    Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
+    tested) with v from q to the nearest point and the feature as ``nearest_on_triangle``'s.
+    """
     best_d2 = np.inf
     best_t, feature, which = -1, 0, 0
     vx = vy = vz = 0.0
@@ -187,19 +263,4 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
             stack[top] = near
             stack_d2[top] = near_d2
             top += 1
-
-    if feature == 3:
-        p = face_normals + 3 * best_t
-    elif feature == 2:
-        p = edge_normals + 3 * ints[face_edges + 3 * best_t + which]
-    else:
-        p = vertex_normals + 3 * ints[faces + 3 * best_t + which]
-    px, py, pz = floats[p], floats[p + 1], floats[p + 2]
-    distance = math.sqrt(best_d2)
-    inside = vx * px + vy * py + vz * pz > 0.0
-    sign = -1.0 if inside else 1.0
-    nx, ny, nz = px, py, pz
-    if feature != 3 and distance > 1e-9 * scale:
-        nx, ny, nz = -sign * vx / distance, -sign * vy / distance, -sign * vz / distance
-    return (sign * distance, qx + vx, qy + vy, qz + vz, nx, ny, nz,
-            best_t, ints[original + best_t], tested)
+    return best_d2, best_t, feature, which, vx, vy, vz, tested

@@ -106,12 +106,12 @@ class DistanceResult:
 
 
 def _packed(shape, request: DistanceRequest) -> tuple[np.ndarray, np.ndarray]:
-    try:
-        floats, ints = _PACKED[shape]
-    except KeyError:
+    """Pack the shape as a one-object scene (once), its scratch sized for the EPA cap."""
+    floats, ints = _PACKED.get(shape, (None, None))
+    if ints is None or ints[2] != request.max_epa_iterations:
         floats, ints = _kernels.pack_scene(
             [shape], [Pose()], tip_radius=0.0, rel_tol=0.0, abs_tol=0.0, max_iterations=1,
-            max_epa_iterations=1)
+            max_epa_iterations=request.max_epa_iterations)
         _PACKED[shape] = floats, ints
     floats[1], floats[2] = request.rel_tol, request.abs_tol
     ints[1], ints[2] = request.max_iterations, request.max_epa_iterations

@@ -12,15 +12,14 @@ is on the surface, or within rounding of it); it is first blown up to a tetrahed
 points along directions that span the missing dimensions (as libccd and coal do).
 """
 
-import math
-
 import numpy as np
 
 from collision_engine._jit import jit
 from collision_engine.gjk import STATUS_NOT_CONVERGED, STATUS_OK
+from collision_engine.norms import norm3, unit3
 from collision_engine.support import support
 
-__all__ = ['epa']
+__all__ = ['epa', 'scratch_size']
 
 _EPS = float(np.finfo(np.float64).eps)
 _FLOOR = 16.0 * _EPS
@@ -28,9 +27,10 @@ _UNIT_AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
 @jit
-def _support_minus_q(kind, floats, fo, ints, io, q, dx, dy, dz):
+def _support_minus_q(kind, floats, fo, ints, io, q, inv, dx, dy, dz):
+    """Support point of ``inv (A - q)``: the Minkowski difference in GJK's scaled unit."""
     sx, sy, sz, _ = support(kind, floats, fo, ints, io, dx, dy, dz, 0)
-    return sx - q[0], sy - q[1], sz - q[2]
+    return (sx - q[0]) * inv, (sy - q[1]) * inv, (sz - q[2]) * inv
 
 
 @jit
@@ -51,7 +51,7 @@ def _off_affine_hull(V, count, x, y, z, tolerance):
 
 
 @jit
-def _blow_up(kind, floats, fo, ints, io, q, V, count, tolerance):
+def _blow_up(kind, floats, fo, ints, io, q, inv, V, count, tolerance):
     """Grow the simplex V[:count] to a tetrahedron with support points; returns its size."""
     while count < 4:
         grown = False
@@ -69,7 +69,7 @@ def _blow_up(kind, floats, fo, ints, io, q, V, count, tolerance):
             if dx == 0.0 and dy == 0.0 and dz == 0.0:
                 continue
             for sign in (1.0, -1.0):
-                x, y, z = _support_minus_q(kind, floats, fo, ints, io, q,
+                x, y, z = _support_minus_q(kind, floats, fo, ints, io, q, inv,
                                            sign * dx, sign * dy, sign * dz)
                 if _off_affine_hull(V, count, x, y, z, tolerance):
                     V[count, 0], V[count, 1], V[count, 2] = x, y, z
@@ -89,11 +89,9 @@ def _set_face(V, F, N, D, f, a, b, c):
     F[f, 0], F[f, 1], F[f, 2] = a, b, c
     ux, uy, uz = V[b, 0] - V[a, 0], V[b, 1] - V[a, 1], V[b, 2] - V[a, 2]
     wx, wy, wz = V[c, 0] - V[a, 0], V[c, 1] - V[a, 1], V[c, 2] - V[a, 2]
-    nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
-    norm = math.sqrt(nx * nx + ny * ny + nz * nz)
-    if norm == 0.0:
+    nx, ny, nz = unit3(uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx)
+    if nx == 0.0 and ny == 0.0 and nz == 0.0:
         return False
-    nx, ny, nz = nx / norm, ny / norm, nz / norm
     N[f, 0], N[f, 1], N[f, 2] = nx, ny, nz
     D[f] = nx * V[a, 0] + ny * V[a, 1] + nz * V[a, 2]
     return True
@@ -118,15 +116,33 @@ def _tetrahedron(V, F, N, D):
 
 
 @jit
-def epa(kind, floats, fo, ints, io, q, W, count, rel_tol, abs_tol, max_iter):
+def scratch_size(max_iter):
+    """Scratch lengths ``epa`` needs for ``max_iter`` iterations: (floats, ints).
+
+    With m = max_iter + 4 vertices at most (the tetrahedron, then one a step): floats hold the
+    vertices (m, 3), face normals (2m, 3) and face offsets (2m,); ints hold the faces (2m, 3),
+    their alive flags (2m,) and the horizon's edge ends (6m,) twice.
+    """
+    m = max_iter + 4
+    return 11 * m, 20 * m
+
+
+@jit
+def epa(kind, floats, fo, ints, io, q, W, count, inv, rel_tol, abs_tol, max_iter,
+        scratch_floats, scratch_ints):
     """Penetration of the point q inside a convex shape, from GJK's contact simplex.
 
     Parameters
     ----------
     q : (3,) float, m, local frame
     W : (12,) float
-        GJK's final simplex of ``C = A - q`` (``count`` rows of a row-major (4, 3) array),
-        which contains the origin.
+        GJK's final simplex of ``inv C``, ``C = A - q`` (``count`` rows of a row-major (4, 3)
+        array), which contains the origin.
+    inv : float
+        GJK's power-of-two unit (``gjk.power_of_two_inverse``): EPA works in it too.
+    scratch_floats, scratch_ints : float64 and int64 arrays
+        Preallocated work space, at least ``scratch_size(max_iter)`` long: allocating it costs
+        more than a short EPA run.
 
     Returns
     -------
@@ -135,38 +151,40 @@ def epa(kind, floats, fo, ints, io, q, W, count, rel_tol, abs_tol, max_iter):
     converged), and the closest point is q moved by ``depth`` along the normal.
     """
     max_vertices = max_iter + 4
-    V = np.empty((max_vertices, 3))
-    F = np.empty((2 * max_vertices, 3), dtype=np.int64)
-    N = np.empty((2 * max_vertices, 3))
-    D = np.empty(2 * max_vertices)
-    alive = np.zeros(2 * max_vertices, dtype=np.bool_)
+    m = max_vertices
+    V = scratch_floats[:3 * m].reshape((m, 3))
+    N = scratch_floats[3 * m:9 * m].reshape((2 * m, 3))
+    D = scratch_floats[9 * m:11 * m]
+    F = scratch_ints[:6 * m].reshape((2 * m, 3))
+    alive = scratch_ints[6 * m:8 * m]  # only faces below n_faces, each set when made, are read
+    edge_a = scratch_ints[8 * m:14 * m]
+    edge_b = scratch_ints[14 * m:20 * m]
     V[:count] = W[:3 * count].reshape((count, 3))
+    abs_tol = abs_tol * inv
     scale = 0.0
     for k in range(count):
-        scale = max(scale, math.sqrt(V[k, 0] ** 2 + V[k, 1] ** 2 + V[k, 2] ** 2))
-    x0, y0, z0 = _support_minus_q(kind, floats, fo, ints, io, q, 1.0, 0.0, 0.0)
-    x1, y1, z1 = _support_minus_q(kind, floats, fo, ints, io, q, -1.0, 0.0, 0.0)
+        scale = max(scale, norm3(V[k, 0], V[k, 1], V[k, 2]))
+    x0, y0, z0 = _support_minus_q(kind, floats, fo, ints, io, q, inv, 1.0, 0.0, 0.0)
+    x1, y1, z1 = _support_minus_q(kind, floats, fo, ints, io, q, inv, -1.0, 0.0, 0.0)
     scale = max(scale, abs(x0 - x1))
-    count = _blow_up(kind, floats, fo, ints, io, q, V, count, 1e-9 * scale)
+    count = _blow_up(kind, floats, fo, ints, io, q, inv, V, count, 1e-9 * scale)
     if count < 4 or not _tetrahedron(V, F, N, D):
         return STATUS_NOT_CONVERGED, 0.0, np.inf, q[0], q[1], q[2], 1.0, 0.0, 0.0, 0
-    alive[:4] = True
+    alive[:4] = 1
     n_vertices, n_faces = 4, 4
-    edge_a = np.empty(6 * max_vertices, dtype=np.int64)
-    edge_b = np.empty(6 * max_vertices, dtype=np.int64)
     status = STATUS_NOT_CONVERGED
     bound = np.inf
     iteration = 0
     while True:
         best = -1
         for f in range(n_faces):
-            if alive[f] and (best < 0 or D[f] < D[best]):
+            if alive[f] == 1 and (best < 0 or D[f] < D[best]):
                 best = f
         nx, ny, nz, depth = N[best, 0], N[best, 1], N[best, 2], D[best]
         if iteration >= max_iter or n_vertices >= max_vertices:
             break
         iteration += 1
-        wx, wy, wz = _support_minus_q(kind, floats, fo, ints, io, q, nx, ny, nz)
+        wx, wy, wz = _support_minus_q(kind, floats, fo, ints, io, q, inv, nx, ny, nz)
         bound = min(bound, nx * wx + ny * wy + nz * wz)
         gap = nx * wx + ny * wy + nz * wz - depth
         if gap <= max(rel_tol * abs(depth), abs_tol, _FLOOR * scale):
@@ -178,12 +196,12 @@ def epa(kind, floats, fo, ints, io, q, W, count, rel_tol, abs_tol, max_iter):
         # Faces the new point sees go; the edges they do not share form the horizon.
         n_edges = 0
         for f in range(n_faces):
-            if not alive[f]:
+            if alive[f] == 0:
                 continue
             a = F[f, 0]
             if (N[f, 0] * (wx - V[a, 0]) + N[f, 1] * (wy - V[a, 1])
                     + N[f, 2] * (wz - V[a, 2])) > _FLOOR * scale:
-                alive[f] = False
+                alive[f] = 0
                 for e in range(3):
                     edge_a[n_edges] = F[f, e]
                     edge_b[n_edges] = F[f, (e + 1) % 3]
@@ -200,9 +218,10 @@ def epa(kind, floats, fo, ints, io, q, W, count, rel_tol, abs_tol, max_iter):
             if n_faces >= len(D) or not _set_face(V, F, N, D, n_faces, edge_a[e], edge_b[e], w):
                 degenerate = True
                 break
-            alive[n_faces] = True
+            alive[n_faces] = 1
             n_faces += 1
         if degenerate:
             break
-    return (status, depth, max(bound, depth), q[0] + depth * nx, q[1] + depth * ny,
-            q[2] + depth * nz, nx, ny, nz, iteration)
+    depth, bound = depth / inv, max(bound, depth) / inv
+    return (status, depth, bound, q[0] + depth * nx, q[1] + depth * ny, q[2] + depth * nz,
+            nx, ny, nz, iteration)

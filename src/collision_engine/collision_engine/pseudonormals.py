@@ -31,7 +31,13 @@ class Pseudonormals:
 
 
 def _unit(vectors: np.ndarray) -> np.ndarray:
-    return vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
+    """Rows divided by their norms, each row first divided by its largest |component|.
+
+    Faces a few 1e-160 m across have cross products whose squares underflow: unscaled, their
+    normals would be 0/0.
+    """
+    scaled = vectors / np.max(np.abs(vectors), axis=1, keepdims=True)
+    return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
 
 
 def pseudonormals(vertices: np.ndarray, faces: np.ndarray) -> Pseudonormals:
@@ -47,7 +53,11 @@ def pseudonormals(vertices: np.ndarray, faces: np.ndarray) -> Pseudonormals:
     Pseudonormals
     """
     corners = vertices[faces]
-    face = _unit(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
+    # Each face moved to its first corner and scaled to a largest offset of 1: normals and
+    # angles do not change, and no cross product of a tiny face underflows.
+    corners = corners - corners[:, :1]
+    corners /= np.max(np.abs(corners), axis=(1, 2))[:, None, None]
+    face = _unit(np.cross(corners[:, 1], corners[:, 2]))
     vertex = np.zeros_like(vertices)
     for k in range(3):
         u = corners[:, (k + 1) % 3] - corners[:, k]

@@ -12,6 +12,7 @@ import numpy as np
 
 from collision_engine import support as _support
 from collision_engine.errors import MeshError
+from collision_engine.norms import scaled3
 
 __all__ = ['Box', 'Sphere', 'Cylinder', 'Capsule', 'ConvexMesh', 'TriangleMesh']
 
@@ -81,7 +82,7 @@ class Box(_ConvexShape):
 
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
         """Centre (3,) m and radius m of a sphere holding the shape, local frame."""
-        return np.zeros(3), 0.5 * math.sqrt(sum(s * s for s in self.size))
+        return np.zeros(3), 0.5 * math.hypot(*self.size)
 
     def __repr__(self) -> str:
         return f'Box(size={list(self.size)})'
@@ -268,8 +269,13 @@ class TriangleMesh:
         self._sphere = None
 
     def support(self, direction) -> np.ndarray:
-        """Farthest vertex along ``direction`` (3,): the support of the convex hull, m."""
-        return self.vertices[np.argmax(self.vertices @ np.asarray(direction, np.float64))]
+        """Farthest vertex along ``direction`` (3,): the support of the convex hull, m.
+
+        The direction is scaled to a largest component of 1 first (``norms.scaled3``), so that
+        no dot product underflows or overflows.
+        """
+        scaled = np.array(scaled3(*(float(c) for c in direction)))
+        return self.vertices[np.argmax(self.vertices @ scaled)]
 
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
         """Centre (3,) m and radius m of a sphere holding the shape, local frame."""
@@ -285,7 +291,8 @@ def _bounding_sphere(vertices: np.ndarray) -> tuple[np.ndarray, float]:
     """Compute the sphere once per mesh (it reads every vertex): the shapes keep it."""
     centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
     centre.setflags(write=False)
-    return centre, float(np.linalg.norm(vertices - centre, axis=1).max())
+    offsets = vertices - centre
+    return centre, float(np.hypot(np.hypot(offsets[:, 0], offsets[:, 1]), offsets[:, 2]).max())
 
 
 def _check_closed_and_wound(vertices: np.ndarray, faces: np.ndarray, name: str) -> None:

@@ -17,11 +17,10 @@ CONVEX_MESH    n vertices x, y, z                              n, then CSR verte
 All vectors are in the shape's local frame, in metres.
 """
 
-import math
-
 import numpy as np
 
 from collision_engine._jit import jit
+from collision_engine.norms import norm2, norm3, scaled3, unit2, unit3
 
 __all__ = [
     'BOX', 'SPHERE', 'CYLINDER', 'CAPSULE', 'CONVEX_MESH', 'TRIANGLE_MESH',
@@ -72,6 +71,8 @@ def pack_convex(shape) -> tuple[int, np.ndarray, np.ndarray]:
 def support(kind, floats, fo, ints, io, dx, dy, dz, start):
     """Farthest point of a convex shape along the direction (dx, dy, dz), local frame.
 
+    Any magnitude of direction gives the exact point (``norms``: no component is squared
+    unscaled); a zero or NaN direction gives some point of the shape, an infinite one its limit.
     ``start`` is the vertex a convex mesh starts its hill climb from (the previous answer is a
     good warm start); the returned index is the vertex found (-1 for primitives). Returns
     (x, y, z, index).
@@ -83,33 +84,34 @@ def support(kind, floats, fo, ints, io, dx, dy, dz, start):
         return x, y, z, -1
     if kind == SPHERE:
         r = floats[fo]
-        norm = math.sqrt(dx * dx + dy * dy + dz * dz)
-        if norm == 0.0:
+        ux, uy, uz = unit3(dx, dy, dz)
+        if ux == 0.0 and uy == 0.0 and uz == 0.0:
             return r, 0.0, 0.0, -1
-        return r * dx / norm, r * dy / norm, r * dz / norm, -1
+        return r * ux, r * uy, r * uz, -1
     if kind == CYLINDER:
         r = floats[fo]
         z = floats[fo + 1] if dz >= 0.0 else -floats[fo + 1]
-        rho = math.sqrt(dx * dx + dy * dy)
-        if rho == 0.0:
-            return 0.0, 0.0, z, -1
-        return r * dx / rho, r * dy / rho, z, -1
+        ux, uy = unit2(dx, dy)
+        return r * ux, r * uy, z, -1
     if kind == CAPSULE:
         r = floats[fo]
         z = floats[fo + 1] if dz >= 0.0 else -floats[fo + 1]
-        norm = math.sqrt(dx * dx + dy * dy + dz * dz)
-        if norm == 0.0:
+        ux, uy, uz = unit3(dx, dy, dz)
+        if ux == 0.0 and uy == 0.0 and uz == 0.0:
             return r, 0.0, z, -1
-        return r * dx / norm, r * dy / norm, z + r * dz / norm, -1
-    return _hill_climb(floats, fo, ints, io, dx, dy, dz, start)
+        return r * ux, r * uy, z + r * uz, -1
+    sx, sy, sz = scaled3(dx, dy, dz)
+    return _hill_climb(floats, fo, ints, io, sx, sy, sz, start)
 
 
 @jit
 def _hill_climb(floats, fo, ints, io, dx, dy, dz, start):
     """Support vertex of a convex polytope by steepest ascent on its vertex graph.
 
-    On a convex polytope a vertex with no better neighbour is a global maximum, so the climb is
-    exact; from the previous support vertex it takes a few steps.
+    The direction's largest component must be about 1 (``norms.scaled3``), so that no dot
+    product underflows or overflows. On a convex polytope a vertex with no better neighbour is
+    a global maximum, so the climb is exact; from the previous support vertex it takes a few
+    steps.
     """
     n = ints[io]
     offsets = io + 1
@@ -148,11 +150,10 @@ def interior(kind, floats, fo, qx, qy, qz):
     cz = 0.0
     if kind == CAPSULE:
         cz = min(max(qz, -floats[fo + 1]), floats[fo + 1])
-    ux, uy, uz = qx, qy, qz - cz
-    norm = math.sqrt(ux * ux + uy * uy + uz * uz)
-    if norm == 0.0:
-        ux, uy, uz, norm = 1.0, 0.0, 0.0, 1.0
-    nx, ny, nz = ux / norm, uy / norm, uz / norm
+    norm = norm3(qx, qy, qz - cz)
+    nx, ny, nz = unit3(qx, qy, qz - cz)
+    if nx == 0.0 and ny == 0.0 and nz == 0.0:
+        nx = 1.0
     return norm - r, r * nx, r * ny, cz + r * nz, nx, ny, nz
 
 
@@ -174,15 +175,14 @@ def _box_interior(hx, hy, hz, qx, qy, qz):
 
 @jit
 def _cylinder_interior(r, hh, qx, qy, qz):
-    rho = math.sqrt(qx * qx + qy * qy)
-    e_side = rho - r
+    e_side = norm2(qx, qy) - r
     e_cap = abs(qz) - hh
     if e_cap >= e_side:
         sz = 1.0 if qz >= 0.0 else -1.0
         return e_cap, qx, qy, sz * hh, 0.0, 0.0, sz
-    if rho == 0.0:
-        return e_side, r, 0.0, qz, 1.0, 0.0, 0.0
-    ux, uy = qx / rho, qy / rho
+    ux, uy = unit2(qx, qy)
+    if ux == 0.0 and uy == 0.0:
+        ux = 1.0
     return e_side, r * ux, r * uy, qz, ux, uy, 0.0
 
 
