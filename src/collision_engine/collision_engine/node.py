@@ -36,10 +36,9 @@ class CollisionNode(Node):
         self.params = declare_parameters(self, CollisionNodeParams)
         scene_path = resolve_path(self.params.scene_file, what='parameter scene_file')
         try:
-            self.scene = load_scene(scene_path)
+            self.scene = load_scene(scene_path, announce=self.get_logger().info)
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
-        self.scene.warm_up()
         self.get_logger().info(
             f'scene {scene_path}: {len(self.scene.objects)} object(s) in frame '
             f'{self.scene.frame_id!r}')

@@ -6,13 +6,16 @@ imported only when the file turns cross-validation on. Every query is one compil
 """
 
 from dataclasses import dataclass
+import logging
 import math
 from pathlib import Path
 import sys
+from typing import Callable
 
 import numpy as np
 
 from collision_engine import _kernels
+from collision_engine._jit import compiling
 from collision_engine.distance import DistanceRequest
 from collision_engine.gjk import STATUS_INVALID_INPUT
 from collision_engine.results import BatchResult, QueryResult
@@ -22,6 +25,8 @@ from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, 
 from collision_engine.transforms import Pose
 
 __all__ = ['Scene', 'SceneObject', 'load_scene']
+
+_LOG = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,15 +110,17 @@ class Scene:
         """Running FCL cross-check totals (``CrossValidationStats``), or None when off."""
         return None if self._validator is None else self._validator.stats
 
-    def warm_up(self) -> None:
+    def warm_up(self, announce: Callable[[str], None] = _LOG.info) -> None:
         """Compile (or load from cache) every kernel, so that the first real query is fast.
 
         The first call in a process takes seconds without numba's cache and about half a
         second with it; call this before a real-time loop starts (``load_scene`` does).
+        ``announce`` gets one line when this process is the one that compiles.
         """
-        self.query_many(np.zeros((1, 3)))
-        _kernels.query_point(self._floats, self._ints, self._row, 0.0, 0.0, 0.0)
-        self.query_within((0.0, 0.0, 0.0), 0.0)
+        with compiling(announce):
+            self.query_many(np.zeros((1, 3)))
+            _kernels.query_point(self._floats, self._ints, self._row, 0.0, 0.0, 0.0)
+            self.query_within((0.0, 0.0, 0.0), 0.0)
 
     def query(self, point) -> QueryResult:
         """Signed distance from one tip position to the nearest object.
@@ -194,7 +201,8 @@ class Scene:
 
 
 def load_scene(path, *, request: DistanceRequest | None = None,
-               check_self_intersection: bool | None = None) -> Scene:
+               check_self_intersection: bool | None = None,
+               announce: Callable[[str], None] = _LOG.info) -> Scene:
     """Read a scene file and build its scene, warmed up.
 
     Parameters
@@ -206,6 +214,8 @@ def load_scene(path, *, request: DistanceRequest | None = None,
     check_self_intersection : bool, optional
         Reject self-intersecting meshes (``mesh_io.load_mesh``; needs fcl). By default only
         when the scene enables FCL cross-validation, so that fcl stays unimported otherwise.
+    announce : callable str -> None
+        Told in one line when this process compiles the kernels (see ``Scene.warm_up``).
 
     Returns
     -------
@@ -225,7 +235,7 @@ def load_scene(path, *, request: DistanceRequest | None = None,
                            o.material) for o in spec.objects]
     scene = Scene(objects, frame_id=spec.frame_id, tip_radius=spec.tip_radius,
                   request=request, cross_validation=spec.cross_validation)
-    scene.warm_up()
+    scene.warm_up(announce)
     return scene
 
 

@@ -89,7 +89,7 @@ class ForceNode(Node):
         gains = [default, *materials.values()]
         if params.law == 'proxy':
             from collision_engine import load_scene
-            scene = load_scene(scene_path)  # built and warmed up
+            scene = load_scene(scene_path, announce=self.get_logger().info)  # warmed up
 
             def signed_distance(point):
                 result = scene.query(point)

@@ -101,7 +101,8 @@ class WandDriverNode(Node):
         project = None
         if needs_scene(params.experiment):
             project = _surface_projection(
-                resolve_path(params.scene_file, what='parameter scene_file'))
+                resolve_path(params.scene_file, what='parameter scene_file'),
+                self.get_logger().info)
         config = SimulatedWandConfig(
             mass=[params.device_mass] * 3, damping=[params.device_damping] * 3,
             limits=DeviceLimits(force_limit=params.force_limit,
@@ -260,11 +261,11 @@ class WandDriverNode(Node):
         return super().destroy_node()
 
 
-def _surface_projection(scene_path):
+def _surface_projection(scene_path, announce):
     """``project(point) -> (closest surface point, outward normal)`` on the scene, for scripts."""
     from collision_engine import load_scene
 
-    scene = load_scene(scene_path)
+    scene = load_scene(scene_path, announce=announce)
 
     def project(point):
         result = scene.query(point)
