@@ -1,6 +1,8 @@
 """Recording a session over ROS 2: nothing lost on a clean stop; readable after kill -9."""
 import os
 import signal
+import subprocess
+import sys
 import time
 
 from domains import session_domain_id
@@ -10,7 +12,7 @@ import numpy as np
 import yaml
 
 from haptic_bringup.bag import FLUSH_PERIOD, recover, typestore_with
-from haptic_bringup.launcher import Loop, LoopConfig
+from haptic_bringup.launcher import Loop, loop_environment, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import published_counts, PUBLISHERS, topic_counts
 
@@ -71,3 +73,20 @@ def test_a_recorder_killed_with_sigkill_leaves_a_recoverable_bag(tmp_path):
     assert max(np.diff(poses)) * 1e-9 < FLUSH_PERIOD / 2
     counts = topic_counts(recovered)
     assert counts['/collision/state'] > 0 and counts['/wand/wrench'] > 0
+
+
+def test_a_recorder_pointed_at_an_existing_bag_refuses_and_leaves_it_untouched(tmp_path):
+    with Loop(session_config(tmp_path, duration=1.0)) as loop:
+        loop.wait(60.0)
+    bag = tmp_path / 'bag'
+    before = {path.name: path.read_bytes() for path in bag.iterdir()}
+    again = subprocess.run(
+        [sys.executable, '-m', 'haptic_bringup.launcher', '--experiment', 'cuboid',
+         '--duration', '1', '--record', str(bag), '--domain-id', str(session_domain_id()),
+         '--run-dir', str(tmp_path / 'again')],
+        env=loop_environment(session_domain_id(), tmp_path / 'log'), capture_output=True,
+        text=True, timeout=180)
+    assert again.returncode == 1
+    errors = [line for line in again.stderr.splitlines() if line.startswith('error:')]
+    assert len(errors) == 1 and str(bag) in errors[0] and 'exists' in errors[0], again.stderr
+    assert {path.name: path.read_bytes() for path in bag.iterdir()} == before
