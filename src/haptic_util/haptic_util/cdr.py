@@ -33,7 +33,7 @@ def _message_class(type_name: str):
 
 
 def _leaves(message_class, prefix: str = '') -> list:
-    """The leaf fields of a message class, depth first: [(dotted name, struct code or 'string')]."""
+    """Return the leaf fields, depth first: [(dotted name, struct code or "string")]."""
     leaves = []
     for name, kind in message_class.get_fields_and_field_types().items():
         if kind in _LEAVES or kind == _STRING:
@@ -90,7 +90,7 @@ class MessageCodec:
         return self._layout(tuple(reversed(lengths)))[0].pack(*args)
 
     def _layout(self, lengths: tuple) -> tuple:
-        """The struct of the whole message for these string lengths, built once."""
+        """Return the struct of the whole message for these string lengths, built once."""
         if lengths not in self._layouts:
             fmt, offset, k, picks, strings = ['<4s'], 0, 0, [], []
             for i, code in enumerate(self._codes):
