@@ -1,13 +1,22 @@
-"""Messages ↔ the collision core: tip position in, CollisionState out."""
+"""Messages <-> the collision core: the pose's leaf fields in, CollisionState's leaf fields out.
+
+The node reads and writes CDR bytes (``haptic_util.cdr``); these functions work on the flat
+tuples of leaf fields, in the order of each message's definition (``POSE.fields``,
+``STATE.fields``).
+"""
 import math
 
 from geometry_msgs.msg import PoseStamped
 
 from haptic_msgs.msg import CollisionState
+from haptic_util.cdr import MessageCodec
 
-__all__ = ['InvalidPose', 'tip_position', 'fill_state', 'fill_invalid_state']
+__all__ = ['InvalidPose', 'POSE', 'STATE', 'tip_position', 'state', 'invalid_state']
 
 UNIT_QUATERNION_TOLERANCE = 1e-3  # |q| may differ from 1 by this much (float32 round trips)
+POSE = MessageCodec(PoseStamped)
+STATE = MessageCodec(CollisionState)
+_NAN3 = (math.nan, math.nan, math.nan)
 
 
 class InvalidPose(ValueError):
@@ -21,65 +30,42 @@ class InvalidPose(ValueError):
         self.kind = kind
 
 
-def tip_position(msg: PoseStamped, frame_id: str) -> tuple:
-    """Return the tip position (x, y, z) [m] of a pose in the scene frame, or raise InvalidPose."""
-    if msg.header.frame_id != frame_id:
+def tip_position(pose: list, frame_id: str) -> tuple:
+    """Return the tip position (x, y, z) [m] of a pose in the scene frame, or raise InvalidPose.
+
+    ``pose`` holds the leaf fields of a PoseStamped (``POSE.fields``).
+    """
+    _, _, frame, px, py, pz, qx, qy, qz, qw = pose
+    if frame != frame_id:
         raise InvalidPose('pose in an unknown frame',
-                          f'pose.header.frame_id is {msg.header.frame_id!r}, not the scene '
-                          f'frame {frame_id!r} (no transform is looked up)')
-    p, q = msg.pose.position, msg.pose.orientation
-    for name, value in (('x', p.x), ('y', p.y), ('z', p.z)):
+                          f'pose.header.frame_id is {frame!r}, not the scene frame '
+                          f'{frame_id!r} (no transform is looked up)')
+    for name, value in (('x', px), ('y', py), ('z', pz)):
         if not math.isfinite(value):
             raise InvalidPose('non-finite position', f'pose.position.{name} is {value}')
-    for name, value in (('x', q.x), ('y', q.y), ('z', q.z), ('w', q.w)):
+    for name, value in (('x', qx), ('y', qy), ('z', qz), ('w', qw)):
         if not math.isfinite(value):
             raise InvalidPose('non-finite orientation', f'pose.orientation.{name} is {value}')
-    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
+    norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
     if abs(norm - 1.0) > UNIT_QUATERNION_TOLERANCE:
         raise InvalidPose('non-unit quaternion',
                           f'pose.orientation is not a unit quaternion (|q| = {norm:.6g})')
-    return (p.x, p.y, p.z)
+    return (px, py, pz)
 
 
-def fill_state(state: CollisionState, header, result, compute_time: float,
-               disagreements: int) -> CollisionState:
-    """Write one query result into a (reused) CollisionState message."""
-    state.header = header
-    state.object = result.object or ''  # an empty scene has no nearest object
-    state.status = result.status
-    state.distance = result.distance
-    state.in_collision = result.in_collision
-    _set_xyz(state.closest_point, result.point)
-    _set_xyz(state.normal, result.normal)
-    _set_xyz(state.penetration, result.penetration)
-    _set_xyz(state.tip, result.tip)
-    state.gjk_iterations = result.iterations
-    state.cross_validated = result.cross_validated
-    state.fcl_distance = result.fcl_distance
-    state.fcl_discrepancy = result.fcl_discrepancy
-    state.fcl_disagreements = disagreements
-    state.compute_time = compute_time
-    return state
+def state(header: tuple, result, compute_time: float, disagreements: int) -> tuple:
+    """Return CollisionState's leaf fields for one query result.
+
+    ``header`` is (sec, nanosec, frame_id) of the pose answered.
+    """
+    row = result.row
+    return (*header, result.object or '', result.status, row[0], row[0] <= 0.0, *row[1:4],
+            *row[4:7], *result.penetration.tolist(), *row[10:13], result.iterations,
+            result.cross_validated, result.fcl_distance, result.fcl_discrepancy,
+            disagreements, compute_time)
 
 
-def fill_invalid_state(state: CollisionState, header, disagreements: int) -> CollisionState:
-    """Mark a state invalid: the renderer then sends zero force."""
-    nan = math.nan
-    state.header = header
-    state.object = ''
-    state.status = CollisionState.STATUS_INVALID_INPUT
-    state.distance = nan
-    state.in_collision = False
-    for vector in (state.closest_point, state.normal, state.penetration, state.tip):
-        _set_xyz(vector, (nan, nan, nan))
-    state.gjk_iterations = 0
-    state.cross_validated = False
-    state.fcl_distance = nan
-    state.fcl_discrepancy = nan
-    state.fcl_disagreements = disagreements
-    state.compute_time = 0.0
-    return state
-
-
-def _set_xyz(vector, values) -> None:
-    vector.x, vector.y, vector.z = float(values[0]), float(values[1]), float(values[2])
+def invalid_state(header: tuple, disagreements: int) -> tuple:
+    """Return the leaf fields of a state marked invalid: the renderer then sends zero force."""
+    return (*header, '', CollisionState.STATUS_INVALID_INPUT, math.nan, False, *_NAN3, *_NAN3,
+            *_NAN3, *_NAN3, 0, False, math.nan, math.nan, disagreements, 0.0)

@@ -43,6 +43,15 @@ class QueryResult:
         self.fcl_discrepancy = fcl_discrepancy
 
     @property
+    def row(self) -> list:
+        """Return the packed output (``_kernels.OUT_SIZE`` floats), to copy many fields at once.
+
+        distance, point (3), normal (3), object index, iterations, status, tip (3), triangle,
+        lower bound; a node writing a message takes its vectors from here without numpy.
+        """
+        return self._row
+
+    @property
     def distance(self) -> float:
         """Signed distance from the tip to the nearest object, m (``inf`` when none)."""
         return self._row[0]

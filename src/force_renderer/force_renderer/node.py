@@ -4,6 +4,7 @@ Subscribes ``collision/state`` (CollisionState) and, when the materials have dam
 ``velocity_source`` is ``twist``, ``wand/twist`` (TwistStamped). Publishes one ``wand/wrench``
 (WrenchStamped) per state, with the state's header (the pose's stamp and frame), force at the tip,
 zero torque. When no fresh state arrives for ``watchdog_timeout``, it publishes zero wrenches.
+The 1 kHz streams are read and written as CDR bytes (``haptic_util.cdr``).
 """
 from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
 from rclpy.node import Node
@@ -18,15 +19,19 @@ from force_renderer.proxy import GodObjectProxy
 from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
 from haptic_msgs.msg import CollisionState
+from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS, MARKER_QOS
-from haptic_util.stamps import to_nanoseconds
 from haptic_util.tally import Tally
 
 __all__ = ['ForceNode', 'main']
+
+STATE = MessageCodec(CollisionState)
+TWIST = MessageCodec(TwistStamped)
+WRENCH = MessageCodec(WrenchStamped)
 
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -57,14 +62,14 @@ class ForceNode(Node):
         self._published = 0
         self._zeroed = Tally()  # zero forces sent, by reason
         self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
-        self._wrench = WrenchStamped()
+        self._force = (0.0, 0.0, 0.0)
         self._wrench_pub = self.create_publisher(WrenchStamped, 'wand/wrench', HAPTIC_STREAM_QOS)
         self.create_subscription(CollisionState, 'collision/state', self.on_state,
-                                 HAPTIC_STREAM_QOS)
+                                 HAPTIC_STREAM_QOS, raw=True)
         uses_damping = any(max(damping) > 0.0 for _, damping in gains)
         if uses_damping and params.velocity_source == 'twist':
             self.create_subscription(TwistStamped, 'wand/twist', self.on_twist,
-                                     HAPTIC_STREAM_QOS)
+                                     HAPTIC_STREAM_QOS, raw=True)
         self.create_timer(params.watchdog_timeout / 2, self.check_stale)
         self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
         if params.marker_rate > 0:
@@ -104,17 +109,18 @@ class ForceNode(Node):
         laws = {name: SpringDamper(*gain) for name, gain in materials.items()}
         return PerObjectLaw(laws, SpringDamper(*default)), gains
 
-    def on_twist(self, msg: TwistStamped) -> None:
-        v = msg.twist.linear
-        self._twist = (to_nanoseconds(msg.header.stamp), (v.x, v.y, v.z))
+    def on_twist(self, data: bytes) -> None:
+        sec, nanosec, _, vx, vy, vz, _, _, _ = TWIST.decode(data)
+        self._twist = (sec * 1_000_000_000 + nanosec, (vx, vy, vz))
 
-    def on_state(self, msg: CollisionState) -> None:
-        stamp_ns = to_nanoseconds(msg.header.stamp)
-        self._approximate += msg.status == CollisionState.STATUS_NOT_CONVERGED
-        p, n, t = msg.closest_point, msg.normal, msg.tip
-        self._contact = Contact(msg.distance, (p.x, p.y, p.z), (n.x, n.y, n.z), (t.x, t.y, t.z),
-                                msg.object, stamp_ns * 1e-9, msg.status)
-        self._header = msg.header
+    def on_state(self, data: bytes) -> None:
+        (sec, nanosec, frame, name, status, distance, _, px, py, pz, nx, ny, nz, _, _, _,
+         tx, ty, tz, *_) = STATE.decode(data)
+        stamp_ns = sec * 1_000_000_000 + nanosec
+        self._approximate += status == CollisionState.STATUS_NOT_CONVERGED
+        self._contact = Contact(distance, (px, py, pz), (nx, ny, nz), (tx, ty, tz), name,
+                                stamp_ns * 1e-9, status)
+        self._header = (sec, nanosec, frame)
         self.render(self._velocity(stamp_ns))
 
     def _velocity(self, stamp_ns: int):
@@ -130,13 +136,10 @@ class ForceNode(Node):
         reason = self.pipeline.last_reason
         if reason is not Reason.OK:
             self._zeroed.add(reason.value)  # logged at 1 Hz: nothing costly per tick here
-        wrench = self._wrench
         # Even the watchdog's zero carries the stamp of the state it judged, so it never
         # supersedes an answer to a newer pose still on its way to the driver.
-        wrench.header = self._header
-        f = wrench.wrench.force
-        f.x, f.y, f.z = float(force[0]), float(force[1]), float(force[2])
-        self._wrench_pub.publish(wrench)
+        self._force = (float(force[0]), float(force[1]), float(force[2]))
+        self._wrench_pub.publish(WRENCH.encode((*self._header, *self._force, 0.0, 0.0, 0.0)))
         self._published += 1
 
     def check_stale(self) -> None:
@@ -151,12 +154,11 @@ class ForceNode(Node):
         if self._contact is None:
             return
         marker = Marker(ns='force', id=0, type=Marker.ARROW, action=Marker.ADD)
-        marker.header = self._wrench.header
-        force = self._wrench.wrench.force
+        marker.header.stamp.sec, marker.header.stamp.nanosec, marker.header.frame_id = \
+            self._header
         tip = self._contact.tip
         start = (float(tip[0]), float(tip[1]), float(tip[2]))
-        end = (start[0] + ARROW_SCALE * force.x, start[1] + ARROW_SCALE * force.y,
-               start[2] + ARROW_SCALE * force.z)
+        end = tuple(a + ARROW_SCALE * f for a, f in zip(start, self._force))
         marker.points = [Point(x=start[0], y=start[1], z=start[2]),
                          Point(x=end[0], y=end[1], z=end[2])]
         marker.scale.x, marker.scale.y, marker.scale.z = 0.002, 0.004, 0.004

@@ -59,6 +59,7 @@ class MessageCodec:
     """
 
     def __init__(self, message_class) -> None:
+        self.message_class = message_class
         leaves = _leaves(message_class)
         self.fields = tuple(name for name, _ in leaves)
         self._codes = tuple(code for _, code in leaves)
@@ -88,6 +89,17 @@ class MessageCodec:
             args[i + 1:i + 2] = (len(text), text)
             lengths.append(len(text))
         return self._layout(tuple(reversed(lengths)))[0].pack(*args)
+
+    def to_message(self, values: Sequence):
+        """Return a message object with these leaf values (for the paths off the 1 kHz loop)."""
+        message = self.message_class()
+        for field, value in zip(self.fields, values):
+            *parents, leaf = field.split('.')
+            target = message
+            for parent in parents:
+                target = getattr(target, parent)
+            setattr(target, leaf, value)
+        return message
 
     def _layout(self, lengths: tuple) -> tuple:
         """Return the struct of the whole message for these string lengths, built once."""

@@ -14,12 +14,12 @@ from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
+from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
-from haptic_util.stamps import to_nanoseconds
 from haptic_util.tally import Tally
 from haptic_wand_driver.device import DeviceLimits, make_device
 from haptic_wand_driver.experiments import make_script, needs_scene
@@ -31,6 +31,10 @@ from haptic_wand_driver.simulated import SimulatedWandConfig
 from haptic_wand_driver.wrench_input import Refusal, WrenchCommand
 
 __all__ = ['WandDriverNode', 'main']
+
+POSE = MessageCodec(PoseStamped)
+TWIST = MessageCodec(TwistStamped)
+WRENCH = MessageCodec(WrenchStamped)
 
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 IN_FLIGHT_GRACE = 0.05  # [s] after the last pose, for its answer to arrive
@@ -78,13 +82,10 @@ class WandDriverNode(Node):
         self._recorder_ready = False
         self._pushing = False
         self._deadline = -math.inf  # [s] when the wrench applied to the device goes stale
-        self._pose = PoseStamped()
-        self._twist = TwistStamped()
-        self._pose.header.frame_id = self._twist.header.frame_id = params.frame_id
         self._pose_pub = self.create_publisher(PoseStamped, 'wand/pose', HAPTIC_STREAM_QOS)
         self._twist_pub = self.create_publisher(TwistStamped, 'wand/twist', HAPTIC_STREAM_QOS)
         self._wrench_sub = self.create_subscription(WrenchStamped, 'wand/wrench', self.on_wrench,
-                                                    HAPTIC_STREAM_QOS)
+                                                    HAPTIC_STREAM_QOS, raw=True)
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
         self.create_timer(1.0 / params.rate, self.tick)
@@ -159,25 +160,19 @@ class WandDriverNode(Node):
         self.get_logger().info('loop closed: experiment started')
 
     def _publish(self, state, now_ns: int) -> None:
-        sec, nanosec = divmod(now_ns, 1_000_000_000)
-        pose, twist = self._pose, self._twist
-        pose.header.stamp.sec = twist.header.stamp.sec = sec
-        pose.header.stamp.nanosec = twist.header.stamp.nanosec = nanosec
-        p, q = pose.pose.position, pose.pose.orientation
-        p.x, p.y, p.z = (float(v) for v in state.position)
-        q.x, q.y, q.z, q.w = (float(v) for v in state.orientation)
-        linear, angular = twist.twist.linear, twist.twist.angular
-        linear.x, linear.y, linear.z = (float(v) for v in state.linear_velocity)
-        angular.x, angular.y, angular.z = (float(v) for v in state.angular_velocity)
-        self._pose_pub.publish(pose)
-        self._twist_pub.publish(twist)
+        header = (*divmod(now_ns, 1_000_000_000), self.params.frame_id)
+        self._pose_pub.publish(POSE.encode((*header, *state.position.tolist(),
+                                            *state.orientation.tolist())))
+        self._twist_pub.publish(TWIST.encode((*header, *state.linear_velocity.tolist(),
+                                              *state.angular_velocity.tolist())))
         self._published += 1
         self._last_probe_ns = now_ns
 
-    def on_wrench(self, msg: WrenchStamped) -> None:
+    def on_wrench(self, data: bytes) -> None:
         now_ns = self.get_clock().now().nanoseconds
         now = now_ns * 1e-9
-        stamp_ns = to_nanoseconds(msg.header.stamp)
+        wrench = WRENCH.decode(data)
+        stamp_ns = wrench[0] * 1_000_000_000 + wrench[1]
         if self._phase is Phase.PROBING:
             if stamp_ns <= self._last_probe_ns:  # it answers a probe: the loop is closed
                 self._run()
@@ -187,7 +182,7 @@ class WandDriverNode(Node):
             return
         device_now = self._device_time()
         state = self._state = self.device.read(device_now)  # acts from now on
-        refusal = self._take(msg, stamp_ns * 1e-9, now)
+        refusal = self._take(wrench, stamp_ns * 1e-9, now)
         if refusal is not None:
             self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
         self._apply(now, device_now, state)
@@ -212,14 +207,14 @@ class WandDriverNode(Node):
         self._deadline = wrench.expiry
         self.device.apply(force, torque, until=device_now + (self._deadline - now))
 
-    def _take(self, msg: WrenchStamped, stamp: float, now: float) -> Refusal | None:
-        """Hand a received wrench to the command; return why it was refused, or None."""
-        if msg.header.frame_id != self.params.frame_id:
+    def _take(self, wrench: list, stamp: float, now: float) -> Refusal | None:
+        """Hand a received wrench (``WRENCH`` leaves) to the command; return why it was refused."""
+        frame = wrench[2]
+        if frame != self.params.frame_id:
             self.wrench.clear()
             return Refusal('wrench in an unknown frame', f'wrench ignored and force zeroed: '
-                           f'frame_id {msg.header.frame_id!r} is not {self.params.frame_id!r}')
-        f, t = msg.wrench.force, msg.wrench.torque
-        return self.wrench.update((f.x, f.y, f.z), (t.x, t.y, t.z), stamp, now)
+                           f'frame_id {frame!r} is not {self.params.frame_id!r}')
+        return self.wrench.update(wrench[3:6], wrench[6:9], stamp, now)
 
     def on_recorder_ready(self, msg: Bool) -> None:
         self._recorder_ready = msg.data
