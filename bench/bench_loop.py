@@ -1,15 +1,22 @@
-"""Round trip of the haptic loop over ROS 2: pose → collision → force → driver, per process layout.
+"""The haptic loop over ROS 2 against its floor, and the loop's round trip per layout and rate.
 
-    .venv/bin/python bench/bench_loop.py [--layouts separate composed] [--rates 1000]
-                                         [--runs 3] [--duration 10]
+    .venv/bin/python bench/bench_loop.py [--layouts separate composed] [--runs 3]
+                                         [--seconds 8] [--recorder off on]
+    .venv/bin/python bench/bench_loop.py --sweep [--rates 500 1000 2000] [--duration 10]
 
-Each run launches the real nodes (the simulated wand tapping the cuboid), lets the driver's
-session run ``duration`` seconds at ``rate``, and reads the driver's own round-trip record: every
-wrench carries the stamp of the pose it answers, so latency is measured on one clock. Printed per
-run and pooled over runs: achieved pose rate (measured, not the timer setting), share of poses
-answered, latency p50/p90/p99/max, and CPU of the loop's processes (100 % = one core).
+The default compares the loop with its floor (``loop_floor.py``: the same topology with no work
+per hop), alternating floor and loop runs, each with one outside observer (a separate process
+subscribed to the poses and wrenches, as ``ros2 topic echo`` or RViz would be), without and
+with the recorder. Per run: CPU of every process over the window (100 % = one core), and, seen
+by the observer, the pose rate, the share of poses answered by a wrench, and pose -> wrench
+p50 and p99. Then the loop's figures as ratios to the floor's (medians over the runs), and
+whether each target of the CPU issue holds.
+
+``--sweep`` runs the loop alone at several rates and reads the driver's own round-trip record
+(every wrench carries the stamp of its pose, so latency is on one clock).
 """
 import argparse
+import math
 import os
 import pathlib
 import sys
@@ -20,10 +27,14 @@ import machine
 import numpy as np
 import psutil
 
-from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.launcher import add_venv_prefix, Loop, loop_environment, LoopConfig
+from haptic_bringup.processes import start_child, stop_children
 
 SCENE = 'package://collision_engine/scenes/cuboid.yaml'
 CPU_WINDOW_SKIP = 1.0  # [s] CPU is measured inside the session, this far from either end
+FLOOR = pathlib.Path(__file__).resolve().parent / 'loop_floor.py'
+WARM_UP = 3.0  # [s] from start to the window: discovery, the driver's probe, first contacts
+TARGETS = {'cpu': 1.25, 'p99': 1.5, 'rate': 0.99, 'answered': 99.9}  # the CPU issue's
 
 
 def cpu_seconds(pids) -> float:
@@ -67,18 +78,165 @@ def row(label: str, latencies: np.ndarray, record: dict) -> str:
             f' {record["cpu_percent"]:6.0f}')
 
 
+def _floor_children(layout: str, recorder: bool, folder: pathlib.Path, env: dict) -> list:
+    python = sys.executable
+    roles = ['composed'] if layout == 'composed' else ['driver', 'collision', 'force']
+    children = [start_child(role, [python, str(FLOOR), role, '--ros-args'], env)
+                for role in roles]
+    if recorder:
+        children.append(start_child('recorder', [
+            python, '-m', 'haptic_bringup.recorder', '--ros-args', '-p',
+            f'output:={folder / "bag"}'], env))
+    return children
+
+
+def session(kind: str, layout: str, recorder: bool, seconds: float, domain_id: int) -> dict:
+    """One run of the floor or the loop with the outside observer; its figures."""
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = pathlib.Path(tmp)
+        env = loop_environment(domain_id, folder / 'log')
+        observed = folder / 'observed.npz'
+        loop = None
+        if kind == 'loop':
+            loop = Loop(LoopConfig(
+                composed=layout == 'composed', scene=SCENE, experiment='cuboid',
+                record=str(folder / 'bag') if recorder else None, domain_id=domain_id,
+                run_dir=folder / 'launch', overrides={'collision_engine': {'marker_rate': 0.0},
+                                                      'force_renderer': {'marker_rate': 0.0}}))
+            loop.start()
+            children = list(loop.children)
+        else:
+            children = _floor_children(layout, recorder, folder, env)
+        observer = start_child('observer', [sys.executable, str(FLOOR), 'observer',
+                                            str(observed), '--ros-args'], env)
+        try:
+            time.sleep(WARM_UP)
+            processes = {c.name: psutil.Process(c.pid) for c in [*children, observer]}
+            start_cpu = {name: _cpu(p) for name, p in processes.items()}
+            start_ns, start = time.time_ns(), time.monotonic()
+            time.sleep(seconds)
+            wall = time.monotonic() - start
+            end_ns = time.time_ns()
+            cpu = {name: 100.0 * (_cpu(p) - start_cpu[name]) / wall
+                   for name, p in processes.items()}
+        finally:
+            stop_children([observer])
+            if loop is not None:
+                loop.stop()
+            else:
+                stop_children(children)
+        seen = np.load(observed)
+    return {'kind': kind, 'cpu': cpu, **_observed(seen, start_ns, end_ns)}
+
+
+def _cpu(process: psutil.Process) -> float:
+    times = process.cpu_times()
+    return times.user + times.system
+
+
+def _observed(seen, start_ns: int, end_ns: int) -> dict:
+    """Rate, share answered and latency of the poses stamped inside the window."""
+    poses = seen['poses'][(seen['poses'] >= start_ns) & (seen['poses'] < end_ns)]
+    wrenches = seen['wrenches']
+    first = {}
+    for stamp, arrival in wrenches.tolist():
+        first.setdefault(stamp, arrival)
+    latency = np.array([first[s] - s for s in poses.tolist() if s in first]) * 1e-9
+    return {'rate': poses.size / ((end_ns - start_ns) * 1e-9),
+            'answered': 100.0 * latency.size / max(poses.size, 1),
+            'p50': float(np.percentile(latency, 50)) if latency.size else math.nan,
+            'p99': float(np.percentile(latency, 99)) if latency.size else math.nan}
+
+
+def loop_cpu(run: dict) -> float:
+    """CPU of the loop's own processes (not the recorder's, nor the observer's), %."""
+    return sum(v for name, v in run['cpu'].items() if name not in ('recorder', 'observer'))
+
+
+def compare(layout: str, recorder: bool, runs: int, seconds: float, domain_id: int,
+            report=print) -> dict:
+    """Alternate floor and loop runs; return the runs and the loop's ratios to the floor."""
+    floor, loop = [], []
+    for run in range(runs):
+        for kind, runs_of_kind in (('floor', floor), ('loop', loop)):
+            result = session(kind, layout, recorder, seconds, domain_id)
+            runs_of_kind.append(result)
+            report(_run_line(f'{layout}, recorder {"on" if recorder else "off"}, {kind} '
+                             f'#{run + 1}', result))
+    median = {kind: {key: float(np.median([f(r) for r in results])) for key, f in (
+        ('cpu', loop_cpu), ('rate', lambda r: r['rate']), ('answered', lambda r: r['answered']),
+        ('p50', lambda r: r['p50']), ('p99', lambda r: r['p99']))}
+        for kind, results in (('floor', floor), ('loop', loop))}
+    ratios = {key: median['loop'][key] / median['floor'][key]
+              for key in ('cpu', 'rate', 'p50', 'p99')}
+    return {'layout': layout, 'recorder': recorder, 'floor': floor, 'loop': loop,
+            'median': median, 'ratios': ratios}
+
+
+def _run_line(label: str, run: dict) -> str:
+    processes = ', '.join(f'{name} {value:.0f}' for name, value in run['cpu'].items())
+    return (f'{label:<36} loop CPU {loop_cpu(run):5.0f} %  rate {run["rate"]:6.0f} Hz  '
+            f'answered {run["answered"]:7.3f} %  p50 {1e3 * run["p50"]:6.2f} ms  '
+            f'p99 {1e3 * run["p99"]:6.2f} ms  ({processes})')
+
+
+def verdicts(comparison: dict) -> list:
+    """The CPU issue's targets for this comparison: (what, holds)."""
+    ratios, loop = comparison['ratios'], comparison['median']['loop']
+    checks = [(f'loop CPU {ratios["cpu"]:.2f} x the floor\'s (target <= {TARGETS["cpu"]})',
+               ratios['cpu'] <= TARGETS['cpu'])]
+    if comparison['recorder']:
+        checks += [
+            (f'answered {loop["answered"]:.2f} % (target >= {TARGETS["answered"]})',
+             loop['answered'] >= TARGETS['answered']),
+            (f'p99 {ratios["p99"]:.2f} x the floor\'s (target <= {TARGETS["p99"]})',
+             ratios['p99'] <= TARGETS['p99']),
+            (f'rate {ratios["rate"]:.3f} x the floor\'s (target >= {TARGETS["rate"]})',
+             ratios['rate'] >= TARGETS['rate'])]
+    return checks
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--layouts', nargs='+', default=['separate', 'composed'],
                         choices=['separate', 'composed'])
+    parser.add_argument('--recorder', nargs='+', default=['off', 'on'], choices=['off', 'on'])
+    parser.add_argument('--runs', type=int, default=3, help='floor/loop pairs per case')
+    parser.add_argument('--seconds', type=float, default=8.0, help='measured window per run')
+    parser.add_argument('--sweep', action='store_true', help='the loop alone at --rates')
     parser.add_argument('--rates', nargs='+', type=float, default=[1000.0])
-    parser.add_argument('--runs', type=int, default=3)
-    parser.add_argument('--duration', type=float, default=10.0)
+    parser.add_argument('--duration', type=float, default=10.0, help='per --sweep run')
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     print(f'machine: {machine.line("rclpy", "numba")}')
+    if args.sweep:
+        return sweep(args)
+    print(f'{args.runs} alternated floor/loop pair(s) of {args.seconds:g} s per case; CPU in % '
+          'of one core; rate, answered and latency seen by the outside observer')
+    table = []
+    for layout in args.layouts:
+        for recorder in args.recorder:
+            comparison = compare(layout, recorder == 'on', args.runs, args.seconds,
+                                 args.domain_id, report=lambda line: print(line, flush=True))
+            table.append(comparison)
+    print()
+    print(f'{"case":<28} {"CPU x":>6} {"rate x":>7} {"answered %":>11} {"p50 x":>6} '
+          f'{"p99 x":>6}  targets')
+    for comparison in table:
+        ratios, loop = comparison['ratios'], comparison['median']['loop']
+        held = all(ok for _, ok in verdicts(comparison))
+        case = f'{comparison["layout"]}, recorder {"on" if comparison["recorder"] else "off"}'
+        print(f'{case:<28} '
+              f'{ratios["cpu"]:6.2f} {ratios["rate"]:7.3f} {loop["answered"]:11.3f} '
+              f'{ratios["p50"]:6.2f} {ratios["p99"]:6.2f}  {"held" if held else "MISSED"}')
+        for what, ok in verdicts(comparison):
+            print(f'    {"ok  " if ok else "MISS"} {what}')
+    return 0
+
+
+def sweep(args) -> int:
     print(f'{args.runs} run(s) of {args.duration:g} s per layout and rate; latency in ms; '
           'CPU in % of one core, all loop processes')
     print(f'{"layout / rate / run":<28} {"pose Hz":>7} {"answered":>8} {"p50":>7} {"p90":>7} '

@@ -47,7 +47,7 @@ BENCHMARKS = (
     Benchmark('collision', 'bench_collision.py', ('--random', '200', '--near', '200',
                                                   '--tapping', '1')),
     Benchmark('wand_driver', 'bench_wand_driver.py', ('--repeats', '2', '--seconds', '2')),
-    Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--duration', '3')),
+    Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3')),
     Benchmark('loop_stats', 'bench_loop_stats.py', ('--hours', '0.1', '1')),
     Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5')),
     Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4')),
