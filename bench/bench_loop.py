@@ -181,7 +181,7 @@ def _run_line(label: str, run: dict) -> str:
 
 
 def verdicts(comparison: dict) -> list:
-    """The CPU issue's targets for this comparison: (what, holds)."""
+    """Return the CPU issue's targets for this comparison, as (what, holds) pairs."""
     ratios, loop = comparison['ratios'], comparison['median']['loop']
     checks = [(f'loop CPU {ratios["cpu"]:.2f} x the floor\'s (target <= {TARGETS["cpu"]})',
                ratios['cpu'] <= TARGETS['cpu'])]
