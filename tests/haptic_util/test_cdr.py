@@ -11,7 +11,8 @@ from rclpy.serialization import deserialize_message, serialize_message
 from haptic_util.cdr import MessageCodec
 
 TYPES = ['geometry_msgs/PoseStamped', 'geometry_msgs/TwistStamped',
-         'geometry_msgs/WrenchStamped', 'haptic_msgs/CollisionState', 'std_msgs/Header']
+         'geometry_msgs/WrenchStamped', 'haptic_msgs/CollisionState', 'haptic_msgs/ContactModel',
+         'std_msgs/Header']
 LEAF = {'?': st.booleans(), 'B': st.integers(0, 255), 'I': st.integers(0, 2**32 - 1),
         'i': st.integers(-2**31, 2**31 - 1), 'd': st.floats(allow_nan=False),
         'string': st.text(max_size=40).filter(lambda s: '\0' not in s)}
@@ -25,10 +26,16 @@ def message_class(type_name: str):
 
 
 def message_from(cls, codec: MessageCodec, values):
+    """Set each leaf by its dotted name (an element of an array by hand, not by the codec)."""
     message = cls()
     for field, value in zip(codec.fields, values):
+        target = message
         *parents, leaf = field.split('.')
-        target = functools.reduce(getattr, parents, message)
+        for parent in parents:
+            name, _, index = parent.partition('[')
+            target = getattr(target, name)
+            if index:
+                target = target[int(index[:-1])]
         setattr(target, leaf, value)
     return message
 
@@ -68,6 +75,18 @@ def test_the_fields_are_the_message_s_leaves_in_order():
                             'pose.position.x', 'pose.position.y', 'pose.position.z',
                             'pose.orientation.x', 'pose.orientation.y', 'pose.orientation.z',
                             'pose.orientation.w')
+
+
+def test_a_fixed_array_of_messages_is_flattened_element_by_element():
+    codec = MessageCodec(message_class('haptic_msgs/ContactModel'))
+    assert codec.fields[6:9] == ('planes[0].point.x', 'planes[0].point.y', 'planes[0].point.z')
+    assert 'planes[2].tool_point.z' in codec.fields and len(codec.fields) == 6 + 45 + 6
+    values = list(range(len(codec.fields)))
+    values[2], values[3] = 'world', 'hand'
+    values[4:] = [float(v) if codec._codes[i + 4] == 'd' else v % 256
+                  for i, v in enumerate(values[4:])]
+    assert codec.to_message(values) == message_from(message_class('haptic_msgs/ContactModel'),
+                                                    codec, values)
 
 
 def test_non_finite_numbers_pass_through():

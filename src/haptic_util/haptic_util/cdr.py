@@ -6,8 +6,9 @@ bytes used 21-37 % of a core per process against 37-51 % with objects). A node t
 with ``raw=True`` gets the serialized bytes; ``Publisher.publish`` takes bytes too. What the node
 reads and writes is a flat tuple of the message's leaf fields, in the order of its definition.
 
-Scope: messages whose leaves are numbers, booleans and strings, nested to any depth (no arrays or
-sequences): the stamped poses, twists and wrenches, and ``haptic_msgs/CollisionState``. The
+Scope: messages whose leaves are numbers, booleans and strings, nested to any depth, with
+fixed-size arrays (no sequences): the stamped poses, twists and wrenches, and
+``haptic_msgs/CollisionState`` and ``ContactModel``. The
 layout is little-endian plain CDR (XCDR1), as Fast DDS writes it: a 4-byte encapsulation header,
 then each field aligned to its own size from the end of that header; a string is a ``uint32``
 length (including its NUL), the bytes and the NUL. The layout of a message depends only on the
@@ -15,6 +16,7 @@ lengths of its strings, so one ``struct.Struct`` per combination of lengths is b
 ``tests/haptic_util/test_cdr.py`` checks both directions against ``rclpy.serialization``.
 """
 import importlib
+import re
 import struct
 from typing import Sequence
 
@@ -24,6 +26,7 @@ _LEAVES = {'boolean': '?', 'octet': 'B', 'uint8': 'B', 'int8': 'b', 'char': 'B',
            'uint16': 'H', 'int32': 'i', 'uint32': 'I', 'int64': 'q', 'uint64': 'Q',
            'float': 'f', 'double': 'd'}
 _ENCAPSULATION = b'\x00\x01\x00\x00'  # CDR, little endian
+_FIXED_ARRAY = re.compile(r'(.+)\[(\d+)\]')  # T[N]: N elements, no length on the wire
 _STRING = 'string'
 
 
@@ -36,12 +39,17 @@ def _leaves(message_class, prefix: str = '') -> list:
     """Return the leaf fields, depth first: [(dotted name, struct code or "string")]."""
     leaves = []
     for name, kind in message_class.get_fields_and_field_types().items():
-        if kind in _LEAVES or kind == _STRING:
-            leaves.append((prefix + name, _LEAVES.get(kind, _STRING)))
-        elif '/' in kind and '[' not in kind and '<' not in kind:
-            leaves += _leaves(_message_class(kind), f'{prefix}{name}.')
-        else:
-            raise ValueError(f'{message_class.__name__}.{prefix}{name}: {kind} is not supported')
+        array = _FIXED_ARRAY.fullmatch(kind)
+        names = ([f'{prefix}{name}[{i}]' for i in range(int(array[2]))] if array
+                 else [prefix + name])
+        kind = array[1] if array else kind
+        for element in names:
+            if kind in _LEAVES or kind == _STRING:
+                leaves.append((element, _LEAVES.get(kind, _STRING)))
+            elif '/' in kind and '[' not in kind and '<' not in kind:
+                leaves += _leaves(_message_class(kind), f'{element}.')
+            else:
+                raise ValueError(f'{message_class.__name__}.{element}: {kind} is not supported')
     return leaves
 
 
@@ -94,11 +102,14 @@ class MessageCodec:
         """Return a message object with these leaf values (for the paths off the 1 kHz loop)."""
         message = self.message_class()
         for field, value in zip(self.fields, values):
-            *parents, leaf = field.split('.')
+            *parents, leaf = _steps(field)
             target = message
             for parent in parents:
-                target = getattr(target, parent)
-            setattr(target, leaf, value)
+                target = target[parent] if isinstance(parent, int) else getattr(target, parent)
+            if isinstance(leaf, int):
+                target[leaf] = value
+            else:
+                setattr(target, leaf, value)
         return message
 
     def _layout(self, lengths: tuple) -> tuple:
@@ -138,3 +149,14 @@ class MessageCodec:
                     offset += size
             self._string_offsets[before] = len(_ENCAPSULATION) + offset
         return self._string_offsets[before]
+
+
+def _steps(field: str) -> list:
+    """``'planes[1].point.x'`` -> ``['planes', 1, 'point', 'x']``."""
+    steps = []
+    for part in field.split('.'):
+        name, _, index = part.partition('[')
+        steps.append(name)
+        if index:
+            steps.append(int(index[:-1]))
+    return steps
