@@ -8,7 +8,8 @@ import re
 
 from run_all import BENCH, Benchmark, BENCHMARKS, run, summary
 
-NOT_BENCHMARKS = {'run_all.py', 'report.py'}  # runnable, but the runner and the report
+NOT_BENCHMARKS = {'run_all.py', 'report.py', 'loop_floor.py'}  # the runner, the report, and
+# the processes bench_loop.py starts
 
 
 def runnable_scripts() -> set[str]:

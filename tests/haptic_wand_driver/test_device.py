@@ -113,6 +113,9 @@ class _Stationary(HapticDevice):
     def apply(self, force, torque):
         self._raise_if_closed()
 
+    def applied(self):
+        return np.zeros(3), np.zeros(3)
+
 
 def test_registered_backend_is_built_with_its_options(monkeypatch):
     monkeypatch.setattr(device, '_registered', {})

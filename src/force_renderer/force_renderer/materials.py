@@ -35,5 +35,9 @@ class PerObjectLaw:
         """Return the axis of the contact's object's law; see `ForceLaw.axis`."""
         return self._law(contact).axis(contact)
 
+    def planes(self, contact: Contact):
+        """Return the planes of the contact's object's law; see `ForceLaw.planes`."""
+        return self._law(contact).planes(contact)
+
     def _law(self, contact: Contact) -> ForceLaw:
         return self.laws.get(contact.object, self.default)

@@ -3,14 +3,17 @@
 Subscribes ``collision/state`` (CollisionState) and, when the materials have damping and
 ``velocity_source`` is ``twist``, ``wand/twist`` (TwistStamped). Publishes one ``wand/wrench``
 (WrenchStamped) per state, with the state's header (the pose's stamp and frame), force at the tip,
-zero torque. When no fresh state arrives for ``watchdog_timeout``, it publishes zero wrenches.
-The 1 kHz streams are read and written as CDR bytes (``haptic_util.cdr``).
+zero torque: the reference force, which a device without local rendering applies. With it, one
+``wand/contact_model`` (ContactModel): the local model the device renders at its servo rate.
+When no fresh state arrives for ``watchdog_timeout``, it publishes zero wrenches (and models that
+render nothing). The 1 kHz streams are read and written as CDR bytes (``haptic_util.cdr``).
 """
 from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
 from rclpy.node import Node
 from visualization_msgs.msg import Marker
 
 from force_renderer.contact import Contact
+from force_renderer.local_model import local_model, MAX_PLANES
 from force_renderer.materials import PerObjectLaw
 from force_renderer.params import ForceRendererParams
 from force_renderer.passivity import passivity_warning
@@ -18,7 +21,7 @@ from force_renderer.pipeline import ForcePipeline, PipelineConfig
 from force_renderer.proxy import GodObjectProxy
 from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
-from haptic_msgs.msg import CollisionState
+from haptic_msgs.msg import CollisionState, ContactModel
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
@@ -29,6 +32,8 @@ from haptic_util.tally import Tally
 
 __all__ = ['ForceNode', 'main']
 
+MODEL = MessageCodec(ContactModel)
+PLANE_FIELDS = 15  # leaves of a ContactPlane
 STATE = MessageCodec(CollisionState)
 TWIST = MessageCodec(TwistStamped)
 WRENCH = MessageCodec(WrenchStamped)
@@ -64,6 +69,8 @@ class ForceNode(Node):
         self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
         self._force = (0.0, 0.0, 0.0)
         self._wrench_pub = self.create_publisher(WrenchStamped, 'wand/wrench', HAPTIC_STREAM_QOS)
+        self._model_pub = self.create_publisher(ContactModel, 'wand/contact_model',
+                                                HAPTIC_STREAM_QOS)
         self.create_subscription(CollisionState, 'collision/state', self.on_state,
                                  HAPTIC_STREAM_QOS, raw=True)
         uses_damping = any(max(damping) > 0.0 for _, damping in gains)
@@ -140,7 +147,19 @@ class ForceNode(Node):
         # supersedes an answer to a newer pose still on its way to the driver.
         self._force = (float(force[0]), float(force[1]), float(force[2]))
         self._wrench_pub.publish(WRENCH.encode((*self._header, *self._force, 0.0, 0.0, 0.0)))
+        model = local_model(self.pipeline.law, self._contact, reason is Reason.OK,
+                            self.params.model_radius)
+        self._model_pub.publish(MODEL.encode(self._model_fields(model)))
         self._published += 1
+
+    def _model_fields(self, model) -> tuple:
+        """Return the leaf fields of the ContactModel of ``model`` and the current contact."""
+        planes = [value for point, normal, stiffness, damping in model.planes
+                  for value in (*point, *normal, *stiffness, *damping, 0.0, 0.0, 0.0)]
+        planes += [0.0] * (PLANE_FIELDS * MAX_PLANES - len(planes))
+        tip = self._contact.tip.tolist()
+        return (*self._header, self._contact.object, model.kind, len(model.planes), *planes,
+                self.params.force_limit, self.params.model_lifetime, model.valid_radius, *tip)
 
     def check_stale(self) -> None:
         """Publish zero force while the collision state is stale (after the first one)."""

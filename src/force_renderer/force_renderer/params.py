@@ -31,6 +31,11 @@ class ForceRendererParams:
                                    unit='N*s/m', low=0.0)
     watchdog_timeout: float = parameter(0.010, 'no fresh collision state for this long: zero '
                                         'force', unit='s', low=0.0005, high=1.0)
+    model_radius: float = parameter(0.002, 'contact models: planes are sent within this '
+                                    'distance of a surface, and hold this far from the tip',
+                                    unit='m', low=1e-5, high=0.1)
+    model_lifetime: float = parameter(0.010, 'contact models hold this long after their '
+                                      'pose\'s stamp', unit='s', low=0.0005, high=1.0)
     velocity_source: str = parameter('twist', 'twist: the driver\'s wand/twist; estimate: from '
                                      'the stamped tip positions', choices=('twist', 'estimate'))
     marker_rate: float = parameter(10.0, 'rate of the RViz force arrow; 0 disables it',

@@ -19,7 +19,7 @@ import numpy as np
 
 from force_renderer._checks import count, floats3, per_axis, positive, vector3
 from force_renderer.contact import Contact
-from force_renderer.spring_damper import unilateral_spring_damper
+from force_renderer.spring_damper import nearest_plane, unilateral_spring_damper
 
 __all__ = ['GodObjectProxy']
 
@@ -66,6 +66,7 @@ class GodObjectProxy:
         self.tolerance = positive(tolerance, 'tolerance')
         self._proxy: np.ndarray | None = None
         self._touching = False
+        self._planes: list[tuple[np.ndarray, np.ndarray]] = []
 
     @property
     def proxy(self) -> np.ndarray | None:
@@ -85,6 +86,7 @@ class GodObjectProxy:
         """Forget the proxy; the next update starts it at the tip (or on the surface near it)."""
         self._proxy = None
         self._touching = False
+        self._planes = []
 
     def force(self, contact: Contact, velocity) -> np.ndarray:
         """Force on the tip, (3,) float, N: K⊙(proxy − tip) − C⊙v while touching, else zero.
@@ -107,6 +109,18 @@ class GodObjectProxy:
             return None
         stretch = self._proxy - contact.tip
         return tuple((stretch / float(np.linalg.norm(stretch))).tolist())
+
+    def planes(self, contact: Contact) -> list:
+        """Return the planes holding the proxy, or the nearest one; see `ForceLaw.planes`.
+
+        Touching, the planes that stopped the proxy (up to three) carry its spring: each pushes
+        the tip by its depth behind it. Else the tangent plane at the closest point.
+        """
+        gains = (tuple(self.stiffness.tolist()), tuple(self.damping.tolist()))
+        if not self._planes:
+            return [nearest_plane(contact) + gains]
+        return [(tuple(point.tolist()), tuple(normal.tolist())) + gains
+                for point, normal in self._planes]
 
     def update(self, tip) -> np.ndarray:
         """Move the proxy towards `tip` (3,) m and return its new position (3,) m."""
@@ -131,6 +145,7 @@ class GodObjectProxy:
         self._proxy = proxy
         held_back = hit is not None or goal is not tip
         self._touching = held_back and float(np.linalg.norm(proxy - tip)) > self.tolerance
+        self._planes = list(planes) if self._touching else []
         return proxy.copy()
 
     def _onto_surface(self, point: np.ndarray) -> np.ndarray:

@@ -15,7 +15,8 @@ from force_renderer._checks import floats3, per_axis, vector3
 from force_renderer.contact import Contact
 from force_renderer.errors import ForceRendererError
 
-__all__ = ['CentroidSpringDamper', 'ForceLaw', 'SpringDamper', 'unilateral_spring_damper']
+__all__ = ['CentroidSpringDamper', 'ForceLaw', 'SpringDamper', 'nearest_plane',
+           'unilateral_spring_damper']
 
 Vector3 = tuple[float, float, float]
 
@@ -33,6 +34,13 @@ class ForceLaw(Protocol):
         """Return the unit direction its spring pushes the tip along (last `force`), or None.
 
         The passivity controller damps along it only (see `passivity`).
+        """
+
+    def planes(self, contact: Contact) -> list | None:
+        """Return the planes a device may render for this contact, or None if it has no model.
+
+        Each plane is (point (3,) m, unit outward normal (3,), stiffness (3,) N/m, damping (3,)
+        N·s/m), the point on the plane the tip's centre may not cross (``local_model``).
         """
 
 
@@ -65,6 +73,18 @@ def unilateral_spring_damper(displacement: Vector3, normal: Vector3, velocity: V
     return fx, fy, fz
 
 
+def nearest_plane(contact: Contact) -> tuple[Vector3, Vector3]:
+    """Return the tangent plane at the closest point, as (point, outward normal).
+
+    The point is the tip moved back to the surface along the normal, ``tip - distance·normal``:
+    the plane the tip's centre may not cross, for a point tip (the closest point itself) and a
+    sphere tip (the surface moved out by its radius) alike.
+    """
+    n = tuple(contact.normal.tolist())
+    tip, d = contact.tip.tolist(), contact.distance
+    return (tip[0] - d * n[0], tip[1] - d * n[1], tip[2] - d * n[2]), n
+
+
 class SpringDamper:
     """F = K⊙x − C⊙v in contact (x = depth × outward normal), never attractive; zero outside.
 
@@ -93,6 +113,10 @@ class SpringDamper:
     def axis(self, contact: Contact) -> Vector3 | None:
         """Return the outward surface normal in contact; see `ForceLaw.axis`."""
         return tuple(contact.normal.tolist()) if contact.in_contact else None
+
+    def planes(self, contact: Contact) -> list:
+        """Return the tangent plane at the closest point; see `ForceLaw.planes`."""
+        return [nearest_plane(contact) + (self._stiffness, self._damping)]
 
 
 class CentroidSpringDamper:
@@ -126,6 +150,10 @@ class CentroidSpringDamper:
         length = math.sqrt(float(radial @ radial))
         spring = radial * (-contact.distance / length) if length > 0.0 else np.zeros(3)
         return self.stiffness * spring - self.damping * np.asarray(velocity, dtype=np.float64)
+
+    def planes(self, contact: Contact) -> None:
+        """Return None: a push away from a centroid is no surface (see `ForceLaw.planes`)."""
+        return None
 
     def axis(self, contact: Contact) -> Vector3 | None:
         """Return the direction away from the centroid in contact; see `ForceLaw.axis`."""

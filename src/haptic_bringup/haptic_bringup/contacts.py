@@ -8,9 +8,13 @@ import dataclasses
 
 import numpy as np
 
-__all__ = ['ContactInterval', 'contact_intervals', 'format_contacts']
+__all__ = ['ContactInterval', 'REBOUND_HEIGHT', 'contact_intervals', 'contacts',
+           'format_contacts']
 
 MIN_FORCE = 1e-6  # [N] below this a force has no direction worth measuring
+# [m] a tip that leaves the surface by less before it re-enters is still in the same contact:
+# a felt rebound lifts by millimetres, a tip settling on a stiff wall by microns.
+REBOUND_HEIGHT = 1e-4
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -31,14 +35,28 @@ class ContactInterval:
         return self.end - self.start
 
 
-def contact_intervals(session, *, min_samples: int = 3) -> list:
-    """List the contacts in time order; runs shorter than ``min_samples`` are grazes."""
-    inside = session.distance < 0.0
+def contacts(distance: np.ndarray, *, min_samples: int = 3) -> list:
+    """(first, stop) sample ranges of the contacts in a signed-distance series (m).
+
+    A contact is a run of samples inside (distance < 0); two runs whose gap stays lower than
+    ``REBOUND_HEIGHT`` above the surface are one contact; runs shorter than ``min_samples`` are
+    grazes.
+    """
+    inside = np.asarray(distance) < 0.0
     edges = np.flatnonzero(np.diff(np.concatenate([[0], inside.astype(np.int8), [0]])))
-    intervals = []
+    runs = []
     for first, stop in zip(edges[::2], edges[1::2]):
-        if stop - first < min_samples:
-            continue
+        if runs and np.max(distance[runs[-1][1]:first]) < REBOUND_HEIGHT:
+            runs[-1] = (runs[-1][0], stop)
+        else:
+            runs.append((first, stop))
+    return [(first, stop) for first, stop in runs if stop - first >= min_samples]
+
+
+def contact_intervals(session, *, min_samples: int = 3) -> list:
+    """List the contacts in time order (see ``contacts``)."""
+    intervals = []
+    for first, stop in contacts(session.distance, min_samples=min_samples):
         window = slice(first, stop)
         force = session.force[window]
         answered = np.all(np.isfinite(force), axis=1)

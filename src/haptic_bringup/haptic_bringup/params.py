@@ -13,6 +13,8 @@ LOOP_TOPICS = {
     '/wand/twist': 'geometry_msgs/msg/TwistStamped',
     '/collision/state': 'haptic_msgs/msg/CollisionState',
     '/wand/wrench': 'geometry_msgs/msg/WrenchStamped',
+    '/wand/contact_model': 'haptic_msgs/msg/ContactModel',
+    '/wand/applied_wrench': 'geometry_msgs/msg/WrenchStamped',
     '/scene/description': 'std_msgs/msg/String',
     '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
 }

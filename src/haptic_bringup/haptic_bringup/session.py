@@ -11,7 +11,8 @@ from rosbags.highlevel import AnyReader
 
 from haptic_util.stamps import to_nanoseconds
 
-__all__ = ['Session', 'read_session', 'topic_counts', 'published_counts', 'PUBLISHERS']
+__all__ = ['Session', 'read_session', 'topic_counts', 'published_counts', 'applied_work',
+           'PUBLISHERS']
 
 # Which node publishes each stream, by its name in /diagnostics reports.
 PUBLISHERS = {'/wand/pose': 'wand_driver', '/wand/twist': 'wand_driver',
@@ -29,6 +30,8 @@ class Session:
     distance : (n,) float, m, signed, negative inside
     point, normal : (n, 3) float: closest surface point (m) and unit outward normal
     force : (n, 3) float, N, the wrench answering the pose (NaN when none came)
+    applied : (n, 3) float, N, the force the device applied over the tick that ended with the
+        pose (``wand/applied_wrench``; NaN when not recorded)
     objects : (n,) str
     status : (n,) int, CollisionState status
     compute_time : (n,) float, s
@@ -42,6 +45,7 @@ class Session:
     point: np.ndarray
     normal: np.ndarray
     force: np.ndarray
+    applied: np.ndarray
     objects: np.ndarray
     status: np.ndarray
     compute_time: np.ndarray
@@ -74,7 +78,7 @@ def published_counts(path: pathlib.Path, typestore) -> dict:
 
 def read_session(path: pathlib.Path, typestore) -> Session:
     """Join a bag's collision states and wrenches on their stamps."""
-    states, wrenches, scene = {}, {}, ''
+    states, wrenches, applied, scene = {}, {}, {}, ''
     with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
         for connection, _, raw in reader.messages():
             msg = reader.deserialize(raw, connection.msgtype)
@@ -82,6 +86,8 @@ def read_session(path: pathlib.Path, typestore) -> Session:
                 states[to_nanoseconds(msg.header.stamp)] = msg
             elif connection.topic == '/wand/wrench':
                 wrenches[to_nanoseconds(msg.header.stamp)] = msg
+            elif connection.topic == '/wand/applied_wrench':
+                applied[to_nanoseconds(msg.header.stamp)] = msg
             elif connection.topic == '/scene/description':
                 scene = msg.data
     stamps = sorted(states)
@@ -97,12 +103,25 @@ def read_session(path: pathlib.Path, typestore) -> Session:
         point=np.array([_xyz(m.closest_point) for m in rows]),
         normal=np.array([_xyz(m.normal) for m in rows]),
         force=np.array(forces),
+        applied=np.array([_xyz(applied[s].wrench.force) if s in applied else nan3
+                          for s in stamps]),
         objects=np.array([m.object for m in rows]),
         status=np.array([m.status for m in rows]),
         compute_time=np.array([m.compute_time for m in rows]),
         fcl_distance=np.array([m.fcl_distance for m in rows]),
         fcl_discrepancy=np.array([m.fcl_discrepancy for m in rows]),
         scene=scene)
+
+
+def applied_work(session: Session) -> float:
+    """Net work (J) the applied force did on the tip: > 0 means the device gave energy.
+
+    Each tick's mean applied force times the tip's displacement over that tick, from the
+    recorded poses (via their states); ticks whose neighbours are missing are left out.
+    """
+    step = np.diff(session.tip, axis=0)
+    work = np.einsum('ij,ij->i', session.applied[1:], step)
+    return float(np.nansum(work))
 
 
 def _xyz(vector) -> tuple:

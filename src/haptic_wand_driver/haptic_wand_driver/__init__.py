@@ -3,9 +3,11 @@
 Pure Python and numpy; the ROS node around it lives in ``node.py``.
 """
 
+from haptic_wand_driver.contact_model import ContactModel, ModelRefused
 from haptic_wand_driver.device import (
     available_devices, DeviceClosedError, DeviceLimits, DeviceUnavailableError, HapticDevice,
-    make_device, register_device, WandState, Workspace)
+    LocalRenderingUnsupported, make_device, register_device, WandState, Workspace)
+from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.orientation import (
     PitchError, quaternion_from_roll_yaw, roll_yaw_from_quaternion, roll_yaw_jacobian)
@@ -18,10 +20,14 @@ from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
 from haptic_wand_driver.wrench_input import saturate, WrenchCommand
 
 __all__ = [
+    'ContactModel',
     'DeviceClosedError',
     'DeviceLimits',
     'DeviceUnavailableError',
     'HapticDevice',
+    'LocalRenderer',
+    'LocalRenderingUnsupported',
+    'ModelRefused',
     'OperatorHand',
     'PitchError',
     'PoseFileError',

@@ -24,6 +24,14 @@ Wrench
     ``until`` deadline passes, whichever comes first (a device-level watchdog). A backend
     renders only what it can actuate (forces x, y, z; torques about its roll and yaw axes) and
     saturates to its declared ``limits``; non-finite or mis-shaped input raises ``ValueError``.
+Local rendering
+    A backend with a servo loop of its own may take a law to run there every servo period
+    (``render_locally``: a ``LocalRenderer``, which renders the latest contact model against the
+    device's current state); from then on it renders that law instead of the held wrench. One
+    that cannot raises ``LocalRenderingUnsupported``, and the driver applies the wrench.
+Applied wrench
+    ``applied`` reports what the device actually rendered since the previous call (its mean over
+    the servo periods, after saturation and watchdog), so that what the hand felt is observable.
 Lifetime
     ``close`` is idempotent and leaves the device commanding no force; afterwards ``read`` and
     ``apply`` raise :class:`DeviceClosedError`. Devices are context managers.
@@ -46,6 +54,7 @@ __all__ = [
     'DeviceLimits',
     'DeviceUnavailableError',
     'HapticDevice',
+    'LocalRenderingUnsupported',
     'WandState',
     'Workspace',
     'available_devices',
@@ -62,6 +71,10 @@ class DeviceUnavailableError(ValueError):
 
 class DeviceClosedError(RuntimeError):
     """The device was used after ``close()``."""
+
+
+class LocalRenderingUnsupported(ValueError):
+    """The backend cannot run a law in a servo loop of its own."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -232,6 +245,24 @@ class HapticDevice(abc.ABC):
         even if no further call comes, so a dead loop cannot leave a force on the user's hand.
         A backend with a hardware watchdog arms it with this deadline.
         """
+
+    @abc.abstractmethod
+    def applied(self) -> tuple[np.ndarray, np.ndarray]:
+        """Return the force (3,) N and torque (3,) N·m rendered since the last call, their means.
+
+        Workspace frame, after the device's saturation and watchdog; zero before anything was
+        rendered.
+        """
+
+    def render_locally(self, law) -> None:
+        """Run ``law`` in the device's servo loop from now on, instead of the held wrench.
+
+        ``law.wrench(time, coordinates, rates, period) -> (force, torque)`` is called every servo
+        period with the device's clock, its joints (x, y, z, roll, yaw) and their rates.
+        Backends without a servo loop of their own keep this default.
+        """
+        raise LocalRenderingUnsupported(f'{type(self).__name__} has no servo loop of its own to '
+                                        'render a contact model in')
 
     def close(self) -> None:
         """Stop rendering and release the device; idempotent.

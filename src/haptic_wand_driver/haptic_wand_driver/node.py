@@ -14,6 +14,7 @@ from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
+from haptic_msgs.msg import ContactModel as ContactModelMessage
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
@@ -21,8 +22,10 @@ from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
 from haptic_util.tally import Tally
-from haptic_wand_driver.device import DeviceLimits, make_device
+from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
+from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
 from haptic_wand_driver.experiments import make_script, needs_scene
+from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.loop_stats import LoopStats
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
@@ -32,6 +35,7 @@ from haptic_wand_driver.wrench_input import Refusal, WrenchCommand
 
 __all__ = ['WandDriverNode', 'main']
 
+MODEL = MessageCodec(ContactModelMessage)
 POSE = MessageCodec(PoseStamped)
 TWIST = MessageCodec(TwistStamped)
 WRENCH = MessageCodec(WrenchStamped)
@@ -71,6 +75,9 @@ class WandDriverNode(Node):
         # The observer always runs (its books are the port's energy figures); the controller acts
         # only when enabled.
         self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
+        self.renderer = self._local_renderer() if params.rendering == 'local' else None
+        self._model_stamp = -math.inf  # of the newest model taken
+        self._model_unavailable = False  # the law sends no model: the wrench is rendered
         self._period = 1.0 / params.rate
         self._phase = Phase.WAITING
         self._state = None
@@ -84,14 +91,35 @@ class WandDriverNode(Node):
         self._deadline = -math.inf  # [s] when the wrench applied to the device goes stale
         self._pose_pub = self.create_publisher(PoseStamped, 'wand/pose', HAPTIC_STREAM_QOS)
         self._twist_pub = self.create_publisher(TwistStamped, 'wand/twist', HAPTIC_STREAM_QOS)
+        self._applied_pub = self.create_publisher(WrenchStamped, 'wand/applied_wrench',
+                                                  HAPTIC_STREAM_QOS)
         self._wrench_sub = self.create_subscription(WrenchStamped, 'wand/wrench', self.on_wrench,
                                                     HAPTIC_STREAM_QOS, raw=True)
+        if self.renderer is not None:
+            self.create_subscription(ContactModelMessage, 'wand/contact_model', self.on_model,
+                                     HAPTIC_STREAM_QOS, raw=True)
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
         self.create_timer(1.0 / params.rate, self.tick)
         self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
+        rendering = 'local' if self.renderer is not None else 'remote'
         self.get_logger().info(f'{params.device} wand at {params.rate:g} Hz in frame '
-                               f'{params.frame_id!r}; waiting for the loop to connect')
+                               f'{params.frame_id!r}, {rendering} rendering; waiting for the loop '
+                               'to connect')
+
+    def _local_renderer(self) -> LocalRenderer | None:
+        """Return the device's servo-rate law, or None (logged) if the device cannot run one."""
+        limits = self.device.limits
+        renderer = LocalRenderer(
+            force_limit=limits.force_limit, torque_limit=limits.torque_limit,
+            passivity=self.passivity, mass=[self.params.device_mass] * 3,
+            contact_damping_ratio=self.params.contact_damping_ratio)
+        try:
+            self.device.render_locally(renderer)
+        except LocalRenderingUnsupported as error:
+            self.get_logger().warn(f'rendering local: {error}; it applies the wrench instead')
+            return None
+        return renderer
 
     def _make_device(self, params: WandDriverParams):
         if params.device == 'replay':
@@ -106,6 +134,7 @@ class WandDriverNode(Node):
                 self.get_logger().info)
         config = SimulatedWandConfig(
             mass=[params.device_mass] * 3, damping=[params.device_damping] * 3,
+            step=1.0 / params.servo_rate,
             limits=DeviceLimits(force_limit=params.force_limit,
                                 torque_limit=params.torque_limit))
         hand = OperatorHand(make_script(params.experiment, project),
@@ -137,7 +166,8 @@ class WandDriverNode(Node):
         elif self._phase is Phase.RUNNING:
             device_now = self._device_time()
             state = self._state = self.device.read(device_now)
-            self._apply(now, device_now, state)
+            if self.renderer is None:
+                self._apply(now, device_now, state)
             self._publish(state, now_ns)
             self.stats.sent(now_ns)
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
@@ -165,6 +195,8 @@ class WandDriverNode(Node):
                                             *state.orientation.tolist())))
         self._twist_pub.publish(TWIST.encode((*header, *state.linear_velocity.tolist(),
                                               *state.angular_velocity.tolist())))
+        force, torque = self.device.applied()  # what the hand felt since the last tick
+        self._applied_pub.publish(WRENCH.encode((*header, *force.tolist(), *torque.tolist())))
         self._published += 1
         self._last_probe_ns = now_ns
 
@@ -185,7 +217,31 @@ class WandDriverNode(Node):
         refusal = self._take(wrench, stamp_ns * 1e-9, now)
         if refusal is not None:
             self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
-        self._apply(now, device_now, state)
+        if self.renderer is None:
+            self._apply(now, device_now, state)
+        elif self._model_unavailable:
+            force, torque = self.wrench.current(now, state.yaw)
+            self.renderer.take_wrench(force, torque,
+                                      device_now + (self.wrench.expiry - now))
+
+    def on_model(self, data: bytes) -> None:
+        """Hand a contact model to the device's renderer; a bad one gives zero force."""
+        if self._phase is not Phase.RUNNING:
+            return
+        now = self.get_clock().now().nanoseconds * 1e-9
+        try:
+            model = ContactModel.from_fields(MODEL.decode(data), self.params.frame_id)
+        except ModelRefused as refusal:
+            self._refused.add(f'model: {refusal.field}', refusal)
+            self.renderer.clear()
+            return
+        if model.stamp < self._model_stamp:
+            self._refused.add('model older than the held one')
+            return
+        self._model_stamp = model.stamp
+        self._model_unavailable = model.kind == Kind.UNAVAILABLE
+        if not self._model_unavailable:
+            self.renderer.take(model, self._device_time() + (model.stamp + model.valid_for - now))
 
     def _apply(self, now: float, device_now: float, state) -> None:
         """Apply the held wrench, kept passive, armed with its deadline as the device watchdog.

@@ -19,6 +19,7 @@ __all__ = [
     'roll_axis',
     'roll_yaw_from_quaternion',
     'roll_yaw_jacobian',
+    'rotate',
 ]
 
 PITCH_TOLERANCE = 1e-4
@@ -87,6 +88,15 @@ def roll_yaw_from_quaternion(quaternion: np.ndarray, *,
     roll = np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
     return float(roll), float(yaw)
+
+
+def rotate(vector, roll: float, yaw: float) -> tuple[float, float, float]:
+    """Return R · vector for the wand's orientation R = Rz(yaw) · Rx(roll); (3,) floats."""
+    x, y, z = vector
+    c, s = math.cos(roll), math.sin(roll)
+    y, z = c * y - s * z, s * y + c * z
+    c, s = math.cos(yaw), math.sin(yaw)
+    return (c * x - s * y, s * x + c * y, z)
 
 
 def roll_axis(yaw: float) -> tuple[float, float, float]:

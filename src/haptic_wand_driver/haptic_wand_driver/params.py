@@ -22,6 +22,14 @@ class WandDriverParams:
                                 unit='s', low=0.0)
     wrench_timeout: float = parameter(0.010, 'a wrench older than this is stale: zero force',
                                       unit='s', low=0.0005, high=1.0)
+    rendering: str = parameter('local', 'local: the device renders the contact model at its servo '
+                               'rate; remote: it applies the wrench as it arrives',
+                               choices=('local', 'remote'))
+    contact_damping_ratio: float = parameter(1.0, 'local rendering: damping ratio of a contact '
+                                             'on the device\'s mass, added along the normal '
+                                             '(0: the material\'s alone)', low=0.0, high=5.0)
+    servo_rate: float = parameter(4000.0, 'simulated device: its servo rate (the dynamics '
+                                  'substep)', unit='Hz', low=100.0, high=100000.0)
     force_limit: float = parameter(10.0, 'device force limit (saturation)', unit='N', low=0.0)
     passivity: bool = parameter(True, 'passivity observer and controller at the device port: '
                                 'removes the energy the loop delay makes a stiff wall return')

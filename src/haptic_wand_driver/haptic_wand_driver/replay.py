@@ -191,6 +191,10 @@ class ReplayDevice(HapticDevice):
         rates = self._rates[after - 1] + weight * (self._rates[after] - self._rates[after - 1])
         return WandState.from_coordinates(now, coordinates, rates)
 
+    def applied(self) -> tuple[np.ndarray, np.ndarray]:
+        """Return zeros: a recording renders nothing."""
+        return np.zeros(3), np.zeros(3)
+
     def apply(self, force: np.ndarray, torque: np.ndarray, *, until: float = math.inf) -> None:
         """Ignore the wrench: a recording cannot be pushed."""
         self._raise_if_closed()

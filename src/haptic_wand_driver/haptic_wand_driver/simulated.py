@@ -5,6 +5,11 @@ damping, moved by the operator's hand and by the applied wrench. The workspace e
 inelastic stops: a joint reaching one is put back on it and loses its outward velocity, so the
 stops only ever remove energy.
 
+The substep is the device's servo period (4 kHz by default). In each, the wand renders either the
+held wrench, or, once given a law to run locally (``render_locally``: a ``LocalRenderer`` with
+the latest contact model), that law against its state at the substep, as a real device's servo
+loop would. ``applied`` reports the mean of what it rendered since the last call.
+
 ``read(now)`` advances in fixed substeps of ``step`` seconds with semi-implicit Euler (velocity
 first, the device's own damping implicit), so the trajectory depends only on the wrench applied
 before each substep, never on when ``read`` was called: a jittery timer that reads the same
@@ -65,7 +70,7 @@ class SimulatedWandConfig:
     yaw_damping: float = 2e-3
     limits: DeviceLimits = field(
         default_factory=lambda: DeviceLimits(force_limit=10.0, torque_limit=0.5))
-    step: float = 5e-4
+    step: float = 2.5e-4
     initial_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
     initial_roll: float = 0.0
     initial_yaw: float = 0.0
@@ -134,6 +139,9 @@ class SimulatedWand(HapticDevice):
         self._until = math.inf
         self._start: float | None = None
         self._steps_done = 0
+        self._law = None
+        self._rendered = [0.0] * 6  # sum of force and torque over the substeps since applied()
+        self._rendered_steps = 0
 
     @property
     def limits(self) -> DeviceLimits:
@@ -177,9 +185,22 @@ class SimulatedWand(HapticDevice):
         self._torque = saturate_components(torque, limits.torque_limit)
         self._until = until
 
+    def render_locally(self, law) -> None:
+        """Run ``law`` at every substep instead of the held wrench (see ``HapticDevice``)."""
+        self._raise_if_closed()
+        self._law = law
+
+    def applied(self) -> tuple[np.ndarray, np.ndarray]:
+        """Return the mean force and torque rendered over the substeps since the last call."""
+        count = max(self._rendered_steps, 1)
+        mean = np.array(self._rendered) / count
+        self._rendered, self._rendered_steps = [0.0] * 6, 0
+        return mean[:3], mean[3:]
+
     def close(self) -> None:
-        """Drop the held wrench and stop."""
+        """Drop the held wrench and the local law, and stop."""
         self._force = self._torque = _ZERO
+        self._law = None
         super().close()
 
     def _time(self) -> float:
@@ -202,10 +223,21 @@ class SimulatedWand(HapticDevice):
         joints = self._joints
         coordinates, rates = self._coordinates, self._rates
         expires = self._expiry_step()
+        law, limits = self._law, self._config.limits
+        rendered = self._rendered
         for done in range(self._steps_done, target_steps):
-            if done == expires:  # the watchdog deadline: the held wrench drops to zero
+            if law is not None:
+                (force_x, force_y, force_z), (torque_x, torque_y, torque_z) = law.wrench(
+                    self._start + done * step, coordinates, rates, step)
+                force_x, force_y, force_z = saturate_components(
+                    (force_x, force_y, force_z), limits.force_limit)
+                torque_x, torque_y, torque_z = saturate_components(
+                    (torque_x, torque_y, torque_z), limits.torque_limit)
+            elif done == expires:  # the watchdog deadline: the held wrench drops to zero
                 force_x = force_y = force_z = torque_x = torque_y = torque_z = 0.0
                 self._force = self._torque = _ZERO
+            for k, value in enumerate((force_x, force_y, force_z, torque_x, torque_y, torque_z)):
+                rendered[k] += value
             roll_x, roll_y, roll_z = roll_axis(coordinates[4])
             efforts = (force_x, force_y, force_z,  # then roll_yaw_jacobian(yaw).T @ torque
                        roll_x * torque_x + roll_y * torque_y + roll_z * torque_z, torque_z)
@@ -225,6 +257,7 @@ class SimulatedWand(HapticDevice):
                 kept.append(rate)
             coordinates, rates = moved, kept
         self._coordinates, self._rates = coordinates, rates
+        self._rendered_steps += target_steps - self._steps_done
         self._steps_done = target_steps
 
 

@@ -1,0 +1,177 @@
+"""A local model of the contact (``haptic_msgs/ContactModel``), checked and rendered on the device.
+
+Why: a force computed from a pose one round trip old lags the motion, and a stiff wall then gives
+energy back (it rebounds). The force renderer sends, with every answer, the planes of the surface
+near the tool and their material; the device renders them against its *current* position at its
+own servo rate, so the force lags by one servo period instead of a round trip.
+
+Each plane pushes one point of the tool (its ``tool_point``, in the tip frame: zero for the tip
+itself) with the force renderer's own law (``force_renderer.spring_damper``): a depth d behind the
+plane gives K ⊙ (d·n) − C ⊙ v, never pulling. A plane is exact only at its point: on a surface of
+curvature radius R, a tip that slid a distance s along it sees the plane off by about s²/(2R),
+hence a force error of K·s²/(2R); ``valid_radius`` bounds s (``docs/local_rendering.md`` has the
+figures on the cylinder and the hand).
+"""
+from dataclasses import dataclass
+import enum
+import math
+from typing import Sequence
+
+from force_renderer.spring_damper import unilateral_spring_damper
+from haptic_wand_driver.orientation import rotate
+
+__all__ = ['Kind', 'ModelRefused', 'Plane', 'ContactModel', 'MAX_PLANES', 'UNIT_TOLERANCE']
+
+MAX_PLANES = 3
+UNIT_TOLERANCE = 1e-6  # |normal| may differ from 1 by this much
+Vector3 = tuple[float, float, float]
+
+
+class Kind(enum.IntEnum):
+    """What a model holds, as ``haptic_msgs/ContactModel.KIND_*``."""
+
+    FREE = 0
+    PLANES = 1
+    UNAVAILABLE = 2
+
+
+class ModelRefused(ValueError):
+    """A model that must not be rendered; ``field`` names what is wrong with it."""
+
+    def __init__(self, field: str, message: str) -> None:
+        super().__init__(f'contact model refused: {field} {message}')
+        self.field = field
+
+
+@dataclass(frozen=True)
+class Plane:
+    """One plane of a model: see ``ContactPlane.msg``. Vectors (3,) float, SI units."""
+
+    point: Vector3
+    normal: Vector3
+    stiffness: Vector3
+    damping: Vector3
+    tool_point: Vector3
+
+
+@dataclass(frozen=True)
+class ContactModel:
+    """A checked model: every number finite, normals unit, gains and limits non-negative.
+
+    Attributes
+    ----------
+    stamp : float, s
+        The pose's stamp (ROS time).
+    kind : Kind
+    planes : tuple of Plane
+    force_limit, valid_for, valid_radius : float
+        N, s, m.
+    tip : (3,) float, m
+        The tip the model was made for.
+    """
+
+    stamp: float
+    kind: Kind
+    planes: tuple
+    force_limit: float
+    valid_for: float
+    valid_radius: float
+    tip: Vector3
+
+    @classmethod
+    def from_fields(cls, fields: Sequence, frame_id: str) -> 'ContactModel':
+        """Check the leaf fields of a ``ContactModel`` message and build the model.
+
+        Raises ModelRefused naming the first bad field (an unknown frame, a NaN, a normal that
+        is not unit, a negative gain, more than three planes, an unknown kind).
+        """
+        sec, nanosec, frame, _, kind, count = fields[:6]
+        if frame != frame_id:
+            raise ModelRefused('header.frame_id', f'is {frame!r}, not {frame_id!r}')
+        if kind not in tuple(Kind):
+            raise ModelRefused('kind', f'is {kind}, not one of {[k.value for k in Kind]}')
+        if count > MAX_PLANES:
+            raise ModelRefused('plane_count', f'is {count}, more than {MAX_PLANES}')
+        force_limit, valid_for, valid_radius = fields[51:54]
+        for name, value in (('force_limit', force_limit), ('valid_for', valid_for),
+                            ('valid_radius', valid_radius)):
+            _non_negative(name, value)
+        tip = tuple(fields[54:57])
+        _finite('tip', tip)
+        planes = tuple(_plane(k, fields[6 + 15 * k:21 + 15 * k]) for k in range(count))
+        return cls(sec + nanosec * 1e-9, Kind(kind), planes if kind == Kind.PLANES else (),
+                   force_limit, valid_for, valid_radius, tip)
+
+    def valid(self, position: Sequence[float]) -> bool:
+        """Whether ``position`` (3,) m is within ``valid_radius`` of the model's tip."""
+        dx, dy, dz = (position[0] - self.tip[0], position[1] - self.tip[1],
+                      position[2] - self.tip[2])
+        return dx * dx + dy * dy + dz * dz <= self.valid_radius * self.valid_radius
+
+    def wrench(self, position: Sequence[float], velocity: Sequence[float], roll: float,
+               yaw: float, angular_velocity: Sequence[float],
+               contact_damping=None) -> tuple[Vector3, Vector3]:
+        """Force (N) and torque about the tip (N·m) of the planes on the tool, world frame.
+
+        ``position``, ``velocity`` (3,) are the tip's; ``roll``, ``yaw`` (rad) its orientation;
+        ``angular_velocity`` (3,) rad/s, world frame. ``contact_damping(plane, normal)`` (N·s/m)
+        adds damping along a plane's normal while it pushes, never pulling (the device's own
+        choice, see ``local_rendering``); None adds none.
+        """
+        fx = fy = fz = tx = ty = tz = 0.0
+        for plane in self.planes:
+            arm = rotate(plane.tool_point, roll, yaw)
+            point = (position[0] + arm[0], position[1] + arm[1], position[2] + arm[2])
+            n = plane.normal
+            depth = (n[0] * (plane.point[0] - point[0]) + n[1] * (plane.point[1] - point[1])
+                     + n[2] * (plane.point[2] - point[2]))
+            if depth <= 0.0:
+                continue
+            spin = _cross(angular_velocity, arm)
+            speed = (velocity[0] + spin[0], velocity[1] + spin[1], velocity[2] + spin[2])
+            f = unilateral_spring_damper((depth * n[0], depth * n[1], depth * n[2]), n, speed,
+                                         plane.stiffness, plane.damping)
+            if contact_damping is not None:
+                f = _damped_along(f, n, speed, contact_damping(plane))
+            t = _cross(arm, f)
+            fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
+            tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
+        return (fx, fy, fz), (tx, ty, tz)
+
+
+def _damped_along(force: Vector3, normal: Vector3, velocity: Sequence[float],
+                  damping: float) -> Vector3:
+    """``force`` minus ``damping`` times the normal speed, along the normal, never pulling."""
+    push = force[0] * normal[0] + force[1] * normal[1] + force[2] * normal[2]
+    speed = velocity[0] * normal[0] + velocity[1] * normal[1] + velocity[2] * normal[2]
+    change = max(-push, -damping * speed)
+    return (force[0] + change * normal[0], force[1] + change * normal[1],
+            force[2] + change * normal[2])
+
+
+def _plane(k: int, values: Sequence[float]) -> Plane:
+    name = f'planes[{k}]'
+    vectors = [tuple(values[i:i + 3]) for i in range(0, 15, 3)]
+    for label, vector in zip(('point', 'normal', 'stiffness', 'damping', 'tool_point'), vectors):
+        _finite(f'{name}.{label}', vector)
+    for label, vector in zip(('stiffness', 'damping'), vectors[2:4]):
+        if min(vector) < 0.0:
+            raise ModelRefused(f'{name}.{label}', f'is negative: {list(vector)}')
+    norm = math.sqrt(sum(c * c for c in vectors[1]))
+    if abs(norm - 1.0) > UNIT_TOLERANCE:
+        raise ModelRefused(f'{name}.normal', f'is not unit (|n| = {norm:.9g})')
+    return Plane(*vectors)
+
+
+def _finite(name: str, vector: Sequence[float]) -> None:
+    if not all(math.isfinite(c) for c in vector):
+        raise ModelRefused(name, f'is not finite: {list(vector)}')
+
+
+def _non_negative(name: str, value: float) -> None:
+    if not (math.isfinite(value) and value >= 0.0):
+        raise ModelRefused(name, f'must be finite and >= 0, got {value}')
+
+
+def _cross(a: Sequence[float], b: Sequence[float]) -> Vector3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])

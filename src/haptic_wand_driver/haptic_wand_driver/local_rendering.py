@@ -1,0 +1,110 @@
+"""The device-side law: the latest contact model rendered at the servo rate, passive, saturated.
+
+A backend with a servo loop of its own (a Force Dimension or Quanser device, or the simulated
+wand's substeps) calls ``LocalRenderer.wrench`` every servo period with the device's current
+state; the driver hands it each new model as it arrives (``take``). What it renders is zero
+whenever the model is missing, expired (its deadline on the device's clock) or left behind (the
+tip beyond its ``valid_radius``): never a stale force. The port's passivity controller runs here,
+at the servo rate, on the force the model gives, and the result is saturated to the device's and
+the model's force limits.
+
+Contact damping: a wall of stiffness K on the device's mass m rings at sqrt(K/m) and, with only
+the material's damping (the paper's 0.8 N·s/m), bounces the tool off it on every tap however
+exactly it is rendered. Only the device can afford to damp that: it knows m, and at its servo rate
+T a damper stays stable up to about m/T (0.15 kg at 4 kHz: 600 N·s/m), while over the ROS 2 loop
+(T = 1 ms plus the round trip) it would oscillate itself. So, along each plane's normal while it
+pushes, it adds ``contact_damping_ratio`` × 2 sqrt(K_n m_n) (1: critical), capped at
+``MAX_DAMPING_PER_MASS`` × m_n / T, and never pulling: taps that stay in contact, as on a real
+rigid surface, and energy only ever taken out.
+
+Thread safety: ``take`` swaps one tuple, which a servo thread reads whole; the passivity books are
+the servo thread's alone.
+"""
+import math
+from typing import Sequence
+
+from haptic_wand_driver.contact_model import ContactModel, Kind
+from haptic_wand_driver.orientation import roll_axis
+from haptic_wand_driver.port_passivity import PortPassivity
+from haptic_wand_driver.wrench_input import saturate_components
+
+__all__ = ['LocalRenderer', 'MAX_DAMPING_PER_MASS']
+
+_ZERO = (0.0, 0.0, 0.0)
+MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
+
+
+class LocalRenderer:
+    """Renders contact models on the device.
+
+    Parameters
+    ----------
+    force_limit, torque_limit : float
+        The device's limits, N and N·m.
+    passivity : PortPassivity
+        The port's observer and controller, run at the servo rate.
+    mass : (3,) float, kg
+        The device's apparent mass per axis, for the contact damping.
+    contact_damping_ratio : float
+        Damping ratio of the contact on the device's mass (0: the material's damping alone).
+    """
+
+    def __init__(self, *, force_limit: float, torque_limit: float, passivity: PortPassivity,
+                 mass: Sequence[float] = (0.0, 0.0, 0.0),
+                 contact_damping_ratio: float = 0.0) -> None:
+        self.force_limit = force_limit
+        self.torque_limit = torque_limit
+        self.passivity = passivity
+        self.mass = tuple(mass)
+        self.contact_damping_ratio = contact_damping_ratio
+        self._held: tuple = (None, None, -math.inf)  # (model, wrench, deadline: device clock)
+
+    def take(self, model: ContactModel, deadline: float) -> None:
+        """Render ``model`` from now until ``deadline`` (s, the device's clock)."""
+        self._held = (model, None, deadline)
+
+    def take_wrench(self, force, torque, deadline: float) -> None:
+        """Render a fixed wrench until ``deadline``: for a law that has no model to send."""
+        self._held = (None, (tuple(force), tuple(torque)), deadline)
+
+    def clear(self) -> None:
+        """Drop what is held: zero force until the next model or wrench."""
+        self._held = (None, None, -math.inf)
+
+    def wrench(self, time: float, coordinates: Sequence[float], rates: Sequence[float],
+               period: float) -> tuple[tuple, tuple]:
+        """Force (N) and torque (N·m, about the tip) to render now, workspace frame.
+
+        ``time`` is the device's clock (s); ``coordinates`` and ``rates`` the joints (x, y, z,
+        roll, yaw) and their rates; ``period`` the servo period (s).
+        """
+        model, wrench, deadline = self._held
+        position, velocity = coordinates[:3], rates[:3]
+        force, torque = _ZERO, _ZERO
+        limit = self.force_limit
+        if wrench is not None and time < deadline:
+            force, torque = wrench
+        elif (model is not None and model.kind == Kind.PLANES and time < deadline
+                and model.valid(position)):
+            x, y, z = roll_axis(coordinates[4])
+            spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
+            force, torque = model.wrench(position, velocity, coordinates[3], coordinates[4],
+                                         spin, self._contact_damping(period))
+            limit = min(self.force_limit, model.force_limit)
+        force = self.passivity.control(force, position, velocity, period)
+        return (saturate_components(force, limit),
+                saturate_components(torque, self.torque_limit))
+
+    def _contact_damping(self, period: float):
+        """Return the per-plane damping for this servo period (None when the ratio is zero)."""
+        if self.contact_damping_ratio <= 0.0:
+            return None
+        ratio, mass = self.contact_damping_ratio, self.mass
+
+        def damping(plane) -> float:
+            n, k = plane.normal, plane.stiffness
+            stiffness = k[0] * n[0] * n[0] + k[1] * n[1] * n[1] + k[2] * n[2] * n[2]
+            inertia = mass[0] * n[0] * n[0] + mass[1] * n[1] * n[1] + mass[2] * n[2] * n[2]
+            return min(2.0 * ratio * math.sqrt(stiffness * inertia),
+                       MAX_DAMPING_PER_MASS * inertia / period)
+        return damping
