@@ -23,7 +23,7 @@ from collision_engine.scene import SceneObject
 __all__ = ['ITERATION_CAPS', 'LOOP_LAYOUTS', 'LOOP_RATES', 'STIFF_WALLS', 'TOLERANCES',
            'colgate_bound', 'error_time_rows', 'loop_rows', 'stiff_wall_rows', 'tradeoff_rows']
 
-STIFF_WALLS = (160.0, 5000.0, 20000.0)  # [N/m] over the real loop
+STIFF_WALLS = (160.0, 1e3, 5e3, 2e4, 1e5)  # [N/m] over the real loop
 LOOP_RATES = (500.0, 1000.0, 2000.0)  # [Hz]
 LOOP_LAYOUTS = ('separate', 'composed')
 TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
@@ -171,9 +171,9 @@ def loop_rows(duration: float, domain_id: int) -> list[dict]:
 
 
 def stiff_wall_rows(duration: float, domain_id: int) -> list[dict]:
-    """One ``stiff_wall_loop.run`` per wall stiffness, the device-port controller on and off."""
-    return [stiff_wall_loop.run(k, port, duration=duration, domain_id=domain_id)
-            for k in STIFF_WALLS for port in (True, False)]
+    """One ``stiff_wall_loop.run`` per wall stiffness, rendered locally and remotely."""
+    return [stiff_wall_loop.run(k, rendering, duration=duration, domain_id=domain_id)
+            for k in STIFF_WALLS for rendering in ('local', 'remote')]
 
 
 def colgate_bound() -> float:

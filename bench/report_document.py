@@ -129,11 +129,13 @@ def _stability_chapter(findings: Findings) -> list[str]:
               if findings.sweep else [skipped('stiffness sweep'), ''])
     parts += ['### A stiff wall over the real ROS 2 loop', '',
               'The sweep above closes the loop in one process with an ideal hold; here the three '
-              'nodes run over ROS 2 and the wand feels each force about a millisecond after the '
-              'pose it answers (`bench/stiff_wall_loop.py`: the cuboid taps, the renderer\'s '
-              'passivity controller on, the driver\'s device-port controller on or off). '
-              '*Contacts per tap* above 1 are rebounds; *net work* above 0 is energy the loop '
-              'gave the user\'s hand.', '']
+              'nodes run over ROS 2 (`bench/stiff_wall_loop.py`: the cuboid taps, both passivity '
+              'controllers on). *Remote*: the wand holds each wrench as it arrives, about a '
+              'millisecond after the pose it answers. *Local*: the wand renders the contact '
+              'model against its current position at its 4 kHz servo rate. Every figure is read '
+              'from the bag: *contacts per tap* above 1 are rebounds (a lift over 0.1 mm); *net '
+              'work* is that of `wand/applied_wrench` on the tip, above 0 energy the loop gave '
+              'the user\'s hand.', '']
     parts += ([stiff_wall_section(findings.stiff_wall), ''] if findings.stiff_wall
               else [skipped('stiff wall over the loop'), ''])
     parts += ['### Extreme geometry', '',

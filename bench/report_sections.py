@@ -329,9 +329,9 @@ def counts_section(recordings: dict) -> str:
 def stiff_wall_section(rows: list) -> str:
     """Tabulate rebounds, work, depth and force of the stiff wall over the loop."""
     return markdown_table(
-        ['K N/m', 'device-port controller', 'contacts per tap', 'net work on the tip (mJ)',
-         'deepest (mm)', 'peak force (N)', 'poses answered'],
-        [[f'{r["stiffness"]:.0f}', 'on' if r['port_passivity'] else 'off',
+        ['K N/m', 'rendering', 'contacts per tap', 'net work on the tip (mJ)',
+         'deepest (mm)', 'peak applied force (N)', 'poses answered'],
+        [[f'{r["stiffness"]:.0f}', r['rendering'],
           f'{r["contacts_per_tap"]:.1f}', f'{1e3 * r["net_work_j"]:+.2f}',
           f'{1e3 * r["max_depth_m"]:.2f}', f'{r["peak_force_n"]:.2f}',
           f'{r["answered_percent"]:.2f} %'] for r in rows])
