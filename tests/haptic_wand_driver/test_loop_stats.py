@@ -34,22 +34,17 @@ def test_the_report_takes_its_percentiles_over_the_recent_answers_only():
     assert summary['poses'] == summary['answers'] == 2 * LoopStats.RECENT
 
 
-def test_the_full_record_keeps_every_answer_and_force_edge(tmp_path):
+def test_the_full_record_keeps_every_answer(tmp_path):
     stats = LoopStats(record=tmp_path / 'record')
     count = 3 * LoopStats.CHUNK + 17  # spans several chunks written out and a partial one
     for k in range(count):
         stats.sent(k * MS)
         stats.answered(k * MS, k * MS + (k % 7 + 1) * 100_000)
-        if k % 1000 == 0:
-            stats.force_on(k * MS + 1)
-            stats.force_off(k * MS + 2)
     stats.save(tmp_path / 'stats.npz', published=count)
     saved = np.load(tmp_path / 'stats.npz')
     np.testing.assert_allclose(saved['latencies'], [(k % 7 + 1) * 1e-4 for k in range(count)])
     np.testing.assert_array_equal(saved['arrival_ns'],
                                   [k * MS + (k % 7 + 1) * 100_000 for k in range(count)])
-    np.testing.assert_array_equal(saved['force_on_ns'], np.arange(0, count, 1000) * MS + 1)
-    np.testing.assert_array_equal(saved['force_off_ns'], np.arange(0, count, 1000) * MS + 2)
     assert saved['latency_max_s'] == pytest.approx(7e-4)  # the whole session's, not the ring's
     assert int(saved['published']) == count
 

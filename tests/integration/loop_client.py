@@ -2,6 +2,7 @@
 
 It lives in its own rclpy context, so a test can use it beside a launched loop.
 """
+import math
 import struct
 import time
 
@@ -14,7 +15,7 @@ from rclpy.node import Node
 from rclpy.serialization import serialize_message
 
 from haptic_msgs.msg import CollisionState
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.qos import HAPTIC_STREAM_QOS, RECORDER_QOS
 from haptic_util.stamps import to_stamp
 
 STAMP_OFFSET = 4  # [bytes] header.stamp in a CDR message, after the encapsulation header
@@ -44,12 +45,20 @@ class LoopClient:
             WrenchStamped, 'wand/wrench', self._on_wrench, HAPTIC_STREAM_QOS)
         self.state_sub = self.node.create_subscription(
             CollisionState, 'collision/state', self._on_state, HAPTIC_STREAM_QOS)
+        self.applied = []  # (stamp [ns], |force| [N]) of each wand/applied_wrench, as it came
+        self.node.create_subscription(WrenchStamped, 'wand/applied_wrench', self._on_applied,
+                                      RECORDER_QOS)  # deep: nothing lost while a test sleeps
 
     def _on_wrench(self, msg: WrenchStamped) -> None:
         key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
         if key not in self.wrenches:  # the answer; a watchdog's zero for the same stamp follows
             self.wrenches[key] = msg
             self.arrivals[key] = self.node.get_clock().now().nanoseconds
+
+    def _on_applied(self, msg: WrenchStamped) -> None:
+        f = msg.wrench.force
+        self.applied.append((msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec,
+                             math.sqrt(f.x * f.x + f.y * f.y + f.z * f.z)))
 
     def _on_state(self, msg: CollisionState) -> None:
         self.states[(msg.header.stamp.sec, msg.header.stamp.nanosec)] = msg

@@ -1,9 +1,13 @@
 """Node faults mid-contact: the wand's force reaches zero within 10 ms, and the loop recovers.
 
 The loop runs as three processes with the simulated wand pressing into the cuboid's top face and
-holding there. A node is then killed (SIGKILL) and restarted, or paused (SIGSTOP) for 100 ms,
-over and over. The driver notes each instant its applied force dropped to zero (the watchdog
-deadline of the last fresh wrench), and this test notes each fault's instant on the same clock.
+holding there, rendering the contact locally (the default). A node is then killed (SIGKILL) and
+restarted, or paused (SIGSTOP) for 100 ms, over and over; this test notes each fault's instant.
+When the force on the hand stopped is measured twice, from what the device applied, never from
+the driver's intentions: the simulated device's own record of when its rendered force switched
+off (servo resolution, 0.25 ms), and ``wand/applied_wrench`` as this separate process received it
+(the mean force of each 1 ms tick: the force was zero from the end of the last tick that held
+any, an upper bound one tick coarse).
 """
 import os
 import signal
@@ -18,6 +22,7 @@ from haptic_bringup.launcher import Loop, LoopConfig
 TRIALS = 20  # per kind of fault, alternating between the collision and the force node
 FAULTY = ('collision_engine', 'force_renderer')
 TIME_TO_ZERO = 0.010  # [s] the issue's bound
+TICK = 0.001  # [s] the resolution of wand/applied_wrench
 PAUSE = 0.100  # [s] SIGSTOP length
 RECOVERY_TIMEOUT = 60.0  # [s] a restarted node imports and loads its scene first
 STEADY = 0.2  # [s] of unbroken contact force before each fault
@@ -144,6 +149,17 @@ def times_to_zero(record, faults) -> np.ndarray:
     return np.array(delays)
 
 
+def seen_from_outside(applied: list, faults) -> np.ndarray:
+    """For each fault, from it to the end of the last applied tick that still held a force [s]."""
+    applied = np.array(applied)
+    stamps, force = applied[:, 0], applied[:, 1]
+    delays = []
+    for before, back in faults:
+        held = stamps[(stamps >= before) & (stamps < back) & (force > 0.0)]
+        delays.append((held.max() - before) * 1e-9 if held.size else 0.0)
+    return np.array(delays)
+
+
 def test_faults_mid_contact_zero_the_force_within_10_ms_and_the_loop_recovers(pressing_loop):
     loop, client, stats = pressing_loop
     kills = fault_trials(loop, client, kill_and_restart)
@@ -153,13 +169,17 @@ def test_faults_mid_contact_zero_the_force_within_10_ms_and_the_loop_recovers(pr
     loop.stop()  # the driver writes its record on a clean stop
     record = np.load(stats)
     for label, trials in (('SIGKILL', kills), ('SIGSTOP 100 ms', pauses)):
-        delays = times_to_zero(record, [(before, back) for before, _, back, _ in trials])
+        faults = [(before, back) for before, _, back, _ in trials]
+        delays = times_to_zero(record, faults)
+        outside = seen_from_outside(client.applied, faults)
         brackets = np.array([after - before for before, after, _, _ in trials]) * 1e-9
         recovery = np.array([seconds for _, _, _, seconds in trials])
         print(f'{label}: {len(trials)} trials, time to zero force max {1e3 * delays.max():.2f} '
               f'ms (median {1e3 * np.median(delays):.2f}; already zero in '
               f'{np.count_nonzero(delays == 0.0)}); recovery median '
               f'{np.median(recovery):.3f} s, max {recovery.max():.3f} s; sending the signal '
-              f'took up to {1e3 * brackets.max():.2f} ms (included in the delays)')
+              f'took up to {1e3 * brackets.max():.2f} ms (included in the delays); seen from '
+              f'outside: max {1e3 * outside.max():.2f} ms')
         assert delays.max() <= TIME_TO_ZERO, f'{label}: {delays}'
+        assert outside.max() <= TIME_TO_ZERO + TICK, f'{label}, outside: {outside}'
         assert len(trials) >= TRIALS

@@ -1,9 +1,9 @@
-"""Book-keeping of the haptic loop as the driver sees it: round trips and force drop-outs.
+"""Book-keeping of the haptic loop as the driver sees it: poses, answers, round trips.
 
 Every wrench carries the stamp of the pose it answers, so the driver, which stamped that pose,
 knows the loop's round trip exactly, on one clock, without any extra traffic: poses sent, poses
-answered (a wrench with that pose's stamp), each answer's latency and arrival time. It also notes
-each instant the applied force started (became non-zero) and stopped.
+answered (a wrench with that pose's stamp), each answer's latency and arrival time. (When the
+force on the hand started and stopped is the device's to say, not the driver's: ``force_edges``.)
 
 A driver runs for days, so memory stays flat: the recent latencies live in a ring of
 ``RECENT`` entries (what the 1 Hz report takes its percentiles over, at a constant cost), and the
@@ -17,8 +17,6 @@ import numpy as np
 
 __all__ = ['LoopStats']
 
-_ANSWER, _FORCE_ON, _FORCE_OFF = 0, 1, 2  # kinds of rows of the full record
-
 
 class LoopStats:
     """Poses sent and answered, and round-trip latencies [s].
@@ -26,8 +24,8 @@ class LoopStats:
     Parameters
     ----------
     record : path or None
-        Where the full record (every answer, every force edge) is spooled while the session
-        runs; ``save`` turns it into an .npz. None keeps only counts and the recent ring.
+        Where the full record (every answer) is spooled while the session runs; ``save`` turns
+        it into an .npz. None keeps only counts and the recent ring.
     """
 
     ANSWER_WINDOW_NS = 1_000_000_000  # a wrench later than this could not be applied anyway
@@ -42,7 +40,7 @@ class LoopStats:
         self._first_ns = None
         self._last_ns = None
         self._record_path = None if record is None else pathlib.Path(record)
-        self._rows = array('q')  # (kind, a, b) triples not yet written out
+        self._rows = array('q')  # (latency, arrival) pairs not yet written out
         if self._record_path is not None:
             self._record_path.write_bytes(b'')
 
@@ -61,22 +59,10 @@ class LoopStats:
         if self._pending.pop(stamp_ns, False) is None:
             self._recent[self._answers % self.RECENT] = received_ns - stamp_ns
             self._answers += 1
-            self._note(_ANSWER, received_ns - stamp_ns, received_ns)
-
-    def force_on(self, instant_ns: int) -> None:
-        """Note that the applied force became non-zero at ``instant_ns``."""
-        self._note(_FORCE_ON, instant_ns, 0)
-
-    def force_off(self, instant_ns: int) -> None:
-        """Note that the applied force dropped to zero at ``instant_ns``."""
-        self._note(_FORCE_OFF, instant_ns, 0)
-
-    def _note(self, kind: int, a: int, b: int) -> None:
-        if self._record_path is None:
-            return
-        self._rows.extend((kind, a, b))
-        if len(self._rows) >= 3 * self.CHUNK:
-            self._flush()
+            if self._record_path is not None:
+                self._rows.extend((received_ns - stamp_ns, received_ns))
+                if len(self._rows) >= 2 * self.CHUNK:
+                    self._flush()
 
     def _flush(self) -> None:
         with self._record_path.open('ab') as stream:
@@ -126,13 +112,10 @@ class LoopStats:
         if self._record_path is None:
             raise ValueError('LoopStats.save needs the full record: make it with record=path')
         self._flush()
-        rows = np.fromfile(self._record_path, dtype=np.int64).reshape(-1, 3)
-        answers = rows[rows[:, 0] == _ANSWER]
-        latencies = answers[:, 1] * 1e-9
+        answers = np.fromfile(self._record_path, dtype=np.int64).reshape(-1, 2)
+        latencies = answers[:, 0] * 1e-9
         whole_session = {**self.summary(), **_latency_figures(latencies)}
-        np.savez(path, latencies=latencies, arrival_ns=answers[:, 2],
-                 force_on_ns=rows[rows[:, 0] == _FORCE_ON, 1],
-                 force_off_ns=rows[rows[:, 0] == _FORCE_OFF, 1], **whole_session, **extra)
+        np.savez(path, latencies=latencies, arrival_ns=answers[:, 1], **whole_session, **extra)
 
 
 def _latency_figures(latency: np.ndarray) -> dict:

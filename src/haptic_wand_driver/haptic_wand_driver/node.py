@@ -11,6 +11,7 @@ import pathlib
 import time
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
+import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
@@ -87,8 +88,6 @@ class WandDriverNode(Node):
         self._refused = Tally()  # wrenches not taken, by fault
         self._reported = (time.monotonic(), 0, 0)  # when, poses and answers at the last report
         self._recorder_ready = False
-        self._pushing = False
-        self._deadline = -math.inf  # [s] when the wrench applied to the device goes stale
         self._pose_pub = self.create_publisher(PoseStamped, 'wand/pose', HAPTIC_STREAM_QOS)
         self._twist_pub = self.create_publisher(TwistStamped, 'wand/twist', HAPTIC_STREAM_QOS)
         self._applied_pub = self.create_publisher(WrenchStamped, 'wand/applied_wrench',
@@ -252,16 +251,7 @@ class WandDriverNode(Node):
         force, torque = wrench.current(now, state.yaw)
         force = self.passivity.control(force, state.position, state.linear_velocity,
                                        self._period)
-        pushing = any(force)
-        if self._pushing and not pushing:
-            # The force on the hand dropped at the applied wrench's deadline, if that came first
-            # (the device's watchdog), or now (a zero, stale or refused wrench replaced it).
-            self.stats.force_off(round(1e9 * min(self._deadline, now)))
-        elif pushing and not self._pushing:
-            self.stats.force_on(round(1e9 * now))
-        self._pushing = pushing
-        self._deadline = wrench.expiry
-        self.device.apply(force, torque, until=device_now + (self._deadline - now))
+        self.device.apply(force, torque, until=device_now + (wrench.expiry - now))
 
     def _take(self, wrench: list, stamp: float, now: float) -> Refusal | None:
         """Hand a received wrench (``WRENCH`` leaves) to the command; return why it was refused."""
@@ -305,11 +295,20 @@ class WandDriverNode(Node):
         self.device.close()
         if self._record is not None:
             self.stats.save(self.params.stats_file, published=self._published,
-                            port_net_work_j=self.passivity.net_work)
+                            port_net_work_j=self.passivity.net_work, **self._force_edges())
             self._record.unlink()
         self.get_logger().info(f'published {self._published} poses; experiment loop: '
                                f'{self.stats.summary()}')
         return super().destroy_node()
+
+    def _force_edges(self) -> dict:
+        """Return the device's own record of its force switching on and off, ROS time [ns]."""
+        edges = getattr(self.device, 'force_edges', [])
+        ros_minus_device = self.get_clock().now().nanoseconds * 1e-9 - self._device_time()
+        on = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if pushing]
+        off = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if not pushing]
+        return {'force_on_ns': np.array(on, dtype=np.int64),
+                'force_off_ns': np.array(off, dtype=np.int64)}
 
 
 def _surface_projection(scene_path, announce):

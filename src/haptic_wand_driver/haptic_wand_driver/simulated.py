@@ -8,7 +8,8 @@ stops only ever remove energy.
 The substep is the device's servo period (4 kHz by default). In each, the wand renders either the
 held wrench, or, once given a law to run locally (``render_locally``: a ``LocalRenderer`` with
 the latest contact model), that law against its state at the substep, as a real device's servo
-loop would. ``applied`` reports the mean of what it rendered since the last call.
+loop would. ``applied`` reports the mean of what it rendered since the last call, and
+``force_edges`` every instant the force it rendered switched on or off (the substep's start).
 
 ``read(now)`` advances in fixed substeps of ``step`` seconds with semi-implicit Euler (velocity
 first, the device's own damping implicit), so the trajectory depends only on the wrench applied
@@ -142,6 +143,8 @@ class SimulatedWand(HapticDevice):
         self._law = None
         self._rendered = [0.0] * 6  # sum of force and torque over the substeps since applied()
         self._rendered_steps = 0
+        self._pushing = False
+        self.force_edges: list = []  # (time s, pushing after it): the force switching on or off
 
     @property
     def limits(self) -> DeviceLimits:
@@ -238,6 +241,10 @@ class SimulatedWand(HapticDevice):
                 self._force = self._torque = _ZERO
             for k, value in enumerate((force_x, force_y, force_z, torque_x, torque_y, torque_z)):
                 rendered[k] += value
+            pushing = force_x != 0.0 or force_y != 0.0 or force_z != 0.0
+            if pushing != self._pushing:
+                self._pushing = pushing
+                self.force_edges.append((self._start + done * step, pushing))
             roll_x, roll_y, roll_z = roll_axis(coordinates[4])
             efforts = (force_x, force_y, force_z,  # then roll_yaw_jacobian(yaw).T @ torque
                        roll_x * torque_x + roll_y * torque_y + roll_z * torque_z, torque_z)
