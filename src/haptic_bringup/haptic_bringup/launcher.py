@@ -193,9 +193,13 @@ class Loop:
         return next(c for c in self.children if c.name == name)
 
     def restart(self, name: str):
-        """Start child ``name`` again as it was started (after it died); return it."""
+        """Start child ``name`` again as it was started (after it died); return it.
+
+        The dead child's shared memory goes first (Fast DDS leaves it behind a SIGKILL).
+        """
         old = self.child(name)
         old.process.wait()
+        clean_stale_shm(domains=[self.config.domain_id], existing=self._segments_before)
         new = start_child(name, old.argv, old.env)
         self.children[self.children.index(old)] = new
         return new
