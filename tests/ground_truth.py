@@ -7,6 +7,7 @@ sign rule is the engine's: negative inside, zero on the surface, positive outsid
 
 from collections.abc import Iterator
 from decimal import Decimal, localcontext
+from itertools import combinations
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,7 @@ __all__ = [
     'mesh_signed_distance',
     'sample_near_surface',
     'scene_path',
+    'simplex_distance',
     'sphere_signed_distance',
     'winding_number',
 ]
@@ -75,6 +77,32 @@ def exact_unit(vector) -> np.ndarray:
         context.prec = 60
         norm = exact_norm(vector)
         return np.array([float(Decimal(float(c)) / norm) for c in vector])
+
+
+def simplex_distance(points: np.ndarray) -> float:
+    """Distance from the origin to the convex hull of at most 4 points, by enumerating subsets.
+
+    For each subset, the origin is projected onto its affine hull by least squares on the edge
+    vectors from its first point (scale-free), and kept if it falls inside the subset.
+
+    Parameters
+    ----------
+    points : (k <= 4, 3) float, m
+    """
+    points = _as_points(points)
+    best = np.inf
+    for size in range(1, len(points) + 1):
+        for subset in combinations(range(len(points)), size):
+            p = points[list(subset)]
+            edges = (p[1:] - p[0]).T
+            if size == 1:
+                weights = np.ones(1)
+            else:
+                steps = np.linalg.lstsq(edges, -p[0], rcond=None)[0]
+                weights = np.concatenate(([1.0 - steps.sum()], steps))
+            if np.all(weights >= -1e-12):
+                best = min(best, float(np.linalg.norm(weights @ p)))
+    return best
 
 
 def _rounded_box(excess: np.ndarray) -> np.ndarray:

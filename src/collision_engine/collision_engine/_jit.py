@@ -20,8 +20,8 @@ from numba import njit
 __all__ = ['jit']
 
 _PACKAGE = Path(__file__).resolve().parent
-_KERNEL_MODULES = ('_jit.py', 'norms.py', 'support.py', 'gjk.py', 'epa.py', 'bvh.py',
-                   '_kernels.py')
+_KERNEL_MODULES = ('_jit.py', 'norms.py', 'support.py', 'signed_volumes.py', 'gjk.py', 'epa.py',
+                   'bvh.py', '_kernels.py')
 _FINGERPRINT = _PACKAGE / '__pycache__' / 'kernels.sha256'
 
 

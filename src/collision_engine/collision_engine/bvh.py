@@ -3,9 +3,10 @@
 The tree is built once in numpy (median split of the triangle centroids along the longest axis,
 at most ``LEAF_SIZE`` triangles a leaf) and searched in the compiled kernel depth-first, nearer
 child first, skipping every box farther than the best distance found so far; the previous
-answer's triangle is tried first, which tightens the bound from the start on a trajectory. Each
-candidate triangle is a convex piece handed to GJK (``gjk.nearest_on_triangle``), which also says
-which feature the nearest point lies on; the sign comes from that feature's angle-weighted
+answer's triangle is tried first, which tightens the bound from the start on a trajectory. On
+each candidate triangle the closest point is computed exactly, in closed form
+(``signed_volumes.closest_point_on_triangle``: no iteration, no GJK), which also says which
+feature the nearest point lies on; the sign comes from that feature's angle-weighted
 pseudonormal (``pseudonormals``). The normal returned is the face's when the nearest point is
 inside a face, else the unit vector between the point and the surface (or, within 1e-9 of the
 mesh's size, where that vector is mostly rounding, the feature's pseudonormal). Vertices must be
@@ -30,9 +31,9 @@ L = ceil(log2(t / LEAF_SIZE)) for any mesh, degenerate or not.)
 import numpy as np
 
 from collision_engine._jit import jit
-from collision_engine.gjk import nearest_on_triangle
 from collision_engine.norms import norm3, unit3
 from collision_engine.pseudonormals import pseudonormals
+from collision_engine.signed_volumes import closest_point_on_triangle
 
 __all__ = ['FAR', 'LEAF_SIZE', 'build_tree', 'mesh_distance', 'pack_triangle_mesh',
            'search_stack_size', 'tree_depth']
@@ -147,7 +148,7 @@ def _box_distance2(floats, b, qx, qy, qz):
 @jit
 def _triangle_distance2(floats, corners, t, qx, qy, qz):
     c = corners + 9 * t
-    return nearest_on_triangle(
+    return closest_point_on_triangle(
         floats[c] - qx, floats[c + 1] - qy, floats[c + 2] - qz,
         floats[c + 3] - qx, floats[c + 4] - qy, floats[c + 5] - qz,
         floats[c + 6] - qx, floats[c + 7] - qy, floats[c + 8] - qz)
@@ -222,7 +223,7 @@ def _nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hi
     """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
 
     Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
-    tested) with v from q to the nearest point and the feature as ``nearest_on_triangle``'s.
+    tested) with v from q to the nearest point and the feature as ``closest_point_on_triangle``'s.
     """
     best_d2 = np.inf
     best_t, feature, which = -1, 0, 0

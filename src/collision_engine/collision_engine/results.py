@@ -70,7 +70,7 @@ class QueryResult:
 
     @property
     def iterations(self) -> int:
-        """GJK and EPA iterations spent (for a mesh: triangles tested, one GJK step each)."""
+        """GJK and EPA iterations spent (for a mesh: triangles tested, each in closed form)."""
         return int(self._row[8])
 
     @property
