@@ -2,6 +2,7 @@
 
 from itertools import product
 import math
+import re
 import subprocess
 import sys
 import textwrap
@@ -218,6 +219,37 @@ def test_only_what_a_scene_needs_is_imported(tmp_path):
         print(loaded())
     ''')
     assert output.splitlines() == ['[]', '[]', "['trimesh']", "['fcl', 'trimesh']"]
+
+
+CUBE = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+CUBE_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                       [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+
+
+def test_a_self_intersecting_mesh_is_refused_with_fcl_off(tmp_path):
+    # Two overlapping cubes in one file (centimetres): closed, wound, manifold, and wrong signs
+    # wherever they overlap. The check used to need FCL and ran only with cross-validation on.
+    vertices = np.vstack([CUBE, CUBE + [0.5, 0.3, 0.2]])
+    faces = np.vstack([CUBE_FACES, CUBE_FACES + 8])
+    lines = [f'v {x} {y} {z}' for x, y, z in vertices]
+    lines += [f'f {a} {b} {c}' for a, b, c in faces + 1]
+    (tmp_path / 'overlap.obj').write_text('\n'.join(lines) + '\n')
+    scene = tmp_path / 'overlap.yaml'
+    scene.write_text('objects:\n'
+                     '  - {name: two, shape: {mesh: {file: overlap.obj, scale: 0.01}}}\n')
+    output = run_python(f'''
+        import sys
+        from collision_engine import load_scene, MeshError
+        try:
+            load_scene({str(scene)!r})
+        except MeshError as error:
+            print(error)
+        print('fcl' in sys.modules)
+    ''')
+    message, fcl_loaded = output.splitlines()
+    assert 'overlap.obj' in message and 'self-intersecting' in message
+    assert re.search(r'triangles \d+ and \d+ \(0-based, as read\)', message)
+    assert fcl_loaded == 'False'
 
 
 def test_public_api():

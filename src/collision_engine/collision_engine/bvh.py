@@ -59,32 +59,51 @@ def build_tree(corners: np.ndarray, leaf_size: int = LEAF_SIZE):
     nodes : (b, 3) int64
         First child (its sibling follows it; -1 for a leaf), first triangle, triangle count.
     """
-    centroids = corners.mean(axis=1)
-    lows, highs = corners.min(axis=1), corners.max(axis=1)
-    order = np.arange(len(corners))
-    boxes, nodes = [], []
-    pending = [(0, len(corners), 0)]
-    boxes.append(None)
-    nodes.append(None)
-    while pending:
-        start, stop, node = pending.pop()
+    order, boxes, nodes, count = _build_tree(np.ascontiguousarray(corners, dtype=np.float64),
+                                             leaf_size)
+    return order, boxes[:count].copy(), nodes[:count].copy()
+
+
+@jit
+def _build_tree(corners, leaf_size):
+    """Compiled body of ``build_tree`` (in numpy it took 0.4 s for the hand's 11k triangles).
+
+    Returns order, boxes and nodes with room for 2 t nodes, and the count used.
+    """
+    t = len(corners)
+    centroids = (corners[:, 0] + corners[:, 1] + corners[:, 2]) / 3.0
+    lows = np.minimum(np.minimum(corners[:, 0], corners[:, 1]), corners[:, 2])
+    highs = np.maximum(np.maximum(corners[:, 0], corners[:, 1]), corners[:, 2])
+    order = np.arange(t)
+    capacity = max(1, 2 * t)
+    boxes = np.empty((capacity, 6))
+    nodes = np.empty((capacity, 3), dtype=np.int64)
+    pending = np.empty((capacity, 3), dtype=np.int64)  # (start, stop, node) still to split
+    pending[0, 0], pending[0, 1], pending[0, 2] = 0, t, 0
+    top, count = 1, 1
+    while top > 0:
+        top -= 1
+        start, stop, node = pending[top, 0], pending[top, 1], pending[top, 2]
         members = order[start:stop]
-        boxes[node] = np.concatenate((lows[members].min(axis=0), highs[members].max(axis=0)))
+        spread = np.empty(3)
+        for axis in range(3):
+            boxes[node, axis] = lows[members, axis].min()
+            boxes[node, 3 + axis] = highs[members, axis].max()
+            spread[axis] = centroids[members, axis].max() - centroids[members, axis].min()
         if stop - start <= leaf_size:
-            nodes[node] = (-1, start, stop - start)
+            nodes[node, 0], nodes[node, 1], nodes[node, 2] = -1, start, stop - start
             continue
-        spread = centroids[members].max(axis=0) - centroids[members].min(axis=0)
-        axis = int(np.argmax(spread))
+        axis = np.argmax(spread)
         middle = (stop - start) // 2
-        ranked = np.argpartition(centroids[members, axis], middle)
-        order[start:stop] = members[ranked]
-        child = len(nodes)
-        boxes.extend((None, None))
-        nodes.extend((None, None))
-        nodes[node] = (child, start, stop - start)
-        pending.append((start + middle, stop, child + 1))
-        pending.append((start, start + middle, child))
-    return order, np.array(boxes), np.array(nodes, dtype=np.int64)
+        order[start:stop] = members[np.argsort(centroids[members, axis])]
+        child = count
+        count += 2
+        nodes[node, 0], nodes[node, 1], nodes[node, 2] = child, start, stop - start
+        pending[top, 0], pending[top, 1], pending[top, 2] = start + middle, stop, child + 1
+        pending[top + 1, 0], pending[top + 1, 1] = start, start + middle
+        pending[top + 1, 2] = child
+        top += 2
+    return order, boxes, nodes, count
 
 
 def tree_depth(nodes: np.ndarray) -> int:

@@ -194,7 +194,7 @@ class Scene:
 
 
 def load_scene(path, *, request: DistanceRequest | None = None,
-               check_self_intersection: bool | None = None) -> Scene:
+               check_self_intersection: bool = True) -> Scene:
     """Read a scene file and build its scene, warmed up.
 
     Parameters
@@ -203,9 +203,9 @@ def load_scene(path, *, request: DistanceRequest | None = None,
         The YAML scene (format in ``scene_file``).
     request : DistanceRequest, optional
         Tolerances and iteration caps.
-    check_self_intersection : bool, optional
-        Reject self-intersecting meshes (``mesh_io.load_mesh``; needs fcl). By default only
-        when the scene enables FCL cross-validation, so that fcl stays unimported otherwise.
+    check_self_intersection : bool
+        Reject self-intersecting meshes (``mesh_io.load_mesh``, compiled; no fcl), whose signed
+        distance would have wrong signs. On by default; off only to load a huge mesh faster.
 
     Returns
     -------
@@ -219,8 +219,6 @@ def load_scene(path, *, request: DistanceRequest | None = None,
         For a mesh file that cannot carry a signed distance.
     """
     spec = read_scene(path)
-    if check_self_intersection is None:
-        check_self_intersection = spec.cross_validation.fcl
     objects = [SceneObject(o.name, _build_shape(o.shape, check_self_intersection), o.pose,
                            o.material) for o in spec.objects]
     scene = Scene(objects, frame_id=spec.frame_id, tip_radius=spec.tip_radius,
@@ -254,8 +252,8 @@ def _import_trimesh_without_fcl() -> None:
 
     ``import trimesh`` imports fcl when it is installed (for trimesh's collision manager, which
     nothing here uses), which would load fcl for every mesh scene. Hidden, trimesh keeps a
-    stand-in that raises on use, and a later ``import fcl`` (cross-validation, the mesh
-    self-intersection check) loads the real one.
+    stand-in that raises on use, and a later ``import fcl`` (cross-validation) loads the real
+    one.
     """
     if 'trimesh' in sys.modules or 'fcl' in sys.modules:
         return
