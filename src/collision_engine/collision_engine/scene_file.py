@@ -18,8 +18,10 @@ Format (SI units, REP-103 frames; paths relative to the scene file)::
 
 Shapes: ``box: {size}``, ``sphere: {radius}``, ``cylinder: {radius, height}`` (axis z),
 ``capsule: {radius, length}`` (axis z, ``length`` of the segment), ``mesh: {file, scale,
-convex}`` (``scale`` from file units to m, default 1; ``convex`` true queries the mesh's convex
-hull by GJK, false the exact non-convex surface; omitted, it is detected on load).
+convex}`` (``file`` relative to the scene file's folder, absolute, ``~/...`` or
+``package://<pkg>/<path>``; ``scale`` from file units to m, default 1; ``convex`` true queries
+the mesh's convex hull by GJK, false the exact non-convex surface; omitted, it is detected on
+load).
 """
 
 from dataclasses import dataclass
@@ -278,14 +280,36 @@ def _shape(reader: _Reader, value, where: str):
         return CylinderSpec(length('radius'), length('height'))
     if kind == 'capsule':
         return CapsuleSpec(length('radius'), length('length'))
-    file = reader.path.parent / reader.text(params['file'], f'{where}.file')
-    if not file.is_file():
-        reader.fail(f'{where}.file', f'no such file: {file}')
+    file = _mesh_file(reader, reader.text(params['file'], f'{where}.file'), f'{where}.file')
     scale = reader.number(params.get('scale', 1.0), f'{where}.scale', minimum=0.0, strict=True)
     convex = params.get('convex')
     if convex is not None:
         convex = reader.boolean(convex, f'{where}.convex')
     return MeshSpec(file.resolve(), scale, convex)
+
+
+def _mesh_file(reader: _Reader, given: str, where: str) -> Path:
+    """Find an existing mesh file as the scene gives it.
+
+    Relative to the scene file's folder (``a.stl``, ``./a.stl``, ``../meshes/a.stl``), whatever
+    the working directory; absolute; under the user's home (``~/a.stl``); or
+    ``package://<pkg>/<path>`` inside a package's share folder (``haptic_util.paths``).
+    """
+    if given.startswith('package://'):
+        from haptic_util.paths import package_file
+
+        try:
+            file = package_file(given)
+        except ValueError as error:
+            reader.fail(where, str(error))
+    else:
+        try:
+            file = reader.path.parent / Path(given).expanduser()  # absolute replaces the base
+        except RuntimeError as error:  # ~user for an unknown user
+            reader.fail(where, f'cannot expand {given!r}: {error}')
+    if not file.is_file():
+        reader.fail(where, f'no such file: {file}')
+    return file
 
 
 def _pose(reader: _Reader, value, where: str) -> Pose:
