@@ -2,6 +2,7 @@
 
 import os
 from pathlib import Path
+import re
 import sys
 import textwrap
 
@@ -119,21 +120,34 @@ def test_shipped_scenes_parse(name):
 ])
 def test_errors_name_the_file_and_the_key(tmp_path, old, new, message):
     assert old in GOOD
-    with pytest.raises(SceneError, match=f'^scene.yaml: {message}') as raised:
-        read_scene(write(tmp_path, GOOD.replace(old, new, 1)))
+    path = write(tmp_path, GOOD.replace(old, new, 1))
+    with pytest.raises(SceneError, match=f'^{re.escape(str(path))}: {message}') as raised:
+        read_scene(path)
     assert '\n' not in str(raised.value)
 
 
 @pytest.mark.parametrize('text, message', [
-    ('objects: [\n', r'^scene\.yaml: line \d+: not valid YAML'),
-    ('- 1\n- 2\n', r'^scene\.yaml: : must be a mapping'),
-    ('frame_id: world\n', r'^scene\.yaml: objects: missing'),
-    ('objects: {a: 1}\n', r'^scene\.yaml: objects: must be a list'),
-    ('objects: [{name: a}]\n', r'^scene\.yaml: objects\[0\]\.shape: missing'),
+    ('objects: [\n', r'line \d+: not valid YAML'),
+    ('- 1\n- 2\n', r': must be a mapping'),
+    ('frame_id: world\n', r'objects: missing'),
+    ('objects: {a: 1}\n', r'objects: must be a list'),
+    ('objects: [{name: a}]\n', r'objects\[0\]\.shape: missing'),
+    ('\udcff', r'not a text file'),
 ])
 def test_structural_errors(tmp_path, text, message):
-    with pytest.raises(SceneError, match=message):
-        read_scene(write(tmp_path, text))
+    path = write(tmp_path, '')
+    path.write_bytes(text.encode('utf-8', 'surrogateescape'))
+    with pytest.raises(SceneError, match=f'^{re.escape(str(path))}: {message}'):
+        read_scene(path)
+
+
+def test_errors_name_the_scene_by_the_path_as_given(tmp_path, monkeypatch):
+    # Relative to the working directory, as a user types it: not only its base name.
+    (tmp_path / 'site' / 'scenes').mkdir(parents=True)
+    (tmp_path / 'site' / 'scenes' / 'scene.yaml').write_text('objects: [{name: a}]\n')
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError, match=r'^site/scenes/scene\.yaml: objects\[0\]\.shape'):
+        read_scene('site/scenes/scene.yaml')
 
 
 def test_missing_scene_file(tmp_path):

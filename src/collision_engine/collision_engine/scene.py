@@ -14,6 +14,7 @@ import numpy as np
 
 from collision_engine import _kernels
 from collision_engine.distance import DistanceRequest
+from collision_engine.errors import MeshError
 from collision_engine.gjk import STATUS_INVALID_INPUT
 from collision_engine.results import BatchResult, QueryResult
 from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CrossValidationSpec,
@@ -216,11 +217,17 @@ def load_scene(path, *, request: DistanceRequest | None = None,
     SceneError
         For a bad scene file (see ``read_scene``).
     MeshError
-        For a mesh file that cannot carry a signed distance.
+        For a mesh file that cannot carry a signed distance: the scene file as given, the key
+        and the mesh file, then the defect.
     """
     spec = read_scene(path)
-    objects = [SceneObject(o.name, _build_shape(o.shape, check_self_intersection), o.pose,
-                           o.material) for o in spec.objects]
+    objects = []
+    for index, declared in enumerate(spec.objects):
+        try:
+            shape = _build_shape(declared.shape, check_self_intersection)
+        except MeshError as error:
+            raise MeshError(f'{spec.path}: objects[{index}].shape.mesh.file: {error}') from None
+        objects.append(SceneObject(declared.name, shape, declared.pose, declared.material))
     scene = Scene(objects, frame_id=spec.frame_id, tip_radius=spec.tip_radius,
                   request=request, cross_validation=spec.cross_validation)
     scene.warm_up()

@@ -2,8 +2,9 @@
 
 Reading a scene imports neither trimesh nor fcl and loads no mesh, so a tool (or the node's
 parameter check) can reject a bad file in milliseconds. Every mistake raises a ``SceneError``
-with one line naming the file and the key path, e.g.
-``cuboid.yaml: objects[0].material.stiffness: must be 3 finite numbers >= 0, got [160, nan]``.
+with one line naming the file, by the path as it was given, and the key path, e.g.
+``scenes/cuboid.yaml: objects[0].material.stiffness: must be 3 finite numbers >= 0, got [160,
+nan]``.
 
 Format (SI units, REP-103 frames; paths relative to the scene file)::
 
@@ -132,7 +133,7 @@ class _Reader:
         self.path = path
 
     def fail(self, where: str, message: str):
-        raise SceneError(f'{self.path.name}: {where}: {message}')
+        raise SceneError(f'{self.path}: {where}: {message}')
 
     def mapping(self, value, where: str, required=(), optional=()) -> dict:
         if not isinstance(value, dict):
@@ -212,12 +213,11 @@ def read_scene(path) -> SceneSpec:
     except OSError as error:
         raise SceneError(f'{path}: cannot read the scene file: {error.strerror}') from None
     except UnicodeDecodeError as error:
-        raise SceneError(f'{path.name}: not a text file (byte {error.start} is not UTF-8)') \
-            from None
+        raise SceneError(f'{path}: not a text file (byte {error.start} is not UTF-8)') from None
     except yaml.YAMLError as error:
         mark = getattr(error, 'problem_mark', None)
         at = f'line {mark.line + 1}' if mark is not None else 'document'
-        raise SceneError(f'{path.name}: {at}: not valid YAML: '
+        raise SceneError(f'{path}: {at}: not valid YAML: '
                          f'{getattr(error, "problem", error)}') from None
     top = reader.mapping(document, '', ('objects',),
                          ('frame_id', 'tip_radius', 'cross_validation'))
