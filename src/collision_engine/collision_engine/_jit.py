@@ -21,7 +21,7 @@ __all__ = ['jit']
 
 _PACKAGE = Path(__file__).resolve().parent
 _KERNEL_MODULES = ('_jit.py', 'norms.py', 'support.py', 'signed_volumes.py', 'gjk.py', 'epa.py',
-                   'bvh.py', '_kernels.py', 'self_intersection.py')
+                   'bvh.py', '_kernels.py', 'self_intersection.py', 'winding.py')
 _FINGERPRINT = _PACKAGE / '__pycache__' / 'kernels.sha256'
 
 

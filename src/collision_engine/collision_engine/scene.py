@@ -68,7 +68,8 @@ class Scene:
     request : DistanceRequest, optional
         Tolerances and iteration caps (its ``guess`` is not used by scene queries).
     cross_validation : CrossValidationSpec, optional
-        With ``fcl`` true, every ``every``-th ``query`` is checked against FCL.
+        With ``fcl`` true, every ``every``-th ``query`` is checked against FCL, on a worker
+        thread (``cross_validation.CrossValidationWorker``): call ``close`` when done.
     """
 
     def __init__(self, objects, *, frame_id: str = 'world', tip_radius: float = 0.0,
@@ -90,11 +91,12 @@ class Scene:
         self._row = np.empty(_kernels.OUT_SIZE)
         self._validator = None
         if cross_validation is not None and cross_validation.fcl and self.objects:
-            from collision_engine.cross_validation import FclCrossValidator
+            from collision_engine.cross_validation import CrossValidationWorker, FclCrossValidator
 
-            self._validator = FclCrossValidator(
-                shapes, poses, every=cross_validation.every,
-                tolerance=cross_validation.tolerance, tip_radius=self.tip_radius)
+            self._validator = CrossValidationWorker(
+                FclCrossValidator(shapes, poses, tolerance=cross_validation.tolerance,
+                                  tip_radius=self.tip_radius),
+                every=cross_validation.every)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -103,8 +105,20 @@ class Scene:
 
     @property
     def cross_validation_stats(self):
-        """Running FCL cross-check totals (``CrossValidationStats``), or None when off."""
+        """Running FCL cross-check totals (``CrossValidationStats``), or None when off.
+
+        The checks run behind the queries: ``wait_for_cross_validation`` first to count all.
+        """
         return None if self._validator is None else self._validator.stats
+
+    def wait_for_cross_validation(self, timeout: float | None = None) -> bool:
+        """Wait until every sampled query so far is checked; false on timeout (true when off)."""
+        return True if self._validator is None else self._validator.drain(timeout)
+
+    def close(self) -> None:
+        """Stop the cross-check's worker thread, if any (queries still work, unchecked)."""
+        if self._validator is not None:
+            self._validator.close()
 
     def warm_up(self) -> None:
         """Compile (or load from cache) every kernel, so that the first real query is fast.
@@ -141,10 +155,8 @@ class Scene:
         validator = self._validator
         if validator is None or values[7] < 0 or not validator.due():
             return QueryResult(values, self._names)
-        fcl_distance, discrepancy = validator.check(
-            int(values[7]), values[10:13], values[0], values[1:4])
-        return QueryResult(values, self._names, not math.isnan(fcl_distance), fcl_distance,
-                           discrepancy)
+        submitted = validator.submit(int(values[7]), (x, y, z), values[0], values[1:4])
+        return QueryResult(values, self._names, submitted)
 
     def query_many(self, points) -> BatchResult:
         """Signed distance from each of n tip positions to the nearest object (no FCL check).
