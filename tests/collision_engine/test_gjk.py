@@ -14,18 +14,24 @@ from scipy.spatial import QhullError
 
 from collision_engine.gjk import gjk, STATUS_NOT_CONVERGED, STATUS_OK
 from collision_engine.shapes import Capsule, ConvexMesh
-from collision_engine.support import pack_convex
+from collision_engine.support import pack_convex, POINT
 
 REL_TOL = ABS_TOL = 1e-12
 
 
-def run_gjk(shape, point, direction=None, max_iterations=100):
+def point_pair(shape, point):
+    """The packed shape as GJK's A and the point as B (a POINT posed at it): (a, b, rel)."""
     kind, floats, ints = pack_convex(shape)
+    rel = np.concatenate((np.eye(3).ravel(), np.asarray(point, dtype=np.float64)))
+    return (kind, floats, 0, ints, 0), (POINT, floats, 0, ints, 0), rel
+
+
+def run_gjk(shape, point, direction=None, max_iterations=100):
     direction = point if direction is None else direction
     size = shape.bounding_sphere()[1]
-    status, contact, count, vx, vy, vz, lower, iterations, _ = gjk(
-        kind, floats, 0, ints, 0, *point, *direction, size, REL_TOL, ABS_TOL, max_iterations,
-        np.zeros(12))
+    status, contact, count, vx, vy, vz, lower, iterations, *_ = gjk(
+        *point_pair(shape, point), *direction, size, REL_TOL, ABS_TOL, max_iterations,
+        np.zeros(12), np.zeros(12))
     return status, contact, np.array([vx, vy, vz]), lower, iterations
 
 

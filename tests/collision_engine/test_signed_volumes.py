@@ -12,7 +12,8 @@ from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
 
-from collision_engine.signed_volumes import closest_point_on_triangle, nearest_on_simplex
+from collision_engine.signed_volumes import (closest_point_on_triangle, nearest_on_simplex,
+                                             nearest_weights_on_triangle)
 
 
 simplex_points = arrays(np.float64, st.tuples(st.integers(1, 4), st.just(3)),
@@ -25,7 +26,7 @@ def test_sub_algorithm_matches_brute_force(points):
     W = np.zeros((4, 3))
     W[:len(points)] = points
     W = W.ravel()
-    count, vx, vy, vz = nearest_on_simplex(W, len(points))
+    count, vx, vy, vz, *_ = nearest_on_simplex(W, len(points), W, False)
     v = np.array([vx, vy, vz])
     assert np.isfinite(v).all()
     assert np.linalg.norm(v) == pytest.approx(simplex_distance(points), abs=1e-12)
@@ -49,7 +50,7 @@ def test_sub_algorithm_degenerate_simplices(points):
     points = np.array(points)
     W = np.zeros((4, 3))
     W[:len(points)] = points
-    count, vx, vy, vz = nearest_on_simplex(W.ravel(), len(points))
+    count, vx, vy, vz, *_ = nearest_on_simplex(W.ravel(), len(points), W.ravel(), False)
     assert np.isfinite([vx, vy, vz]).all()
     assert np.linalg.norm([vx, vy, vz]) == pytest.approx(simplex_distance(points), abs=1e-12)
 
@@ -66,3 +67,27 @@ def test_closest_point_on_a_triangle_and_its_feature(corners):
         a, b = np.delete(corners, which, axis=0)
         # On the edge's segment, not at its ends: orthogonal to it.
         assert abs(np.dot(v, b - a)) <= 1e-9 * np.linalg.norm(b - a) * max(1.0, np.linalg.norm(v))
+
+
+@settings(max_examples=300, deadline=None)
+@given(simplex_points, arrays(np.float64, 3, elements=st.floats(-5.0, 5.0)))
+def test_weights_give_the_nearest_point_and_tracked_rows_follow(points, offset):
+    W = np.zeros((4, 3))
+    W[:len(points)] = points
+    A = W + offset  # what each vertex came from: here the vertex moved by a known offset
+    W, A = W.ravel(), A.ravel()
+    count, vx, vy, vz, *weights = nearest_on_simplex(W, len(points), A, True)
+    kept, weights = W.reshape(4, 3)[:count], np.array(weights)
+    np.testing.assert_allclose(A.reshape(4, 3)[:count], kept + offset, rtol=0, atol=1e-12)
+    assert np.all(weights[:count] >= 0.0) and np.all(weights[count:] == 0.0)
+    assert weights.sum() == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(weights[:count] @ kept, [vx, vy, vz], rtol=0, atol=1e-12)
+
+
+@settings(max_examples=200, deadline=None)
+@given(arrays(np.float64, (3, 3), elements=st.floats(-1.0, 1.0)))
+def test_nearest_weights_on_a_triangle(corners):
+    weights = np.array(nearest_weights_on_triangle(*corners.ravel()))
+    assert np.all(weights >= 0.0) and weights.sum() == pytest.approx(1.0, abs=1e-12)
+    assert np.linalg.norm(weights @ corners) == pytest.approx(simplex_distance(corners),
+                                                              abs=1e-12)

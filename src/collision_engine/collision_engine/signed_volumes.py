@@ -12,7 +12,7 @@ import numpy as np
 
 from collision_engine._jit import jit
 
-__all__ = ['closest_point_on_triangle', 'nearest_on_simplex']
+__all__ = ['closest_point_on_triangle', 'nearest_on_simplex', 'nearest_weights_on_triangle']
 
 
 @jit
@@ -213,25 +213,33 @@ def _nearest_face(W, det, c0, c1, c2, c3, every):
 
 
 @jit
-def nearest_on_simplex(W, count):
+def nearest_on_simplex(W, count, A, track):
     """Reduce the simplex to the support set of its point nearest the origin.
 
     ``W`` is (12,): ``count`` vertices as rows of a row-major (4, 3) array. Its first
-    ``new_count`` rows are rewritten with the support set. Returns (new_count, vx, vy, vz).
+    ``new_count`` rows are rewritten with the support set; with ``track``, the rows of ``A``
+    (12,) (what each vertex came from, e.g. one shape's support point) move with them.
+    Returns (new_count, vx, vy, vz, l0, l1, l2, l3): v = sum of l_i times kept row i.
     """
     if count == 1:
-        return 1, W[0], W[1], W[2]
+        return 1, W[0], W[1], W[2], 1.0, 0.0, 0.0, 0.0
     if count == 2:
         n, a, b, la, vx, vy, vz = _s1d(W[0], W[1], W[2], W[3], W[4], W[5])
         _keep(W, a, b, -1, -1)
-        return n, vx, vy, vz
+        if track:
+            _keep(A, a, b, -1, -1)
+        return n, vx, vy, vz, la, 1.0 - la, 0.0, 0.0
     if count == 3:
         n, a, b, c, la, lb, lc, vx, vy, vz = _face_s2d(W, 0, 1, 2)
         _keep(W, a, b, c, -1)
-        return n, vx, vy, vz
+        if track:
+            _keep(A, a, b, c, -1)
+        return n, vx, vy, vz, la, lb, lc, 0.0
     n, a, b, c, d, la, lb, lc, ld, vx, vy, vz = _s3d(W)
     _keep(W, a, b, c, d)
-    return n, vx, vy, vz
+    if track:
+        _keep(A, a, b, c, d)
+    return n, vx, vy, vz, la, lb, lc, ld
 
 
 @jit
@@ -262,3 +270,16 @@ def closest_point_on_triangle(ax, ay, az, bx, by, bz, cx, cy, cz):
     if n == 2:
         which = 3 - i - j
     return vx * vx + vy * vy + vz * vz, vx, vy, vz, n, which
+
+
+@jit
+def nearest_weights_on_triangle(ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Barycentric weights (on a, b, c) of the triangle's point nearest the origin."""
+    n, i, j, k, li, lj, lk, _, _, _ = _s2d(ax, ay, az, bx, by, bz, cx, cy, cz)
+    weights = [0.0, 0.0, 0.0]
+    weights[i] = li
+    if n >= 2:
+        weights[j] = lj
+    if n == 3:
+        weights[k] = lk
+    return weights[0], weights[1], weights[2]
