@@ -39,7 +39,7 @@ from collision_engine.epa import epa, scratch_size as epa_scratch_size
 from collision_engine.gjk import gjk
 from collision_engine.scene import load_scene, Scene, SceneObject
 from collision_engine.shapes import Box, ConvexMesh, Cylinder, TriangleMesh
-from collision_engine.support import pack_convex
+from collision_engine.support import pack_convex, POINT
 
 sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
 import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
@@ -300,21 +300,21 @@ def format_rows(rows: list[dict], peer: str = 'coal') -> str:
 
 
 @jit
-def _epa_batch(kind, floats, ints, points, simplices, counts, invs, max_iter, scratch_floats,
-               scratch_ints, allocate):
+def _epa_batch(kind, floats, ints, rels, simplices, supports, counts, invs, max_iter,
+               scratch_floats, scratch_ints, allocate):
     """Run EPA on every prepared contact; ``allocate`` adds the 7 arrays it once allocated."""
     total = 0.0
     m = max_iter + 4
-    for k in range(len(points)):
+    for k in range(len(rels)):
         if allocate:  # the sizes and kinds of the arrays EPA allocated per call until 2026-11
             arrays = (np.empty((m, 3)), np.empty((2 * m, 3)), np.empty(2 * m))
             edges = (np.empty(6 * m, dtype=np.int64), np.empty(6 * m, dtype=np.int64))
             flags = np.zeros(2 * m, dtype=np.bool_)
             faces = np.empty((2 * m, 3), dtype=np.int64)
             total += arrays[0][0, 0] * 0.0 + flags[0] + (faces[0, 0] + edges[0][0]) * 0
-        q = (points[k, 0], points[k, 1], points[k, 2])
-        total += epa(kind, floats, 0, ints, 0, q, simplices[k], counts[k], invs[k], 1e-12,
-                     1e-12, max_iter, scratch_floats, scratch_ints)[1]
+        total += epa((kind, floats, 0, ints, 0), (POINT, floats, 0, ints, 0), rels[k],
+                     simplices[k], supports[k], counts[k], invs[k], 1e-12, 1e-12, max_iter,
+                     scratch_floats, scratch_ints)[1]
     return total
 
 
@@ -332,11 +332,13 @@ def epa_scratch_figures(name: str = 'cylinder_stl', count: int = 2000, rounds: i
     points = scene_object.pose.to_local(sets['inside'][0])
     kind, floats, ints = pack_convex(shape)
     radius = shape.bounding_sphere()[1]
-    simplices, counts, invs = np.zeros((count, 12)), np.zeros(count, np.int64), np.ones(count)
+    simplices, supports = np.zeros((count, 12)), np.zeros((count, 12))
+    counts, invs = np.zeros(count, np.int64), np.ones(count)
+    rels = np.column_stack((np.tile(np.eye(3).ravel(), (count, 1)), points))
     for k, point in enumerate(points):
         direction = point - shape.vertices.mean(axis=0)
-        contact = gjk(kind, floats, 0, ints, 0, *point, *direction, radius, 1e-12, 1e-12, 100,
-                      simplices[k])
+        contact = gjk((kind, floats, 0, ints, 0), (POINT, floats, 0, ints, 0), rels[k],
+                      *direction, radius, 1e-12, 1e-12, 100, simplices[k], supports[k])
         counts[k], invs[k] = contact[2], contact[8]
     max_iter = 128
     scratch = tuple(np.zeros(n, dtype) for n, dtype in zip(epa_scratch_size(max_iter),
@@ -344,8 +346,8 @@ def epa_scratch_figures(name: str = 'cylinder_stl', count: int = 2000, rounds: i
     times = {False: [], True: []}
     for _ in range(rounds):
         for allocate in (False, True):
-            arguments = (kind, floats, ints, points, simplices.copy(), counts, invs, max_iter,
-                         *scratch, allocate)
+            arguments = (kind, floats, ints, rels, simplices.copy(), supports.copy(), counts,
+                         invs, max_iter, *scratch, allocate)
             _epa_batch(*arguments)  # compiled, and warm
             start = time.perf_counter_ns()
             _epa_batch(*arguments)

@@ -261,8 +261,7 @@ def _abort_cause(said: str, child) -> str:
 def _fcl_child(case: _Case, pose: Pose, world: np.ndarray, results: list, sender,
                stderr: int) -> None:
     os.dup2(stderr, 2)
-    validator = FclCrossValidator([case.shape], [pose], every=1,
-                                  tolerance=FCL_TOLERANCE * case.scale)
+    validator = FclCrossValidator([case.shape], [pose], tolerance=FCL_TOLERANCE * case.scale)
     discrepancies = [validator.check(0, point, result.distance, result.point)[1]
                      for point, result in zip(world, results)]
     sender.send((float(np.nanmax(discrepancies)), validator.stats.disagreements))

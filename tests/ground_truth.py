@@ -7,6 +7,7 @@ sign rule is the engine's: negative inside, zero on the surface, positive outsid
 
 from collections.abc import Iterator
 from decimal import Decimal, localcontext
+from itertools import combinations
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,8 @@ __all__ = [
     'mesh_signed_distance',
     'sample_near_surface',
     'scene_path',
+    'simplex_distance',
+    'triangles_meet',
     'sphere_signed_distance',
     'winding_number',
 ]
@@ -85,6 +88,60 @@ def exact_unit(vector) -> np.ndarray:
         context.prec = 60
         norm = exact_norm(vector)
         return np.array([float(Decimal(float(c)) / norm) for c in vector])
+
+
+def simplex_distance(points: np.ndarray) -> float:
+    """Distance from the origin to the convex hull of at most 4 points, by enumerating subsets.
+
+    For each subset, the origin is projected onto its affine hull by least squares on the edge
+    vectors from its first point (scale-free), and kept if it falls inside the subset.
+
+    Parameters
+    ----------
+    points : (k <= 4, 3) float, m
+    """
+    points = _as_points(points)
+    best = np.inf
+    for size in range(1, len(points) + 1):
+        for subset in combinations(range(len(points)), size):
+            p = points[list(subset)]
+            edges = (p[1:] - p[0]).T
+            if size == 1:
+                weights = np.ones(1)
+            else:
+                steps = np.linalg.lstsq(edges, -p[0], rcond=None)[0]
+                weights = np.concatenate(([1.0 - steps.sum()], steps))
+            if np.all(weights >= -1e-12):
+                best = min(best, float(np.linalg.norm(weights @ p)))
+    return best
+
+
+def triangles_meet(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two triangles meet anywhere but along the corners and the edge they share.
+
+    By linear programming, not geometry: a point in both triangles is a pair of barycentric
+    weights (lambda on a's corners, mu on b's) with sum lambda_i a_i = sum mu_j b_j. The
+    triangles meet beyond what they share when such a point can give weight to a corner of a
+    that b lacks (any point, when they share no corner). Exact enough on small integer
+    coordinates, where a real meeting is far above the solver's 1e-9 tolerance.
+
+    Parameters
+    ----------
+    a, b : (3, 3) float
+        The corners; a corner of a equal to one of b's is shared.
+    """
+    from scipy.optimize import linprog
+
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    own = [not np.any(np.all(corner == b, axis=1)) for corner in a]
+    if not any(own):
+        return True
+    equalities = np.zeros((5, 6))
+    equalities[0, :3] = equalities[1, 3:] = 1.0
+    equalities[2:, :3], equalities[2:, 3:] = a.T, -b.T
+    result = linprog(-np.array(own + [False] * 3, dtype=float), A_eq=equalities,
+                     b_eq=[1.0, 1.0, 0.0, 0.0, 0.0], bounds=(0.0, None), method='highs')
+    return result.status == 0 and -result.fun > 1e-9
 
 
 def _rounded_box(excess: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ from scipy.spatial import QhullError
 from collision_engine.epa import epa, scratch_size
 from collision_engine.gjk import gjk, STATUS_OK
 from collision_engine.shapes import ConvexMesh
-from collision_engine.support import pack_convex
+from collision_engine.support import pack_convex, POINT
 
 TOL = 1e-12
 
@@ -26,15 +26,15 @@ def fresh_scratch(max_iter=128):
 def penetration(shape: ConvexMesh, point: np.ndarray, scratch=None):
     """GJK to contact, then EPA: (status, depth, closest point, normal)."""
     kind, floats, ints = pack_convex(shape)
-    W = np.zeros(12)
+    a, b = (kind, floats, 0, ints, 0), (POINT, floats, 0, ints, 0)
+    rel = np.concatenate((np.eye(3).ravel(), point))
+    W, A = np.zeros(12), np.zeros(12)
     direction = point - shape.vertices.mean(axis=0)
     size = shape.bounding_sphere()[1]
-    _, contact, count, *_, inv = gjk(kind, floats, 0, ints, 0, *point, *direction, size, TOL,
-                                     TOL, 100, W)
+    _, contact, count, *_, inv, _, _, _ = gjk(a, b, rel, *direction, size, TOL, TOL, 100, W, A)
     assert contact
     status, depth, bound, x, y, z, nx, ny, nz, _ = epa(
-        kind, floats, 0, ints, 0, tuple(point), W, count, inv, TOL, TOL, 128,
-        *(scratch or fresh_scratch()))
+        a, b, rel, W, A, count, inv, TOL, TOL, 128, *(scratch or fresh_scratch()))
     assert depth <= bound + 1e-15
     return status, depth, np.array([x, y, z]), np.array([nx, ny, nz])
 

@@ -1,11 +1,8 @@
-"""Our GJK and its signed-volumes sub-algorithm, against brute force.
+"""Our GJK, against brute force.
 
-The references here share no code with the engine: the nearest point of a small simplex by
-enumerating every face, edge and vertex with a least-squares affine projection, and the
-distance to a polytope by ``ground_truth.mesh_signed_distance`` on scipy's hull facets.
+The reference shares no code with the engine: the distance to a polytope by
+``ground_truth.mesh_signed_distance`` on scipy's hull facets.
 """
-
-from itertools import combinations
 
 from fuzzing import examples
 from ground_truth import capsule_signed_distance, mesh_signed_distance, outward_hull
@@ -16,42 +13,26 @@ import numpy as np
 import pytest
 from scipy.spatial import QhullError
 
-from collision_engine.gjk import (gjk, nearest_on_simplex, nearest_on_triangle,
-                                  STATUS_NOT_CONVERGED, STATUS_OK)
+from collision_engine.gjk import gjk, STATUS_NOT_CONVERGED, STATUS_OK
 from collision_engine.shapes import Capsule, ConvexMesh
-from collision_engine.support import pack_convex
+from collision_engine.support import pack_convex, POINT
 
 REL_TOL = ABS_TOL = 1e-12
 
 
-def brute_nearest(points: np.ndarray) -> float:
-    """Distance from the origin to the convex hull of <= 4 points, by enumerating subsets.
-
-    For each subset, the origin is projected onto its affine hull by least squares on the edge
-    vectors from its first point (scale-free), and kept if it falls inside the subset.
-    """
-    best = np.inf
-    for size in range(1, len(points) + 1):
-        for subset in combinations(range(len(points)), size):
-            p = points[list(subset)]
-            edges = (p[1:] - p[0]).T
-            if size == 1:
-                weights = np.ones(1)
-            else:
-                steps = np.linalg.lstsq(edges, -p[0], rcond=None)[0]
-                weights = np.concatenate(([1.0 - steps.sum()], steps))
-            if np.all(weights >= -1e-12):
-                best = min(best, float(np.linalg.norm(weights @ p)))
-    return best
+def point_pair(shape, point):
+    """The packed shape as GJK's A and the point as B (a POINT posed at it): (a, b, rel)."""
+    kind, floats, ints = pack_convex(shape)
+    rel = np.concatenate((np.eye(3).ravel(), np.asarray(point, dtype=np.float64)))
+    return (kind, floats, 0, ints, 0), (POINT, floats, 0, ints, 0), rel
 
 
 def run_gjk(shape, point, direction=None, max_iterations=100):
-    kind, floats, ints = pack_convex(shape)
     direction = point if direction is None else direction
     size = shape.bounding_sphere()[1]
-    status, contact, count, vx, vy, vz, lower, iterations, _ = gjk(
-        kind, floats, 0, ints, 0, *point, *direction, size, REL_TOL, ABS_TOL, max_iterations,
-        np.zeros(12))
+    status, contact, count, vx, vy, vz, lower, iterations, *_ = gjk(
+        *point_pair(shape, point), *direction, size, REL_TOL, ABS_TOL, max_iterations,
+        np.zeros(12), np.zeros(12))
     return status, contact, np.array([vx, vy, vz]), lower, iterations
 
 
@@ -59,59 +40,6 @@ def hull_distance(cloud: np.ndarray, points) -> np.ndarray:
     """Brute-force signed distance to the hull, its facets wound outward for the sign."""
     faces, _ = outward_hull(cloud)
     return mesh_signed_distance(np.asarray(points, dtype=np.float64), cloud, faces)[0]
-
-
-simplex_points = arrays(np.float64, st.tuples(st.integers(1, 4), st.just(3)),
-                        elements=st.floats(-1.0, 1.0))
-
-
-@settings(max_examples=examples(300), deadline=None)
-@given(simplex_points)
-def test_sub_algorithm_matches_brute_force(points):
-    W = np.zeros((4, 3))
-    W[:len(points)] = points
-    W = W.ravel()
-    count, vx, vy, vz = nearest_on_simplex(W, len(points))
-    v = np.array([vx, vy, vz])
-    assert np.isfinite(v).all()
-    assert np.linalg.norm(v) == pytest.approx(brute_nearest(points), abs=1e-12)
-    # The kept rows are input points whose hull holds v: the support set.
-    kept = W.reshape(4, 3)[:count]
-    assert all(np.any(np.all(points == row, axis=1)) for row in kept)
-    assert brute_nearest(kept) == pytest.approx(np.linalg.norm(v), abs=1e-12)
-
-
-@pytest.mark.parametrize('points', [
-    [[1.0, 1.0, 0.0], [1.0, 1.0, 0.0]],                                    # duplicate
-    [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]],                   # collinear
-    [[1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [1.0, -1.0, 1.0]],                 # repeated corner
-    [[1.0, -1.0, -1.0], [1.0, 1.0, -1.0], [1.0, 0.0, 1.0], [1.0, 0.2, 0.3]],  # coplanar
-    [[0.5, 0.5, 0.5]] * 4,                                                  # all one point
-    [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],                   # origin a vertex
-    [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],  # origin on an edge
-    [[1e-9, -1.0, -1.0], [1e-9, 1.0, -1.0], [1e-9, 0.0, 1.0], [1e-9 + 1e-20, 0.0, 0.0]],
-])
-def test_sub_algorithm_degenerate_simplices(points):
-    points = np.array(points)
-    W = np.zeros((4, 3))
-    W[:len(points)] = points
-    count, vx, vy, vz = nearest_on_simplex(W.ravel(), len(points))
-    assert np.isfinite([vx, vy, vz]).all()
-    assert np.linalg.norm([vx, vy, vz]) == pytest.approx(brute_nearest(points), abs=1e-12)
-
-
-@settings(max_examples=examples(200), deadline=None)
-@given(arrays(np.float64, (3, 3), elements=st.floats(-1.0, 1.0)))
-def test_triangle_step_reports_the_feature(corners):
-    d2, vx, vy, vz, feature, which = nearest_on_triangle(*corners.ravel())
-    assert d2 == pytest.approx(brute_nearest(corners) ** 2, abs=1e-12)
-    v = np.array([vx, vy, vz])
-    if feature == 1:
-        np.testing.assert_allclose(v, corners[which], atol=1e-15)
-    elif feature == 2:
-        a, b = np.delete(corners, which, axis=0)
-        # On the edge's segment, not at its ends: orthogonal to it.
-        assert abs(np.dot(v, b - a)) <= 1e-9 * np.linalg.norm(b - a) * max(1.0, np.linalg.norm(v))
 
 
 def grid_clouds():

@@ -2,11 +2,13 @@
 
 import dataclasses
 from pathlib import Path
+import re
 import subprocess
 import sys
 import tempfile
 
 from fuzzing import examples
+from ground_truth import triangles_meet
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -385,14 +387,53 @@ def test_bad_scale(tmp_path, scale):
     assert 'scale must be a positive finite number' in load_error(path, scale=scale)
 
 
+def named_pair(message: str) -> tuple[int, int]:
+    """The two face indices a self-intersection message names."""
+    found = re.search(r'triangles (\d+) and (\d+) \(0-based, as read\)', message)
+    assert found, message
+    return int(found.group(1)), int(found.group(2))
+
+
 def test_self_intersection(tmp_path):
     corners = CUBE_VERTICES[CUBE_FACES]
-    path = write(tmp_path, 'overlap.stl', binary_stl(np.vstack([corners,
-                                                                corners + [0.5, 0.3, 0.2]])))
+    overlapping = np.vstack([corners, corners + [0.5, 0.3, 0.2]])
+    path = write(tmp_path, 'overlap.stl', binary_stl(overlapping))
     message = load_error(path)
-    assert 'self-intersecting' in message and '(0-based, as read)' in message
+    assert 'self-intersecting' in message
+    first, second = named_pair(message)
+    assert triangles_meet(overlapping[first], overlapping[second])
     unchecked = load_mesh(path, check_self_intersection=False)
     assert len(unchecked.faces) == 24
+
+
+def test_one_body_poked_through_itself(tmp_path):
+    # A closed, consistently wound single body: one corner of the cube pushed out through the
+    # opposite face. Every other check passes; only the self-intersection test catches it.
+    vertices = CUBE_VERTICES.copy()
+    vertices[7] = [0.3, 0.4, -0.5]
+    corners = vertices[CUBE_FACES]
+    path = write(tmp_path, 'poked.stl', binary_stl(corners))
+    first, second = named_pair(load_error(path))
+    assert triangles_meet(corners[first], corners[second])
+    assert len(load_mesh(path, check_self_intersection=False).faces) == 12
+
+
+def test_bodies_touching_along_a_face(tmp_path):
+    # A half-size cube against the face x = 1, sharing no vertex: the surface touches itself.
+    corners = CUBE_VERTICES[CUBE_FACES]
+    touching = np.vstack([corners, 0.5 * corners + [1.0, 0.25, 0.25]])
+    path = write(tmp_path, 'touching.stl', binary_stl(touching))
+    message = load_error(path)
+    assert 'touch or cross' in message
+    first, second = named_pair(message)
+    assert triangles_meet(touching[first], touching[second])
+
+
+@pytest.mark.parametrize('name, scale', [('hand.stl', 0.001), ('cylinder.stl', 1.0),
+                                         ('cuboid.stl', 1.0)])
+def test_shipped_meshes_do_not_meet_themselves(name, scale):
+    # Load times, beside FCL's self-collision that this check replaced: bench/bench_mesh_load.py.
+    assert load_mesh(MESH_DIR / name, scale=scale, check_self_intersection=True).warnings == ()
 
 
 def test_separate_bodies_are_not_self_intersecting(tmp_path):

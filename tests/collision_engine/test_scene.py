@@ -2,6 +2,8 @@
 
 from itertools import product
 import math
+from pathlib import Path
+import re
 import subprocess
 import sys
 import textwrap
@@ -15,6 +17,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 import yaml
 
+from collision_engine.errors import MeshError
 from collision_engine.gjk import STATUS_NO_OBJECT, STATUS_OK
 from collision_engine.mesh_io import load_mesh
 from collision_engine.scene import load_scene, Scene, SceneObject
@@ -228,6 +231,54 @@ def test_only_what_a_scene_needs_is_imported(tmp_path):
         print(loaded())
     ''')
     assert output.splitlines() == ['[]', '[]', "['trimesh']", "['fcl', 'trimesh']"]
+
+
+CUBE = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+CUBE_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                       [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+
+
+def overlapping_cubes_scene(directory) -> Path:
+    """Two overlapping cubes in one file (centimetres) and a scene of it: closed, wound,
+    manifold, and wrong signs wherever they overlap."""
+    vertices = np.vstack([CUBE, CUBE + [0.5, 0.3, 0.2]])
+    faces = np.vstack([CUBE_FACES, CUBE_FACES + 8])
+    lines = [f'v {x} {y} {z}' for x, y, z in vertices]
+    lines += [f'f {a} {b} {c}' for a, b, c in faces + 1]
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / 'overlap.obj').write_text('\n'.join(lines) + '\n')
+    scene = directory / 'overlap.yaml'
+    scene.write_text('objects:\n'
+                     '  - {name: two, shape: {mesh: {file: overlap.obj, scale: 0.01}}}\n')
+    return scene
+
+
+def test_a_self_intersecting_mesh_is_refused_with_fcl_off(tmp_path):
+    # The check used to need FCL and ran only with cross-validation on.
+    scene = overlapping_cubes_scene(tmp_path)
+    output = run_python(f'''
+        import sys
+        from collision_engine import load_scene, MeshError
+        try:
+            load_scene({str(scene)!r})
+        except MeshError as error:
+            print(error)
+        print('fcl' in sys.modules)
+    ''')
+    message, fcl_loaded = output.splitlines()
+    assert message.startswith(f'{scene}: objects[0].shape.mesh.file: ')
+    assert 'overlap.obj' in message and 'self-intersecting' in message
+    assert re.search(r'triangles \d+ and \d+ \(0-based, as read\)', message)
+    assert fcl_loaded == 'False'
+
+
+def test_mesh_errors_name_the_scene_by_the_path_as_given(tmp_path, monkeypatch):
+    overlapping_cubes_scene(tmp_path / 'site')
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(MeshError) as raised:
+        load_scene('site/overlap.yaml')
+    assert str(raised.value).startswith('site/overlap.yaml: objects[0].shape.mesh.file: ')
+    assert f'{tmp_path}/site/overlap.obj: self-intersecting' in str(raised.value)
 
 
 def test_public_api():

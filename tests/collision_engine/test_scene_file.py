@@ -1,6 +1,9 @@
 """Scene files: what parses, and the one-line error naming file and key for what does not."""
 
+import os
 from pathlib import Path
+import re
+import sys
 import textwrap
 
 from fuzzing import examples
@@ -118,21 +121,34 @@ def test_shipped_scenes_parse(name):
 ])
 def test_errors_name_the_file_and_the_key(tmp_path, old, new, message):
     assert old in GOOD
-    with pytest.raises(SceneError, match=f'^scene.yaml: {message}') as raised:
-        read_scene(write(tmp_path, GOOD.replace(old, new, 1)))
+    path = write(tmp_path, GOOD.replace(old, new, 1))
+    with pytest.raises(SceneError, match=f'^{re.escape(str(path))}: {message}') as raised:
+        read_scene(path)
     assert '\n' not in str(raised.value)
 
 
 @pytest.mark.parametrize('text, message', [
-    ('objects: [\n', r'^scene\.yaml: line \d+: not valid YAML'),
-    ('- 1\n- 2\n', r'^scene\.yaml: : must be a mapping'),
-    ('frame_id: world\n', r'^scene\.yaml: objects: missing'),
-    ('objects: {a: 1}\n', r'^scene\.yaml: objects: must be a list'),
-    ('objects: [{name: a}]\n', r'^scene\.yaml: objects\[0\]\.shape: missing'),
+    ('objects: [\n', r'line \d+: not valid YAML'),
+    ('- 1\n- 2\n', r': must be a mapping'),
+    ('frame_id: world\n', r'objects: missing'),
+    ('objects: {a: 1}\n', r'objects: must be a list'),
+    ('objects: [{name: a}]\n', r'objects\[0\]\.shape: missing'),
+    ('\udcff', r'not a text file'),
 ])
 def test_structural_errors(tmp_path, text, message):
-    with pytest.raises(SceneError, match=message):
-        read_scene(write(tmp_path, text))
+    path = write(tmp_path, '')
+    path.write_bytes(text.encode('utf-8', 'surrogateescape'))
+    with pytest.raises(SceneError, match=f'^{re.escape(str(path))}: {message}'):
+        read_scene(path)
+
+
+def test_errors_name_the_scene_by_the_path_as_given(tmp_path, monkeypatch):
+    # Relative to the working directory, as a user types it: not only its base name.
+    (tmp_path / 'site' / 'scenes').mkdir(parents=True)
+    (tmp_path / 'site' / 'scenes' / 'scene.yaml').write_text('objects: [{name: a}]\n')
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError, match=r'^site/scenes/scene\.yaml: objects\[0\]\.shape'):
+        read_scene('site/scenes/scene.yaml')
 
 
 def test_missing_scene_file(tmp_path):
@@ -179,3 +195,57 @@ def test_fuzzed_bytes_give_a_scene_or_a_scene_error(tmp_path_factory, raw):
         read_scene(path)
     except SceneError as error:
         assert 'bytes.yaml' in str(error)
+
+
+# Mesh paths: every form is taken relative to the scene file's folder (or is absolute).
+
+@pytest.fixture
+def layout(tmp_path, monkeypatch):
+    """tmp/scenes/scene.yaml beside a.stl and sub/a.stl; tmp/meshes/b.stl; tmp/home/c.stl."""
+    for relative in ('scenes/a.stl', 'scenes/sub/a.stl', 'meshes/b.stl', 'home/c.stl'):
+        (tmp_path / relative).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / relative).write_bytes(b'')
+    monkeypatch.setenv('HOME', str(tmp_path / 'home'))
+    monkeypatch.setenv('AMENT_PREFIX_PATH', os.environ.get('AMENT_PREFIX_PATH', sys.prefix))
+    return tmp_path
+
+
+def mesh_scene(directory: Path, file: str) -> Path:
+    path = directory / 'scenes' / 'scene.yaml'
+    path.write_text(f'objects:\n  - {{name: m, shape: {{mesh: {{file: {file!r}}}}}}}\n')
+    return path
+
+
+@pytest.mark.parametrize('file, expected', [
+    ('a.stl', 'scenes/a.stl'), ('./a.stl', 'scenes/a.stl'), ('sub/a.stl', 'scenes/sub/a.stl'),
+    ('sub/../a.stl', 'scenes/a.stl'), ('../meshes/b.stl', 'meshes/b.stl'),
+    ('~/c.stl', 'home/c.stl'),
+])
+def test_mesh_paths_are_relative_to_the_scene_file(layout, monkeypatch, file, expected):
+    # Read from another working directory, by a relative scene path: the scene's folder counts.
+    monkeypatch.chdir(layout / 'meshes')
+    spec = read_scene(Path('..') / 'scenes' / mesh_scene(layout, file).name)
+    assert spec.objects[0].shape.file == (layout / expected).resolve()
+    assert spec.objects[0].shape.file.is_absolute()
+
+
+def test_absolute_and_package_mesh_paths(layout):
+    absolute = str(layout / 'meshes' / 'b.stl')
+    assert read_scene(mesh_scene(layout, absolute)).objects[0].shape.file == Path(absolute)
+    shipped = read_scene(mesh_scene(layout, 'package://collision_engine/scenes/meshes/hand.stl'))
+    assert shipped.objects[0].shape.file.name == 'hand.stl'
+    assert shipped.objects[0].shape.file.read_bytes() == \
+        (scene_path('hand').parent / 'meshes' / 'hand.stl').read_bytes()
+
+
+@pytest.mark.parametrize('file, message', [
+    ('missing.stl', r'no such file: .*scenes/missing\.stl'),
+    ('package://collision_engine/../../etc/passwd', 'names no file inside the share folder'),
+    ('package://collision_engine//etc/passwd', 'must be relative'),
+    ('package://no_such_package/a.stl', "package 'no_such_package' is not installed"),
+    ('~no_such_user_here/a.stl', 'cannot expand'),
+])
+def test_bad_mesh_paths_name_the_scene_and_the_key(layout, file, message):
+    path = mesh_scene(layout, file)
+    with pytest.raises(SceneError, match=r'objects\[0\]\.shape\.mesh\.file: .*' + message):
+        read_scene(path)

@@ -9,8 +9,9 @@ Packed scene layout
 ``floats``: ``[tip radius, rel_tol, abs_tol, scratch offset]``, then per object a record of
 ``OBJECT_FLOATS`` values: rotation (9, row-major, local to world), translation (3),
 bounding-sphere centre in the local frame (3) and in the world frame (3), bounding-sphere radius
-(1); then the shapes' float blocks; then scratch space: GJK's simplex (12), the search
-stack's box distances (s), EPA's floats (``epa.scratch_size``).
+(1); then the shapes' float blocks; then scratch space: GJK's simplex (12), the support points
+of A it came from (12) and B's pose in A's frame (12), the search stack's box distances (s),
+EPA's floats (``epa.scratch_size``).
 ``ints``: ``[object count, GJK iteration cap, EPA iteration cap, scratch offset]``, then per
 object ``[kind, object float record offset, shape float offset, shape int offset, hint]``
 (``hint`` is the last nearest triangle of a mesh, rewritten by every query as a warm start),
@@ -39,7 +40,7 @@ from collision_engine.gjk import (gjk, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
                                   STATUS_NOT_CONVERGED, STATUS_OK)
 from collision_engine.norms import norm3, unit3
 from collision_engine.support import (CAPSULE, CONVEX_MESH, CYLINDER, interior, pack_convex,
-                                      TRIANGLE_MESH)
+                                      POINT, TRIANGLE_MESH)
 
 __all__ = ['OUT_SIZE', 'OBJECT_FLOATS', 'pack_scene', 'place_object', 'query_point',
            'query_points', 'query_each_object', 'query_shape']
@@ -49,6 +50,7 @@ OBJECT_FLOATS = 19
 _HEADER_FLOATS = 4
 _HEADER_INTS = 4
 _OBJECT_INTS = 5
+_GJK_SCRATCH = 36  # simplex (12), A's support points (12), B's pose in A's frame (12)
 
 
 def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, abs_tol: float,
@@ -82,7 +84,7 @@ def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, 
                  if kind == TRIANGLE_MESH], default=1)
     epa_floats, epa_ints = scratch_size(max_epa_iterations)
     floats = np.concatenate([[tip_radius, rel_tol, abs_tol, float_at], *records, *float_blocks,
-                             np.zeros(12 + stack + epa_floats)])
+                             np.zeros(_GJK_SCRATCH + stack + epa_floats)])
     ints = np.concatenate([[n, max_iterations, max_epa_iterations, int_at], *table, *int_blocks,
                            [stack], np.zeros(stack + epa_ints)])
     return floats.astype(np.float64), ints.astype(np.int64)
@@ -113,8 +115,8 @@ def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, radius,
     """Signed distance to a convex shape: GJK outside, exact interior or EPA inside.
 
     (cx, cy, cz) and ``radius`` are the shape's bounding sphere, (gx, gy, gz) a first search
-    direction (zero: from the shape's core toward q). Returns (status, distance, lower bound,
-    x, y, z, nx, ny, nz, iterations), local frame.
+    direction (zero: from the shape's core toward q); W is GJK's scratch (``_GJK_SCRATCH``).
+    Returns (status, distance, lower bound, x, y, z, nx, ny, nz, iterations), local frame.
     """
     s, x, y, z, nx, ny, nz = 0.0, qx, qy, qz, 1.0, 0.0, 0.0
     if kind != CONVEX_MESH:
@@ -125,21 +127,33 @@ def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, radius,
         gx, gy, gz = qx - cx, qy - cy, qz - cz
         if kind == CYLINDER or kind == CAPSULE:
             gz = qz - min(max(qz, -floats[fo + 1]), floats[fo + 1])
-    status, contact, count, vx, vy, vz, lower, iterations, inv = gjk(
-        kind, floats, fo, ints, io, qx, qy, qz, gx, gy, gz, radius, rel_tol, abs_tol, max_iter,
-        W)
+    shape, point, simplex, supports, rel = _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W)
+    status, contact, count, vx, vy, vz, lower, iterations, inv, x, y, z = gjk(
+        shape, point, rel, gx, gy, gz, radius, rel_tol, abs_tol, max_iter, simplex, supports)
     if not contact:
         ux, uy, uz = unit3(vx, vy, vz)
-        return (status, norm3(vx, vy, vz), lower, qx + vx, qy + vy, qz + vz, -ux, -uy, -uz,
-                iterations)
+        return status, norm3(vx, vy, vz), lower, x, y, z, -ux, -uy, -uz, iterations
     if kind != CONVEX_MESH:
         # Within rounding of a primitive's surface: its exact interior formula holds there.
         return STATUS_OK, s, s, x, y, z, nx, ny, nz, iterations
     epa_floats, epa_ints = _epa_scratch(floats, ints)
     status, depth, bound, x, y, z, nx, ny, nz, more = epa(
-        kind, floats, fo, ints, io, (qx, qy, qz), W, count, inv, rel_tol, abs_tol,
-        max_epa_iter, epa_floats, epa_ints)
+        shape, point, rel, simplex, supports, count, inv, rel_tol, abs_tol, max_epa_iter,
+        epa_floats, epa_ints)
     return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
+
+
+@jit
+def _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W):
+    """Pose the point q as GJK's B against the packed shape, and split W into GJK's scratch.
+
+    Returns (shape, point, simplex, supports, rel): ``rel`` holds q as the point's pose.
+    """
+    rel = W[24:36]
+    rel[0], rel[1], rel[2], rel[3], rel[4], rel[5], rel[6], rel[7], rel[8] = (
+        1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+    rel[9], rel[10], rel[11] = qx, qy, qz
+    return (kind, floats, fo, ints, io), (POINT, floats, 0, ints, 0), W[:12], W[12:24], rel
 
 
 @jit
@@ -234,11 +248,12 @@ def _nearest(floats, ints, out, row, px, py, pz, W, stack, stack_d2):
 
 @jit
 def _scratch(floats, ints):
-    """View the scratch space: simplex (12,), search stack and its box distances (s,) each."""
+    """View the scratch space: GJK's (``_GJK_SCRATCH``,), the search stack, its distances."""
     f = int(floats[3])
     i = ints[3]
     stack = ints[i]
-    return floats[f:f + 12], ints[i + 1:i + 1 + stack], floats[f + 12:f + 12 + stack]
+    g = f + _GJK_SCRATCH
+    return floats[f:g], ints[i + 1:i + 1 + stack], floats[g:g + stack]
 
 
 @jit
@@ -248,8 +263,8 @@ def _epa_scratch(floats, ints):
     i = ints[3]
     stack = ints[i]
     n_floats, n_ints = scratch_size(ints[2])
-    return (floats[f + 12 + stack:f + 12 + stack + n_floats],
-            ints[i + 1 + stack:i + 1 + stack + n_ints])
+    g = f + _GJK_SCRATCH + stack
+    return floats[g:g + n_floats], ints[i + 1 + stack:i + 1 + stack + n_ints]
 
 
 @jit

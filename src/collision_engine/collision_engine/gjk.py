@@ -1,12 +1,12 @@
-"""Our GJK: distance from a point to a convex shape given by its support function, compiled.
+"""Our GJK: distance between two convex shapes given by their support functions, compiled.
 
-GJK (Gilbert, Johnson, Keerthi 1988) searches the shape minus the point, ``C = A - q``, for its
-point ``v`` nearest the origin; ``q + v`` is then the closest point of ``A`` and ``|v|`` the
-distance. The sub-algorithm that finds the nearest point of the current simplex is the
-signed-volumes method of Montanari, Petrinic and Barbieri (2017, ACM TOG 36(3) 32): barycentric
-coordinates as ratios of signed volumes (tetrahedron), areas (triangle, in the coordinate plane
-where it is largest) and lengths (segment), which its authors show to be more accurate and robust
-than Johnson's dot-product recursion on near-degenerate simplices.
+GJK (Gilbert, Johnson, Keerthi 1988) searches the Minkowski difference ``C = A - B`` for its
+point ``v`` nearest the origin: ``|v|`` is the distance, and the barycentric weights of v in its
+simplex, applied to the support points of A each vertex came from, give the witness on A (the
+one on B is that minus v). A point is the convex shape whose support is itself (``POINT``): the
+point query is this same GJK, ``q + v`` its closest point. The sub-algorithm that finds the
+nearest point of the current simplex is the signed-volumes method of Montanari, Petrinic and
+Barbieri (2017), in ``signed_volumes``.
 
 The loop stops on whichever comes first:
 
@@ -39,10 +39,11 @@ import math
 import numpy as np
 
 from collision_engine._jit import jit
-from collision_engine.support import support
+from collision_engine.signed_volumes import nearest_on_simplex
+from collision_engine.support import POINT, support
 
 __all__ = ['STATUS_OK', 'STATUS_NOT_CONVERGED', 'STATUS_NO_OBJECT', 'STATUS_INVALID_INPUT',
-           'gjk', 'nearest_on_simplex', 'nearest_on_triangle', 'power_of_two_inverse']
+           'gjk', 'power_of_two_inverse', 'support_difference']
 
 STATUS_OK = 0
 STATUS_NOT_CONVERGED = 1
@@ -54,256 +55,6 @@ _ROUNDING = 1024.0 * _EPS
 _CONTACT = 16.0 * _EPS
 _MAX_EXPONENT = 1000  # 2**1000 and 2**-1000 are finite and normal
 _SIDEWAYS = 2  # steps in a row to a simplex as near as the last to rounding, before a stall
-
-
-@jit
-def _same_sign(a, b):
-    return (a > 0.0 and b > 0.0) or (a < 0.0 and b < 0.0)
-
-
-@jit
-def _s1d(ax, ay, az, bx, by, bz):
-    """Nearest point to the origin on the segment a b.
-
-    Returns (count, first, second, lambda_first, vx, vy, vz): the support set as local indices
-    (0 for a, 1 for b; ``second`` is -1 when it is one vertex), the weight of ``first`` (the
-    other weight is 1 - lambda_first) and the nearest point.
-    """
-    tx, ty, tz = bx - ax, by - ay, bz - az
-    tt = tx * tx + ty * ty + tz * tz
-    if tt == 0.0:
-        return 1, 0, -1, 1.0, ax, ay, az
-    s = -(ax * tx + ay * ty + az * tz) / tt
-    px, py, pz = ax + s * tx, ay + s * ty, az + s * tz
-    # Signed lengths along the axis where the segment is longest.
-    if abs(tx) >= abs(ty) and abs(tx) >= abs(tz):
-        a_k, b_k, p_k = ax, bx, px
-    elif abs(ty) >= abs(tz):
-        a_k, b_k, p_k = ay, by, py
-    else:
-        a_k, b_k, p_k = az, bz, pz
-    mu = a_k - b_k
-    c_first = p_k - b_k
-    c_second = a_k - p_k
-    if _same_sign(mu, c_first) and _same_sign(mu, c_second):
-        la = c_first / mu
-        lb = 1.0 - la
-        return 2, 0, 1, la, la * ax + lb * bx, la * ay + lb * by, la * az + lb * bz
-    if _same_sign(mu, c_first):
-        return 1, 0, -1, 1.0, ax, ay, az
-    return 1, 1, -1, 1.0, bx, by, bz
-
-
-@jit
-def _cross_k(ux, uy, uz, wx, wy, wz, k):
-    """Component k of u x w: the signed area of (0, u, w) seen along axis k (doubled)."""
-    if k == 0:
-        return uy * wz - uz * wy
-    if k == 1:
-        return uz * wx - ux * wz
-    return ux * wy - uy * wx
-
-
-@jit
-def _s2d(ax, ay, az, bx, by, bz, cx, cy, cz):
-    """Nearest point to the origin on the triangle a b c.
-
-    Returns (count, i0, i1, i2, l0, l1, l2, vx, vy, vz): the support set as local indices in
-    increasing order (0 a, 1 b, 2 c; unused slots -1), their weights and the nearest point.
-    """
-    # No point of the triangle is nearer than its nearest point, nor farther than a corner:
-    # the consistency check that catches rounding on slivers.
-    corner2 = min(ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz,
-                  cx * cx + cy * cy + cz * cz)
-    ux, uy, uz = bx - ax, by - ay, bz - az
-    wx, wy, wz = cx - ax, cy - ay, cz - az
-    nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
-    nn = nx * nx + ny * ny + nz * nz
-    c0 = c1 = c2 = mu = 0.0
-    if nn > 0.0:
-        scale = (ax * nx + ay * ny + az * nz) / nn
-        px, py, pz = scale * nx, scale * ny, scale * nz
-        # Signed areas in the coordinate plane where the triangle's projection is largest.
-        k, mu = 0, nx
-        if abs(ny) > abs(mu):
-            k, mu = 1, ny
-        if abs(nz) > abs(mu):
-            k, mu = 2, nz
-        c0 = _cross_k(bx - px, by - py, bz - pz, cx - px, cy - py, cz - pz, k)
-        c1 = _cross_k(cx - px, cy - py, cz - pz, ax - px, ay - py, az - pz, k)
-        c2 = _cross_k(ax - px, ay - py, az - pz, bx - px, by - py, bz - pz, k)
-        if _same_sign(mu, c0) and _same_sign(mu, c1) and _same_sign(mu, c2):
-            total = c0 + c1 + c2
-            l0, l1, l2 = c0 / total, c1 / total, c2 / total
-            vx = l0 * ax + l1 * bx + l2 * cx
-            vy = l0 * ay + l1 * by + l2 * cy
-            vz = l0 * az + l1 * bz + l2 * cz
-            if vx * vx + vy * vy + vz * vz <= corner2:
-                return 3, 0, 1, 2, l0, l1, l2, vx, vy, vz
-    # The projection is outside (or the triangle is degenerate): the nearest point is on an
-    # edge facing the origin, one opposite a vertex whose signed area has the wrong sign.
-    result = _nearest_edge(ax, ay, az, bx, by, bz, cx, cy, cz, mu, c0, c1, c2, False)
-    if result[7] ** 2 + result[8] ** 2 + result[9] ** 2 > corner2:
-        # Farther than a corner: on a sliver, rounding tilted the plane or flipped a sign.
-        # No cheap test is left to trust, so every edge is tried.
-        result = _nearest_edge(ax, ay, az, bx, by, bz, cx, cy, cz, mu, c0, c1, c2, True)
-    return result
-
-
-@jit
-def _nearest_edge(ax, ay, az, bx, by, bz, cx, cy, cz, mu, c0, c1, c2, every):
-    """Nearest point on the edges facing the origin (``every``: on all three edges).
-
-    Returns the ``_s2d`` result tuple.
-    """
-    best = np.inf
-    result = (1, 0, -1, -1, 1.0, 0.0, 0.0, ax, ay, az)
-    if every or not _same_sign(mu, c0):
-        n, f, s, lf, vx, vy, vz = _s1d(bx, by, bz, cx, cy, cz)
-        best = vx * vx + vy * vy + vz * vz
-        result = (n, f + 1, s + 1 if s >= 0 else -1, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
-    if every or not _same_sign(mu, c1):
-        n, f, s, lf, vx, vy, vz = _s1d(ax, ay, az, cx, cy, cz)
-        dist = vx * vx + vy * vy + vz * vz
-        if dist < best:
-            best = dist
-            result = (n, 2 * f, 2 if s >= 0 else -1, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
-    if every or not _same_sign(mu, c2):
-        n, f, s, lf, vx, vy, vz = _s1d(ax, ay, az, bx, by, bz)
-        dist = vx * vx + vy * vy + vz * vz
-        if dist < best:
-            result = (n, f, s, -1, lf, 1.0 - lf, 0.0, vx, vy, vz)
-    return result
-
-
-@jit
-def _vertex(W, i):
-    """Row i of the flat (4 x 3, row-major) simplex W."""
-    return W[3 * i], W[3 * i + 1], W[3 * i + 2]
-
-
-@jit
-def _put(W, i, x, y, z):
-    W[3 * i], W[3 * i + 1], W[3 * i + 2] = x, y, z
-
-
-@jit
-def _det3(W, i, j, k):
-    ax, ay, az = _vertex(W, i)
-    bx, by, bz = _vertex(W, j)
-    cx, cy, cz = _vertex(W, k)
-    return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
-
-
-@jit
-def _face_s2d(W, i, j, k):
-    """``_s2d`` on the rows i < j < k of W, with the support set as rows of W."""
-    ax, ay, az = _vertex(W, i)
-    bx, by, bz = _vertex(W, j)
-    cx, cy, cz = _vertex(W, k)
-    n, a, b, c, la, lb, lc, vx, vy, vz = _s2d(ax, ay, az, bx, by, bz, cx, cy, cz)
-    rows = (i, j, k)
-    return (n, rows[a], rows[b] if b >= 0 else -1, rows[c] if c >= 0 else -1,
-            la, lb, lc, vx, vy, vz)
-
-
-@jit
-def _s3d(W):
-    """Nearest point to the origin on the tetrahedron W[0..3].
-
-    Returns (count, v0, v1, v2, v3, l0, l1, l2, l3, vx, vy, vz) with the support set as rows
-    of W; count 4 means the origin is inside and v = 0.
-    """
-    c0 = _det3(W, 1, 2, 3)
-    c1 = -_det3(W, 0, 2, 3)
-    c2 = _det3(W, 0, 1, 3)
-    c3 = -_det3(W, 0, 1, 2)
-    det = c0 + c1 + c2 + c3
-    if (_same_sign(det, c0) and _same_sign(det, c1) and _same_sign(det, c2)
-            and _same_sign(det, c3)):
-        return 4, 0, 1, 2, 3, c0 / det, c1 / det, c2 / det, c3 / det, 0.0, 0.0, 0.0
-    result = _nearest_face(W, det, c0, c1, c2, c3, False)
-    corner2 = min(W[0] ** 2 + W[1] ** 2 + W[2] ** 2, W[3] ** 2 + W[4] ** 2 + W[5] ** 2,
-                  W[6] ** 2 + W[7] ** 2 + W[8] ** 2, W[9] ** 2 + W[10] ** 2 + W[11] ** 2)
-    if result[9] ** 2 + result[10] ** 2 + result[11] ** 2 > corner2:
-        # Farther than a corner: rounding flipped a sign on a sliver; try every face.
-        result = _nearest_face(W, det, c0, c1, c2, c3, True)
-    return result
-
-
-@jit
-def _nearest_face(W, det, c0, c1, c2, c3, every):
-    """Nearest point on the faces facing the origin (``every``: on all four faces).
-
-    Returns the ``_s3d`` result tuple.
-    """
-    best = np.inf
-    result = (1, 0, -1, -1, -1, 1.0, 0.0, 0.0, 0.0, W[0], W[1], W[2])
-    for slot in range(4):
-        c = c0 if slot == 0 else (c1 if slot == 1 else (c2 if slot == 2 else c3))
-        if not every and _same_sign(det, c):
-            continue
-        # The face opposite the vertex in this slot, its rows in increasing order.
-        n, a, b, c_, la, lb, lc, vx, vy, vz = _face_s2d(
-            W, 1 if slot == 0 else 0, 1 if slot >= 2 else 2, 2 if slot == 3 else 3)
-        dist = vx * vx + vy * vy + vz * vz
-        if dist < best:
-            best = dist
-            result = (n, a, b, c_, -1, la, lb, lc, 0.0, vx, vy, vz)
-    return result
-
-
-@jit
-def nearest_on_simplex(W, count):
-    """Reduce the simplex to the support set of its point nearest the origin.
-
-    ``W`` is (12,): ``count`` vertices as rows of a row-major (4, 3) array. Its first
-    ``new_count`` rows are rewritten with the support set. Returns (new_count, vx, vy, vz).
-    """
-    if count == 1:
-        return 1, W[0], W[1], W[2]
-    if count == 2:
-        n, a, b, la, vx, vy, vz = _s1d(W[0], W[1], W[2], W[3], W[4], W[5])
-        _keep(W, a, b, -1, -1)
-        return n, vx, vy, vz
-    if count == 3:
-        n, a, b, c, la, lb, lc, vx, vy, vz = _face_s2d(W, 0, 1, 2)
-        _keep(W, a, b, c, -1)
-        return n, vx, vy, vz
-    n, a, b, c, d, la, lb, lc, ld, vx, vy, vz = _s3d(W)
-    _keep(W, a, b, c, d)
-    return n, vx, vy, vz
-
-
-@jit
-def _keep(W, a, b, c, d):
-    """Move rows a, b, c, d (-1 = absent, present ones in increasing order) of W to the front."""
-    slot = 0
-    for index in (a, b, c, d):
-        if index < 0:
-            continue
-        if index != slot:
-            x, y, z = _vertex(W, index)
-            _put(W, slot, x, y, z)
-        slot += 1
-
-
-@jit
-def nearest_on_triangle(ax, ay, az, bx, by, bz, cx, cy, cz):
-    """Nearest point to the origin on one triangle, with the feature it lies on.
-
-    This is GJK started from the whole triangle as its simplex: the signed-volumes step gives
-    the nearest point v, and the next support point (the triangle vertex farthest along -v)
-    cannot pass below v's bound, so GJK's termination test ends it after that one step.
-
-    Returns (squared distance, vx, vy, vz, feature, which) where feature is 3 (face), 2 (edge:
-    ``which`` is the vertex opposite it) or 1 (vertex: ``which`` is the vertex).
-    """
-    n, i, j, k, li, lj, lk, vx, vy, vz = _s2d(ax, ay, az, bx, by, bz, cx, cy, cz)
-    which = i
-    if n == 2:
-        which = 3 - i - j
-    return vx * vx + vy * vy + vz * vz, vx, vy, vz, n, which
 
 
 @jit
@@ -321,28 +72,55 @@ def power_of_two_inverse(length):
 
 
 @jit
-def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, size, rel_tol, abs_tol, max_iter,
-        W):
-    """Distance from the point q to a convex shape (packed as in ``support``), local frame.
+def support_difference(a, b, rel, dx, dy, dz, start_a, start_b):
+    """Support point of the Minkowski difference A - B along d, in A's frame.
 
-    (dx, dy, dz) is the first search direction, from the shape toward the point (a warm start
-    when it is near the answer); ``size`` (m) is about the shape's size (its bounding radius).
-    The search runs on ``C = A - q`` scaled by ``inv``, a power of two that brings the larger of
-    ``size`` and the first ``|w|`` to about 1 (``power_of_two_inverse``): exact, and no squared
-    length underflows or overflows at any magnitude of the shape or of the offset of q.
-    ``W`` (12,) is scratch; on contact it holds the final simplex of ``inv C`` for EPA, as rows
-    of a row-major (4, 3) array.
-
-    Returns (status, contact, count, vx, vy, vz, lower, iterations, inv): ``q + v`` is the
-    nearest point found, ``|v|`` the upper bound on the distance and ``lower`` the best lower
-    bound, in metres. ``contact`` is true when the point is inside or on the shape (then
-    v ~ 0).
+    ``a`` and ``b`` are packed shapes ``(kind, floats, fo, ints, io)`` (see ``support``);
+    ``rel`` (12,) is B's pose in A's frame, rotation row-major then translation
+    (``x_A = R x_B + t``). A point B (kind ``POINT``) is its translation, with no rotation.
+    Returns (wx, wy, wz, ax, ay, az, vertex_a, vertex_b): w = a - b, and a, A's support point.
     """
-    sx, sy, sz, vertex = support(kind, floats, fo, ints, io, dx, dy, dz, 0)
-    inv = power_of_two_inverse(max(abs(sx - qx), abs(sy - qy), abs(sz - qz), size))
-    vx, vy, vz = (sx - qx) * inv, (sy - qy) * inv, (sz - qz) * inv
+    ax, ay, az, vertex_a = support(a[0], a[1], a[2], a[3], a[4], dx, dy, dz, start_a)
+    if b[0] == POINT:
+        return ax - rel[9], ay - rel[10], az - rel[11], ax, ay, az, vertex_a, -1
+    ex = -(rel[0] * dx + rel[3] * dy + rel[6] * dz)  # -d in B's frame: R^T (-d)
+    ey = -(rel[1] * dx + rel[4] * dy + rel[7] * dz)
+    ez = -(rel[2] * dx + rel[5] * dy + rel[8] * dz)
+    sx, sy, sz, vertex_b = support(b[0], b[1], b[2], b[3], b[4], ex, ey, ez, start_b)
+    bx = rel[0] * sx + rel[1] * sy + rel[2] * sz + rel[9]
+    by = rel[3] * sx + rel[4] * sy + rel[5] * sz + rel[10]
+    bz = rel[6] * sx + rel[7] * sy + rel[8] * sz + rel[11]
+    return ax - bx, ay - by, az - bz, ax, ay, az, vertex_a, vertex_b
+
+
+@jit
+def gjk(a, b, rel, dx, dy, dz, size, rel_tol, abs_tol, max_iter, W, A):
+    """Distance between convex shapes A and B (packed as in ``support``), in A's frame.
+
+    GJK on ``C = A - B`` (``support_difference``; ``rel`` is B's pose in A's frame). A point is
+    the shape whose support is itself (``POINT``), which makes this the point query too; then
+    no witness is tracked, ``q + v`` being the nearest point. (dx, dy, dz) is the first search
+    direction, from B toward A (a warm start when it is near the answer); ``size`` (m) is about
+    the pair's size (the sum of their bounding radii). The search runs on C scaled by ``inv``, a
+    power of two that brings the larger of ``size`` and the first ``|w|`` to about 1
+    (``power_of_two_inverse``): exact, and no squared length underflows or overflows at any
+    magnitude of the shapes or of their offset. ``W`` and ``A`` (12,) are scratch; on contact
+    ``W`` holds the final simplex of ``inv C`` for EPA (rows of a row-major (4, 3) array) and
+    ``A`` the support points of A they came from.
+
+    Returns (status, contact, count, vx, vy, vz, lower, iterations, inv, wx, wy, wz): v = a - b
+    for the nearest points a of A (the witness w) and b = w - v of B found, ``|v|`` the upper
+    bound on the distance and ``lower`` the best lower bound, in metres. ``contact`` is true
+    when the shapes touch or overlap (then v ~ 0).
+    """
+    track = b[0] != POINT
+    cx, cy, cz, sx, sy, sz, vertex_a, vertex_b = support_difference(a, b, rel, dx, dy, dz, 0, 0)
+    inv = power_of_two_inverse(max(abs(cx), abs(cy), abs(cz), size))
+    vx, vy, vz = cx * inv, cy * inv, cz * inv
     abs_tol = abs_tol * inv
-    _put(W, 0, vx, vy, vz)
+    W[0], W[1], W[2] = vx, vy, vz
+    A[0], A[1], A[2] = sx, sy, sz
+    wx, wy, wz = sx, sy, sz  # the witness on A of the current v
     count = 1
     vv = vx * vx + vy * vy + vz * vz
     w_max2 = vv
@@ -352,15 +130,16 @@ def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, size, rel_tol, abs_t
     while iteration < max_iter:
         iteration += 1
         if vv == 0.0:
-            return STATUS_OK, True, count, 0.0, 0.0, 0.0, 0.0, iteration, inv
-        sx, sy, sz, vertex = support(kind, floats, fo, ints, io, -vx, -vy, -vz, vertex)
-        wx, wy, wz = (sx - qx) * inv, (sy - qy) * inv, (sz - qz) * inv
-        w_max2 = max(w_max2, wx * wx + wy * wy + wz * wz)
+            return STATUS_OK, True, count, 0.0, 0.0, 0.0, 0.0, iteration, inv, wx, wy, wz
+        cx, cy, cz, sx, sy, sz, vertex_a, vertex_b = support_difference(
+            a, b, rel, -vx, -vy, -vz, vertex_a, vertex_b)
+        cx, cy, cz = cx * inv, cy * inv, cz * inv
+        w_max2 = max(w_max2, cx * cx + cy * cy + cz * cz)
         norm_v = math.sqrt(vv)
-        vw = vx * wx + vy * wy + vz * wz
-        if vw > 0.0:
-            lower = max(lower, vw / norm_v)
-        gap = vv - vw
+        vc = vx * cx + vy * cy + vz * cz
+        if vc > 0.0:
+            lower = max(lower, vc / norm_v)
+        gap = vv - vc
         tolerance = max(rel_tol * vv, abs_tol * norm_v, _ROUNDING * norm_v * math.sqrt(w_max2))
         if gap <= tolerance:
             status = STATUS_OK
@@ -368,16 +147,20 @@ def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, size, rel_tol, abs_t
         stalled = STATUS_OK if gap <= _ROUNDING * w_max2 else STATUS_NOT_CONVERGED
         duplicate = False
         for m in range(count):
-            if W[3 * m] == wx and W[3 * m + 1] == wy and W[3 * m + 2] == wz:
+            if W[3 * m] == cx and W[3 * m + 1] == cy and W[3 * m + 2] == cz:
                 duplicate = True
         if duplicate:
             status = stalled
             break
-        _put(W, count, wx, wy, wz)
-        count, nx, ny, nz = nearest_on_simplex(W, count + 1)
+        W[3 * count], W[3 * count + 1], W[3 * count + 2] = cx, cy, cz
+        A[3 * count], A[3 * count + 1], A[3 * count + 2] = sx, sy, sz
+        count, nx, ny, nz, l0, l1, l2, l3 = nearest_on_simplex(W, count + 1, A, track)
         nn = nx * nx + ny * ny + nz * nz
         if count == 4 or nn <= (_CONTACT * _CONTACT) * w_max2:
-            return STATUS_OK, True, count, nx / inv, ny / inv, nz / inv, 0.0, iteration, inv
+            if track:
+                wx, wy, wz = _combine(A, count, l0, l1, l2, l3)
+            return (STATUS_OK, True, count, nx / inv, ny / inv, nz / inv, 0.0, iteration, inv,
+                    wx, wy, wz)
         if nn >= vv:
             # Not nearer. When only by rounding while the gap is still wide, the old v was the
             # one rounded low (it lay off its simplex by an ulp): take a few such steps.
@@ -388,4 +171,21 @@ def gjk(kind, floats, fo, ints, io, qx, qy, qz, dx, dy, dz, size, rel_tol, abs_t
         else:
             sideways = 0
         vx, vy, vz, vv = nx, ny, nz, nn
-    return status, False, count, vx / inv, vy / inv, vz / inv, lower / inv, iteration, inv
+        if track:
+            wx, wy, wz = _combine(A, count, l0, l1, l2, l3)
+    vx, vy, vz = vx / inv, vy / inv, vz / inv
+    if not track:
+        wx, wy, wz = rel[9] + vx, rel[10] + vy, rel[11] + vz
+    return status, False, count, vx, vy, vz, lower / inv, iteration, inv, wx, wy, wz
+
+
+@jit
+def _combine(A, count, l0, l1, l2, l3):
+    """Return the sum of l_i times row i of A, over its first ``count`` rows."""
+    x, y, z = l0 * A[0], l0 * A[1], l0 * A[2]
+    weights = (l1, l2, l3)
+    for row in range(1, count):
+        x += weights[row - 1] * A[3 * row]
+        y += weights[row - 1] * A[3 * row + 1]
+        z += weights[row - 1] * A[3 * row + 2]
+    return x, y, z

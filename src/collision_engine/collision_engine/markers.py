@@ -1,5 +1,17 @@
-"""RViz markers for the scene's objects and the current contact."""
+"""RViz markers for the scene's objects and the current contact.
+
+A mesh must not be published by its ``file://`` path: that names the machine's folders to every
+subscriber (user names, project layout), and the path means nothing on the machine running
+RViz anyway. A mesh inside an installed package's share folder is published as the
+``package://<pkg>/<path>`` URI RViz resolves on its own machine. Any other mesh is published as
+a ``TRIANGLE_LIST`` of its own triangles, in metres: it leaks nothing but the geometry RViz is
+there to draw, and shows the exact surface the engine queries, where a bounding shape would hide
+the very concavities (the gaps between fingers) that set the distance. Its cost is the triangles
+themselves, 3 points of 24 bytes each a message (about 0.8 MB for an 11k-triangle hand, sent at
+the node's marker rate): for a large mesh, install it in a package.
+"""
 import math
+from pathlib import Path
 
 from geometry_msgs.msg import Point, Pose, Quaternion
 from scipy.spatial.transform import Rotation
@@ -9,7 +21,7 @@ from visualization_msgs.msg import Marker
 from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CylinderSpec, MeshSpec,
                                          SceneSpec, SphereSpec)
 
-__all__ = ['scene_markers', 'contact_markers']
+__all__ = ['contact_markers', 'package_uri', 'scene_markers']
 
 OBJECT_COLOR = ColorRGBA(r=0.8, g=0.7, b=0.6, a=0.6)
 CONTACT_COLOR = ColorRGBA(r=1.0, g=0.2, b=0.1, a=1.0)
@@ -66,10 +78,48 @@ def _shape_markers(shape) -> list:
         caps = [_primitive(Marker.SPHERE, d, d, d, z=z) for z in (-half, half)]
         return [_primitive(Marker.CYLINDER, d, d, shape.length), *caps]
     if isinstance(shape, MeshSpec):
-        marker = _primitive(Marker.MESH_RESOURCE, shape.scale, shape.scale, shape.scale)
-        marker.mesh_resource = shape.file.resolve().as_uri()
-        return [marker]
+        return [_mesh_marker(shape)]
     raise TypeError(f'no marker for shape {shape!r}')
+
+
+def _mesh_marker(shape: MeshSpec) -> Marker:
+    """Show a mesh by its package:// URI, else by its triangles (module docstring)."""
+    uri = package_uri(shape.file)
+    if uri is not None:
+        marker = _primitive(Marker.MESH_RESOURCE, shape.scale, shape.scale, shape.scale)
+        marker.mesh_resource = uri
+        return marker
+    from collision_engine.mesh_io import load_mesh
+
+    mesh = load_mesh(shape.file, scale=shape.scale, check_self_intersection=False)
+    marker = _primitive(Marker.TRIANGLE_LIST, 1.0, 1.0, 1.0)
+    marker.points = [_point(corner) for corner in mesh.vertices[mesh.faces].reshape(-1, 3)]
+    return marker
+
+
+def package_uri(file: Path) -> str | None:
+    """``package://<pkg>/<path>`` of a file inside an installed package's share folder, or None.
+
+    The package whose share folder holds the file most deeply wins; both sides are compared with
+    symlinks resolved (as ``haptic_util.paths.package_file`` maps the URI back).
+    """
+    from ament_index_python.packages import get_packages_with_prefixes
+
+    target = Path(file).resolve()
+    try:
+        packages = get_packages_with_prefixes()
+    except OSError:  # no AMENT_PREFIX_PATH: no package is installed
+        return None
+    best = None
+    for package, prefix in packages.items():
+        share = (Path(prefix) / 'share' / package).resolve()
+        deeper = best is None or len(share.parts) > len(best[1].parts)
+        if target.is_relative_to(share) and deeper:
+            best = package, share
+    if best is None:
+        return None
+    package, share = best
+    return f'package://{package}/{target.relative_to(share).as_posix()}'
 
 
 def _primitive(kind: int, sx: float, sy: float, sz: float, *, z: float = 0.0) -> Marker:

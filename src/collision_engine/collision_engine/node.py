@@ -115,12 +115,15 @@ class CollisionNode(Node):
         if stats is None:
             return Report(OK, 'FCL cross-validation off', values)
         values.update(fcl_checks=stats.checks, fcl_disagreements=stats.disagreements,
-                      fcl_max_discrepancy_m=stats.max_discrepancy, fcl_errors=stats.errors)
+                      fcl_max_discrepancy_m=stats.max_discrepancy, fcl_errors=stats.errors,
+                      fcl_dropped=stats.dropped, sign_checks=stats.sign_checks,
+                      sign_disagreements=stats.sign_disagreements)
         return Report(WARN if stats.disagreements else OK,
                       f'{stats.disagreements} FCL disagreement(s) in {stats.checks} check(s)',
                       values)
 
     def destroy_node(self) -> bool:
+        self.scene.close()  # the FCL cross-check's worker thread
         self.diagnostics.final()
         self.get_logger().info(f'answered {self._answered} poses, refused '
                                f'{self._refused.total()}')

@@ -25,11 +25,11 @@ class QueryResult:
     Attributes
     ----------
     cross_validated : bool
-        True when FCL checked this query.
-    fcl_distance : float, m
-        FCL's distance to the same object (unsigned for a non-convex mesh); NaN when not run.
-    fcl_discrepancy : float, m
-        ``|distance - fcl_distance|`` (of magnitudes for a non-convex mesh); NaN when not run.
+        True when this query was handed to the FCL cross-check. The check runs afterwards, on
+        its own thread: its verdict goes to ``Scene.cross_validation_stats``, not here.
+    fcl_distance, fcl_discrepancy : float, m
+        NaN: FCL's answer for this query comes after the query returns (the totals are in
+        ``CrossValidationStats``). Kept for ``CollisionState``'s fields of the same names.
     """
 
     __slots__ = ('_row', '_names', 'cross_validated', 'fcl_distance', 'fcl_discrepancy')
@@ -79,7 +79,7 @@ class QueryResult:
 
     @property
     def iterations(self) -> int:
-        """GJK and EPA iterations spent (for a mesh: triangles tested, one GJK step each)."""
+        """GJK and EPA iterations spent (for a mesh: triangles tested, each in closed form)."""
         return int(self._row[8])
 
     @property

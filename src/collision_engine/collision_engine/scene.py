@@ -17,6 +17,7 @@ import numpy as np
 from collision_engine import _kernels
 from collision_engine._jit import compiling
 from collision_engine.distance import DistanceRequest
+from collision_engine.errors import MeshError
 from collision_engine.gjk import STATUS_INVALID_INPUT
 from collision_engine.results import BatchResult, QueryResult
 from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CrossValidationSpec,
@@ -72,7 +73,8 @@ class Scene:
     request : DistanceRequest, optional
         Tolerances and iteration caps (its ``guess`` is not used by scene queries).
     cross_validation : CrossValidationSpec, optional
-        With ``fcl`` true, every ``every``-th ``query`` is checked against FCL.
+        With ``fcl`` true, every ``every``-th ``query`` is checked against FCL, on a worker
+        thread (``cross_validation.CrossValidationWorker``): call ``close`` when done.
     """
 
     def __init__(self, objects, *, frame_id: str = 'world', tip_radius: float = 0.0,
@@ -94,11 +96,12 @@ class Scene:
         self._row = np.empty(_kernels.OUT_SIZE)
         self._validator = None
         if cross_validation is not None and cross_validation.fcl and self.objects:
-            from collision_engine.cross_validation import FclCrossValidator
+            from collision_engine.cross_validation import CrossValidationWorker, FclCrossValidator
 
-            self._validator = FclCrossValidator(
-                shapes, poses, every=cross_validation.every,
-                tolerance=cross_validation.tolerance, tip_radius=self.tip_radius)
+            self._validator = CrossValidationWorker(
+                FclCrossValidator(shapes, poses, tolerance=cross_validation.tolerance,
+                                  tip_radius=self.tip_radius),
+                every=cross_validation.every)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -107,8 +110,20 @@ class Scene:
 
     @property
     def cross_validation_stats(self):
-        """Running FCL cross-check totals (``CrossValidationStats``), or None when off."""
+        """Running FCL cross-check totals (``CrossValidationStats``), or None when off.
+
+        The checks run behind the queries: ``wait_for_cross_validation`` first to count all.
+        """
         return None if self._validator is None else self._validator.stats
+
+    def wait_for_cross_validation(self, timeout: float | None = None) -> bool:
+        """Wait until every sampled query so far is checked; false on timeout (true when off)."""
+        return True if self._validator is None else self._validator.drain(timeout)
+
+    def close(self) -> None:
+        """Stop the cross-check's worker thread, if any (queries still work, unchecked)."""
+        if self._validator is not None:
+            self._validator.close()
 
     def warm_up(self, announce: Callable[[str], None] = _LOG.info) -> None:
         """Compile (or load from cache) every kernel, so that the first real query is fast.
@@ -147,10 +162,8 @@ class Scene:
         validator = self._validator
         if validator is None or values[7] < 0 or not validator.due():
             return QueryResult(values, self._names)
-        fcl_distance, discrepancy = validator.check(
-            int(values[7]), values[10:13], values[0], values[1:4])
-        return QueryResult(values, self._names, not math.isnan(fcl_distance), fcl_distance,
-                           discrepancy)
+        submitted = validator.submit(int(values[7]), (x, y, z), values[0], values[1:4])
+        return QueryResult(values, self._names, submitted)
 
     def query_many(self, points) -> BatchResult:
         """Signed distance from each of n tip positions to the nearest object (no FCL check).
@@ -201,7 +214,7 @@ class Scene:
 
 
 def load_scene(path, *, request: DistanceRequest | None = None,
-               check_self_intersection: bool | None = None,
+               check_self_intersection: bool = True,
                announce: Callable[[str], None] = _LOG.info) -> Scene:
     """Read a scene file and build its scene, warmed up.
 
@@ -211,9 +224,9 @@ def load_scene(path, *, request: DistanceRequest | None = None,
         The YAML scene (format in ``scene_file``).
     request : DistanceRequest, optional
         Tolerances and iteration caps.
-    check_self_intersection : bool, optional
-        Reject self-intersecting meshes (``mesh_io.load_mesh``; needs fcl). By default only
-        when the scene enables FCL cross-validation, so that fcl stays unimported otherwise.
+    check_self_intersection : bool
+        Reject self-intersecting meshes (``mesh_io.load_mesh``, compiled; no fcl), whose signed
+        distance would have wrong signs. On by default; off only to load a huge mesh faster.
     announce : callable str -> None
         Told in one line when this process compiles the kernels (see ``Scene.warm_up``).
 
@@ -226,13 +239,17 @@ def load_scene(path, *, request: DistanceRequest | None = None,
     SceneError
         For a bad scene file (see ``read_scene``).
     MeshError
-        For a mesh file that cannot carry a signed distance.
+        For a mesh file that cannot carry a signed distance: the scene file as given, the key
+        and the mesh file, then the defect.
     """
     spec = read_scene(path)
-    if check_self_intersection is None:
-        check_self_intersection = spec.cross_validation.fcl
-    objects = [SceneObject(o.name, _build_shape(o.shape, check_self_intersection), o.pose,
-                           o.material) for o in spec.objects]
+    objects = []
+    for index, declared in enumerate(spec.objects):
+        try:
+            shape = _build_shape(declared.shape, check_self_intersection)
+        except MeshError as error:
+            raise MeshError(f'{spec.path}: objects[{index}].shape.mesh.file: {error}') from None
+        objects.append(SceneObject(declared.name, shape, declared.pose, declared.material))
     scene = Scene(objects, frame_id=spec.frame_id, tip_radius=spec.tip_radius,
                   request=request, cross_validation=spec.cross_validation)
     scene.warm_up(announce)
@@ -264,8 +281,8 @@ def _import_trimesh_without_fcl() -> None:
 
     ``import trimesh`` imports fcl when it is installed (for trimesh's collision manager, which
     nothing here uses), which would load fcl for every mesh scene. Hidden, trimesh keeps a
-    stand-in that raises on use, and a later ``import fcl`` (cross-validation, the mesh
-    self-intersection check) loads the real one.
+    stand-in that raises on use, and a later ``import fcl`` (cross-validation) loads the real
+    one.
     """
     if 'trimesh' in sys.modules or 'fcl' in sys.modules:
         return

@@ -2,8 +2,9 @@
 
 Reading a scene imports neither trimesh nor fcl and loads no mesh, so a tool (or the node's
 parameter check) can reject a bad file in milliseconds. Every mistake raises a ``SceneError``
-with one line naming the file and the key path, e.g.
-``cuboid.yaml: objects[0].material.stiffness: must be 3 finite numbers >= 0, got [160, nan]``.
+with one line naming the file, by the path as it was given, and the key path, e.g.
+``scenes/cuboid.yaml: objects[0].material.stiffness: must be 3 finite numbers >= 0, got [160,
+nan]``.
 
 Format (SI units, REP-103 frames; paths relative to the scene file)::
 
@@ -18,8 +19,10 @@ Format (SI units, REP-103 frames; paths relative to the scene file)::
 
 Shapes: ``box: {size}``, ``sphere: {radius}``, ``cylinder: {radius, height}`` (axis z),
 ``capsule: {radius, length}`` (axis z, ``length`` of the segment), ``mesh: {file, scale,
-convex}`` (``scale`` from file units to m, default 1; ``convex`` true queries the mesh's convex
-hull by GJK, false the exact non-convex surface; omitted, it is detected on load).
+convex}`` (``file`` relative to the scene file's folder, absolute, ``~/...`` or
+``package://<pkg>/<path>``; ``scale`` from file units to m, default 1; ``convex`` true queries
+the mesh's convex hull by GJK, false the exact non-convex surface; omitted, it is detected on
+load).
 """
 
 from dataclasses import dataclass
@@ -130,7 +133,7 @@ class _Reader:
         self.path = path
 
     def fail(self, where: str, message: str):
-        raise SceneError(f'{self.path.name}: {where}: {message}')
+        raise SceneError(f'{self.path}: {where}: {message}')
 
     def mapping(self, value, where: str, required=(), optional=()) -> dict:
         if not isinstance(value, dict):
@@ -210,12 +213,11 @@ def read_scene(path) -> SceneSpec:
     except OSError as error:
         raise SceneError(f'{path}: cannot read the scene file: {error.strerror}') from None
     except UnicodeDecodeError as error:
-        raise SceneError(f'{path.name}: not a text file (byte {error.start} is not UTF-8)') \
-            from None
+        raise SceneError(f'{path}: not a text file (byte {error.start} is not UTF-8)') from None
     except yaml.YAMLError as error:
         mark = getattr(error, 'problem_mark', None)
         at = f'line {mark.line + 1}' if mark is not None else 'document'
-        raise SceneError(f'{path.name}: {at}: not valid YAML: '
+        raise SceneError(f'{path}: {at}: not valid YAML: '
                          f'{getattr(error, "problem", error)}') from None
     top = reader.mapping(document, '', ('objects',),
                          ('frame_id', 'tip_radius', 'cross_validation'))
@@ -278,14 +280,36 @@ def _shape(reader: _Reader, value, where: str):
         return CylinderSpec(length('radius'), length('height'))
     if kind == 'capsule':
         return CapsuleSpec(length('radius'), length('length'))
-    file = reader.path.parent / reader.text(params['file'], f'{where}.file')
-    if not file.is_file():
-        reader.fail(f'{where}.file', f'no such file: {file}')
+    file = _mesh_file(reader, reader.text(params['file'], f'{where}.file'), f'{where}.file')
     scale = reader.number(params.get('scale', 1.0), f'{where}.scale', minimum=0.0, strict=True)
     convex = params.get('convex')
     if convex is not None:
         convex = reader.boolean(convex, f'{where}.convex')
     return MeshSpec(file.resolve(), scale, convex)
+
+
+def _mesh_file(reader: _Reader, given: str, where: str) -> Path:
+    """Find an existing mesh file as the scene gives it.
+
+    Relative to the scene file's folder (``a.stl``, ``./a.stl``, ``../meshes/a.stl``), whatever
+    the working directory; absolute; under the user's home (``~/a.stl``); or
+    ``package://<pkg>/<path>`` inside a package's share folder (``haptic_util.paths``).
+    """
+    if given.startswith('package://'):
+        from haptic_util.paths import package_file
+
+        try:
+            file = package_file(given)
+        except ValueError as error:
+            reader.fail(where, str(error))
+    else:
+        try:
+            file = reader.path.parent / Path(given).expanduser()  # absolute replaces the base
+        except RuntimeError as error:  # ~user for an unknown user
+            reader.fail(where, f'cannot expand {given!r}: {error}')
+    if not file.is_file():
+        reader.fail(where, f'no such file: {file}')
+    return file
 
 
 def _pose(reader: _Reader, value, where: str) -> Pose:

@@ -12,6 +12,8 @@ CYLINDER       radius, half height (axis z)                    (none)
 CAPSULE        radius, half segment length (axis z)            (none)
 CONVEX_MESH    n vertices x, y, z                              n, then CSR vertex adjacency:
                                                                n + 1 offsets, then neighbours
+POINT          (none): the point is the local origin            (none)
+TRIANGLE       corners a, b, c (9)                             (none)
 =============  ==============================================  ===================================
 
 All vectors are in the shape's local frame, in metres.
@@ -23,7 +25,7 @@ from collision_engine._jit import jit
 from collision_engine.norms import norm2, norm3, scaled3, unit2, unit3
 
 __all__ = [
-    'BOX', 'SPHERE', 'CYLINDER', 'CAPSULE', 'CONVEX_MESH', 'TRIANGLE_MESH',
+    'BOX', 'SPHERE', 'CYLINDER', 'CAPSULE', 'CONVEX_MESH', 'TRIANGLE_MESH', 'POINT', 'TRIANGLE',
     'pack_convex', 'support', 'support_point', 'interior',
 ]
 
@@ -33,6 +35,8 @@ CYLINDER = 2
 CAPSULE = 3
 CONVEX_MESH = 4
 TRIANGLE_MESH = 5
+POINT = 6
+TRIANGLE = 7
 
 
 def pack_convex(shape) -> tuple[int, np.ndarray, np.ndarray]:
@@ -100,8 +104,24 @@ def support(kind, floats, fo, ints, io, dx, dy, dz, start):
         if ux == 0.0 and uy == 0.0 and uz == 0.0:
             return r, 0.0, z, -1
         return r * ux, r * uy, z + r * uz, -1
+    if kind == POINT:
+        return 0.0, 0.0, 0.0, -1
     sx, sy, sz = scaled3(dx, dy, dz)
+    if kind == TRIANGLE:
+        return _farthest_corner(floats, fo, sx, sy, sz)
     return _hill_climb(floats, fo, ints, io, sx, sy, sz, start)
+
+
+@jit
+def _farthest_corner(floats, fo, dx, dy, dz):
+    """Support of a triangle: its corner farthest along d (first of equals)."""
+    best, best_dot = 0, floats[fo] * dx + floats[fo + 1] * dy + floats[fo + 2] * dz
+    for k in (1, 2):
+        dot = floats[fo + 3 * k] * dx + floats[fo + 3 * k + 1] * dy + floats[fo + 3 * k + 2] * dz
+        if dot > best_dot:
+            best, best_dot = k, dot
+    p = fo + 3 * best
+    return floats[p], floats[p + 1], floats[p + 2], best
 
 
 @jit
