@@ -10,8 +10,11 @@ Arguments: ``scene:=<path or package://...>``, ``experiment:=cuboid|cylinder|han
 DDS discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``) unless the user
 exported another range. The loop is all or nothing: when one of its nodes exits, the launch
 stops the others, and exits non-zero if that node failed (a misspelt ``experiment``, say).
+``kill -INT`` of the launch process stops the loop also when a script started it in the background.
 """
 import os
+import signal
+import threading
 
 from ament_index_python.packages import get_package_share_directory
 from launch import LaunchDescription
@@ -27,6 +30,19 @@ from haptic_bringup.params import LOOP_TOPICS
 NODES = (('haptic_wand_driver', 'wand_driver', 'wand_driver'),
          ('collision_engine', 'collision_node', 'collision_engine'),
          ('force_renderer', 'force_node', 'force_renderer'))
+
+
+def _hear_sigint() -> None:
+    """Let launch hear SIGINT when it was started as a script's background job.
+
+    A shell without job control starts ``ros2 launch ... &`` with SIGINT ignored, so Python sets
+    no handler and launch, which learns of signals through Python's wakeup fd, never sees one:
+    ``kill -INT <launch pid>`` did nothing. Any Python handler makes the signal reach launch's own
+    SIGINT handling; this one does nothing else.
+    """
+    if (threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.SIG_IGN):
+        signal.signal(signal.SIGINT, lambda signum, frame: None)
 
 
 def _config(package: str) -> str:
@@ -80,6 +96,7 @@ def _nodes(context):
 
 
 def generate_launch_description() -> LaunchDescription:
+    _hear_sigint()
     return LaunchDescription([
         SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', EnvironmentVariable(
             'ROS_AUTOMATIC_DISCOVERY_RANGE', default_value='LOCALHOST')),
