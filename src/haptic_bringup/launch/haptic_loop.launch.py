@@ -14,6 +14,7 @@ stops the others, and exits non-zero if that node failed (a misspelt ``experimen
 """
 import os
 import signal
+import tempfile
 import threading
 
 from ament_index_python.packages import get_package_share_directory
@@ -24,6 +25,7 @@ from launch.event_handlers import OnProcessExit
 from launch.events import Shutdown
 from launch.substitutions import EnvironmentVariable, LaunchConfiguration
 from launch_ros.actions import Node
+import yaml
 
 from haptic_bringup.params import LOOP_TOPICS
 
@@ -47,6 +49,17 @@ def _hear_sigint() -> None:
 
 def _config(package: str) -> str:
     return os.path.join(get_package_share_directory(package), 'config', f'{package}.yaml')
+
+
+def _parameters_of(node: str, values: dict) -> str:
+    """Write ``values`` as parameters of ``node`` alone, for a process that holds several nodes.
+
+    (A dict in ``parameters`` reaches every node of the process.)
+    """
+    with tempfile.NamedTemporaryFile('w', prefix='launch_params_', suffix='.yaml',
+                                     delete=False) as out:
+        yaml.safe_dump({node: {'ros__parameters': values}}, out)
+    return out.name
 
 
 def _end_of_loop(name: str):
@@ -77,9 +90,11 @@ def _nodes(context):
     actions = []
     if LaunchConfiguration('composed').perform(context).lower() == 'true':
         # No name: a name given here would rename all three nodes of the process.
+        driver = [_parameters_of('wand_driver', {'experiment': experiment})] if experiment else []
         actions += _stopping_with_the_loop(Node(
             package='haptic_bringup', executable='composed', output='screen',
-            parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides]), 'composed')
+            parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides] + driver),
+            'composed')
     else:
         for package, executable, name in NODES:
             values = driver_overrides if name == 'wand_driver' else overrides
