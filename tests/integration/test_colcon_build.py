@@ -1,0 +1,157 @@
+"""``colcon build`` of ``src/`` gives the install tree that ``ros2 run`` and ``ros2 launch`` use.
+
+The PyPI set-up installs the packages into the venv, where ament tools never look for a
+workspace; a ROS 2 user builds them with colcon instead. This builds ``src/`` as such a user would
+(colcon from PyPI, against the venv's ROS 2 wheels) into a temporary folder, checks what every
+package installs, and starts one installed executable with the install's environment.
+"""
+import ast
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SRC = ROOT / 'src'
+PYTHON_PACKAGES = ('haptic_util', 'collision_engine', 'force_renderer', 'haptic_wand_driver',
+                   'haptic_bringup')
+SOURCES = {'haptic_msgs': SRC / 'msgs', **{name: SRC / name for name in PYTHON_PACKAGES}}
+BUILD_TIMEOUT = 900  # [s] about 40 s here; the margin is for a busy shared machine
+
+
+def console_scripts(package: str) -> list:
+    """Return the executables that a package's setup.py declares, read without running it."""
+    tree = ast.parse((SRC / package / 'setup.py').read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            for key, value in zip(node.keys, node.values):
+                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
+                    return [ast.literal_eval(item).split('=')[0].strip() for item in value.elts]
+    return []
+
+
+def files_under(folder: pathlib.Path) -> dict:
+    """Return every file below ``folder`` (relative path -> bytes); empty if there is none."""
+    if not folder.is_dir():
+        return {}
+    return {str(path.relative_to(folder)): path.read_bytes()
+            for path in sorted(folder.rglob('*')) if path.is_file()}
+
+
+def tree_listing(folder: pathlib.Path) -> list:
+    """Return every path below ``folder``, to tell whether a build left anything there."""
+    return sorted(str(path.relative_to(folder)) for path in folder.rglob('*'))
+
+
+def build_environment(work: pathlib.Path) -> dict:
+    """Return the environment a user builds in: the venv's ROS 2 wheels and nothing sourced."""
+    env = dict(os.environ)
+    for sourced in ('COLCON_PREFIX_PATH', 'CMAKE_PREFIX_PATH', 'PYTHONPATH'):
+        env.pop(sourced, None)
+    env['AMENT_PREFIX_PATH'] = sys.prefix  # CMake finds the rosidl generators through it
+    env['PATH'] = os.pathsep.join([str(pathlib.Path(sys.executable).parent), env['PATH']])
+    env['COLCON_HOME'] = str(work / 'colcon_home')  # no user defaults or mixins
+    env['ROS_LOG_DIR'] = str(work / 'ros_log')
+    env['ROS_HOME'] = str(work / 'ros_home')
+    return env
+
+
+class Build:
+    """One colcon build of ``src/``: its install base, environment and the repo's state."""
+
+    def __init__(self, work: pathlib.Path):
+        self.install = work / 'install'
+        self.env = build_environment(work)
+        repo_before = tree_listing(SRC), tree_listing(ROOT / 'build')
+        colcon = pathlib.Path(sys.executable).parent / 'colcon'
+        self.result = subprocess.run(
+            [str(colcon), '--log-base', str(work / 'log'), 'build',
+             '--base-paths', str(SRC), '--build-base', str(work / 'build'),
+             '--install-base', str(self.install),
+             '--event-handlers', 'desktop_notification-', 'terminal_title-',
+             '--cmake-args', '-DBUILD_TESTING=OFF', f'-DPython3_EXECUTABLE={sys.executable}'],
+            cwd=work, env=self.env, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+        self.repo_unchanged = (tree_listing(SRC), tree_listing(ROOT / 'build')) == repo_before
+
+    def share(self, package: str) -> pathlib.Path:
+        return self.install / package / 'share' / package
+
+    def run_sourced(self, *command: str) -> subprocess.CompletedProcess:
+        """Run ``command`` after sourcing the install's setup.bash, as a user's shell would."""
+        script = 'source "$1/setup.bash" && shift && exec "$@"'
+        return subprocess.run(['bash', '-c', script, 'bash', str(self.install), *command],
+                              env=self.env, capture_output=True, text=True, timeout=120)
+
+
+@pytest.fixture(scope='module')
+def build(tmp_path_factory) -> Build:
+    done = Build(tmp_path_factory.mktemp('colcon'))
+    assert done.result.returncode == 0, (
+        f'colcon build failed:\n{done.result.stdout[-4000:]}\n{done.result.stderr[-4000:]}')
+    return done
+
+
+def test_the_build_leaves_sources_and_the_repository_build_folder_alone(build):
+    assert build.repo_unchanged
+
+
+@pytest.mark.parametrize('package', sorted(SOURCES))
+def test_every_package_is_in_the_ament_index_with_its_manifest(build, package):
+    prefix = build.install / package
+    assert (prefix / 'share' / 'ament_index' / 'resource_index' / 'packages' / package).is_file()
+    assert ((build.share(package) / 'package.xml').read_bytes()
+            == (SOURCES[package] / 'package.xml').read_bytes())
+
+
+EXECUTABLES = [(package, executable) for package in PYTHON_PACKAGES
+               for executable in console_scripts(package)]
+
+
+@pytest.mark.parametrize('package, executable', EXECUTABLES)
+def test_console_scripts_are_executables_where_ros2_run_looks(build, package, executable):
+    assert os.access(build.install / package / 'lib' / package / executable, os.X_OK)
+
+
+def test_the_nodes_and_the_bringup_declare_their_executables():
+    # Guards the test above against a setup.py it can no longer read.
+    assert len(EXECUTABLES) >= 8
+    assert console_scripts('collision_engine') == ['collision_node']
+    assert console_scripts('force_renderer') == ['force_node']
+    assert console_scripts('haptic_wand_driver') == ['wand_driver']
+    assert 'composed' in console_scripts('haptic_bringup')
+
+
+@pytest.mark.parametrize('package', PYTHON_PACKAGES)
+def test_config_files_are_installed_as_in_the_sources(build, package):
+    assert files_under(build.share(package) / 'config') == files_under(SRC / package / 'config')
+
+
+def test_the_launch_file_scenes_and_meshes_are_installed(build):
+    launch = build.share('haptic_bringup') / 'launch' / 'haptic_loop.launch.py'
+    assert launch.read_bytes() == (SRC / 'haptic_bringup' / 'launch' / launch.name).read_bytes()
+    scenes = files_under(SRC / 'collision_engine' / 'scenes')
+    assert any(name.startswith('meshes/') for name in scenes)
+    assert files_under(build.share('collision_engine') / 'scenes') == scenes
+
+
+def test_the_install_environment_imports_the_installed_packages(build):
+    code = ('import collision_engine, force_renderer, haptic_msgs.msg, haptic_util\n'
+            'for module in (collision_engine, force_renderer, haptic_msgs.msg, haptic_util):\n'
+            '    print(module.__file__)')
+    result = build.run_sourced(sys.executable, '-c', code)
+    assert result.returncode == 0, result.stderr
+    files = result.stdout.split()
+    assert len(files) == 4
+    for file in files:  # not the venv's editable copies
+        assert pathlib.Path(file).is_relative_to(build.install), file
+
+
+def test_an_installed_node_starts_and_refuses_a_bad_parameter_in_one_line(build):
+    node = build.install / 'force_renderer' / 'lib' / 'force_renderer' / 'force_node'
+    result = build.run_sourced(str(node), '--ros-args', '-p', 'law:=nonsense')
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith('error: force_renderer:') and "'law'" in lines[0], lines[0]
