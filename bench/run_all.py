@@ -50,6 +50,8 @@ BENCHMARKS = (
     Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3')),
     Benchmark('loop_stats', 'bench_loop_stats.py', ('--hours', '0.1', '1')),
     Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5')),
+    Benchmark('servo_rate', 'servo_rate.py',
+              ('--rates', '1000', '4000', '--stiffness', '5000', '100000')),
     Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4')),
     Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60')),
 )

@@ -1,24 +1,19 @@
 """The device-side law: what it renders and when it renders nothing, and a stiff tap through it.
 
-The tap is the simulated wand pushed by a hand into a wall z < 0 and pulled back out, the wall at
-K = 1e5 N/m: rendered by the device at its 4 kHz servo rate from a plane model, against the same
-wall as a held wrench computed from the pose one 1 ms tick old (remote rendering in miniature).
-Work comes from the device's own record of what it applied (``applied``); contacts are counted as
-the report counts them (a lift under 0.1 mm is no rebound).
+The tap (``taps.py``) is the simulated wand pushed by a hand into a wall z < 0 and pulled back out,
+the wall at K = 1e5 N/m: rendered by the device at its 4 kHz servo rate from a plane model, against
+the same wall as a held wrench computed from the pose one 1 ms tick old (remote rendering in
+miniature). Contacts are counted as the report counts them (a lift under 0.1 mm is no rebound).
 """
 import math
 
 from contact_model_fields import fields, plane
-import numpy as np
 import pytest
+from taps import tap
 
-from haptic_bringup.contacts import contacts
 from haptic_wand_driver.contact_model import ContactModel, Kind
 from haptic_wand_driver.local_rendering import LocalRenderer, MAX_DAMPING_PER_MASS
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.port_passivity import PortPassivity
-from haptic_wand_driver.scripts import WaypointScript
-from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
 
 STILL = [0.0, 0.0, 0.0, 0.0, 0.0]
 MASS = 0.15  # [kg] the simulated wand's default
@@ -79,32 +74,12 @@ def test_contact_damping_is_critical_on_the_device_mass_and_never_pulls(speed):
     assert force[2] == pytest.approx(max(0.0, 5.0 - damping * speed))
 
 
-def tap(local: bool, stiffness: float = 1e5) -> dict:
-    """Push 10 mm into the wall z < 0 from 5 mm above it, hold, and lift; 1 s of 1 kHz ticks."""
-    script = WaypointScript.from_rows([(0.0, 0.0, 0.0, 0.005), (0.3, 0.0, 0.0, -0.010),
-                                       (0.6, 0.0, 0.0, -0.010), (0.8, 0.0, 0.0, 0.005)])
-    config = SimulatedWandConfig(initial_position=np.array([0.0, 0.0, 0.005]))
-    wand = SimulatedWand(config, operator=OperatorHand(script))
-    law = renderer(mass=(MASS,) * 3, contact_damping_ratio=1.0 if local else 0.0)
-    if local:
-        wand.render_locally(law)
-    positions, applied, wrench = [], [], np.zeros(3)
-    for tick in range(1000):
-        state = wand.read(tick * 1e-3)
-        model = wall(stiffness, tip=tuple(state.position), radius=0.002)
-        if local:  # the model of this tick's pose reaches the device a round trip later
-            law.take(model, deadline=math.inf)
-        else:
-            wand.apply(wrench, np.zeros(3))
-            wrench = np.array(model.wrench(state.position, state.linear_velocity, 0.0, 0.0,
-                                           (0, 0, 0))[0])  # applied at the next tick
-        positions.append(state.position[2])
-        applied.append(wand.applied()[0][2])
-    z, force = np.array(positions), np.array(applied)
-    return {'contacts': len(contacts(z)), 'work': float(np.sum(force[1:] * np.diff(z)))}
-
-
 def test_a_stiff_tap_rendered_on_the_device_stays_one_contact_and_gives_no_energy():
-    local, remote = tap(local=True), tap(local=False)
-    assert local['contacts'] == 1 and local['work'] <= 0.0, local
-    assert remote['contacts'] > 1, remote  # the baseline rebounds: the comparison can fail
+    local, remote = tap(1e5, local=True), tap(1e5, local=False)
+    assert local.contacts == 1 and local.work <= 0.0, local
+    assert remote.contacts > 1, remote  # the baseline rebounds: the comparison can fail
+
+
+def test_the_force_is_felt_one_servo_period_after_the_tip_enters_at_most():
+    assert 0.0 < tap(5e3, local=True).felt_latency <= 2.5e-4
+    assert tap(5e3, local=False).felt_latency > 1e-3  # a tick and a round trip
