@@ -31,7 +31,7 @@ class ForceRendererParams:
                                    unit='N*s/m', low=0.0)
     watchdog_timeout: float = parameter(0.010, 'no fresh collision state for this long: zero '
                                         'force', unit='s', low=0.0005, high=1.0)
-    model_radius: float = parameter(0.002, 'contact models: planes are sent within this '
+    model_radius: float = parameter(0.0005, 'contact models: planes are sent within this '
                                     'distance of a surface, and hold this far from the tip',
                                     unit='m', low=1e-5, high=0.1)
     model_lifetime: float = parameter(0.010, 'contact models hold this long after their '
