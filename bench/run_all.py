@@ -48,6 +48,7 @@ BENCHMARKS = (
                                                   '--tapping', '1')),
     Benchmark('cross_validation', 'bench_cross_validation.py', ('--seconds', '1')),
     Benchmark('mesh_load', 'bench_mesh_load.py', ('--rounds', '1')),
+    Benchmark('model_error', 'model_error.py', ('--contacts', '100')),
     Benchmark('wand_driver', 'bench_wand_driver.py', ('--repeats', '2', '--seconds', '2')),
     Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3')),
     Benchmark('loop_stats', 'bench_loop_stats.py', ('--hours', '0.1', '1')),
