@@ -1,7 +1,7 @@
 """The report: the paper's three experiments, reproduced over ROS 2, measured against exact truth.
 
     .venv/bin/python bench/report.py [--demo-dir build/demo] [--out report]
-                                     [--skip timing tradeoff loop sweep stiffwall extreme]
+                                     [--skip timing tradeoff loop sweep stiffwall servo extreme]
                                      [--quick]
 
 Reads the bags ``demo`` recorded (the simulated wand tapping the hand, the cylinder and the
@@ -46,14 +46,15 @@ from report_paper_replay import replay_paper
 from report_provenance import provenance
 from report_recordings import control_contacts, read_recording, typestore
 from report_truth import exact_truth
+import servo_rate
 import stiffness_sweep
 
 __all__ = ['SKIPPABLE', 'STAGES', 'build', 'main']
 
 ROOT = Path(__file__).resolve().parents[1]
 STAGES = ('bags', 'truth', 'paper', 'figures', 'timing', 'tradeoff', 'loop', 'sweep',
-          'stiffwall', 'extreme', 'write')
-SKIPPABLE = ('timing', 'tradeoff', 'loop', 'sweep', 'stiffwall', 'extreme')
+          'stiffwall', 'servo', 'extreme', 'write')
+SKIPPABLE = ('timing', 'tradeoff', 'loop', 'sweep', 'stiffwall', 'servo', 'extreme')
 
 
 class _Stages:
@@ -123,6 +124,8 @@ def build(args) -> Path:
         sweep_figure(sweep, bound, out / 'stiffness_sweep.png')
     stiff_wall = stages.run('stiffwall', 'a stiff wall over the real ROS 2 loop', lambda: (
         stiff_wall_rows(4.0 if quick else 6.0, args.domain_id)))
+    servo = stages.run('servo', 'the device\'s servo rate', lambda: servo_rate.rows(
+        (1e3, 4e3) if quick else (1e3, 2e3, 4e3, 1e4), (1e3, 1e4, 1e5, 2e5, 5e5, 1e6)))
     extreme = stages.run('extreme', 'extreme-geometry table',
                          lambda: extreme_cases.rows(60 if quick else 200))
 
@@ -130,7 +133,7 @@ def build(args) -> Path:
         findings = Findings(
             recordings, truths, replays, measures, control_contacts(args.demo_dir, type_store),
             timing, bench_collision.timer_overhead() if timing else None, tradeoff, loop, sweep,
-            bound, stiff_wall, extreme)
+            bound, stiff_wall, servo, extreme)
         return readme(findings, provenance=provenance(), argv=args.argv, demo_dir=args.demo_dir,
                       durations=stages.durations)
 

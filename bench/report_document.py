@@ -11,7 +11,8 @@ from report_experiments import PAPER
 from report_sections import (counts_section, DEFINITIONS, error_time_section,
                              experiment_section, extreme_section, force_effect_section,
                              headline_section, identical_modes, interval_table, loop_section,
-                             provenance_section, skipped, stiff_wall_section, sweep_section,
+                             provenance_section, servo_section, skipped, stiff_wall_section,
+                             sweep_section,
                              table_2, table_3, tradeoff_section)
 
 __all__ = ['Findings', 'readme']
@@ -33,6 +34,7 @@ class Findings:
     sweep: list | None
     bound: float
     stiff_wall: list | None
+    servo: list | None
     extreme: list | None
 
 
@@ -138,6 +140,15 @@ def _stability_chapter(findings: Findings) -> list[str]:
               'the user\'s hand.', '']
     parts += ([stiff_wall_section(findings.stiff_wall), ''] if findings.stiff_wall
               else [skipped('stiff wall over the loop'), ''])
+    parts += ['### The device\'s servo rate', '',
+              'The simulated wand taps a wall, each pose\'s model reaching it a 1 ms tick later '
+              '(`bench/servo_rate.py`). *Period* is the cost of one servo period (the wand\'s '
+              'dynamics and the local law); *stiffest clean wall* the highest K at one contact '
+              'per tap with no energy given to the hand; *felt* the delay from the tip entering '
+              'the wall to the first period with a force. Remote rendering (the held wrench of '
+              'the tick-old pose) beside it.', '']
+    parts += ([servo_section(findings.servo), ''] if findings.servo
+              else [skipped('servo rate'), ''])
     parts += ['### Extreme geometry', '',
               'Our `collision_engine.distance` against exact truth (`bench/extreme_cases.py`); '
               'FCL\'s answers on the same points through the engine\'s FCL cross-check, in a '

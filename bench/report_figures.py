@@ -106,8 +106,8 @@ def _distance_panel(axes, session, truth: Truth, replay: PaperReplay) -> None:
 
 def _force_panel(axes, session, replay: PaperReplay) -> None:
     for axis, label in enumerate('xyz'):
-        axes.plot(session.time, session.force[:, axis], c=f'C{axis}', lw=1.0,
-                  label=f'F{label} ours')
+        axes.plot(session.time, session.applied[:, axis], c=f'C{axis}', lw=1.0,
+                  label=f'F{label} ours, applied')
         axes.plot(session.time, replay.force[:, axis], c=f'C{axis}', lw=0.8, ls='--',
                   label=f'F{label} paper\'s law')
     axes.set_ylabel('force N')

@@ -14,12 +14,14 @@ from report_truth import Truth
 
 from haptic_bringup.contacts import MIN_FORCE
 
-__all__ = ['FALSE_ERROR', 'FELT_FORCE', 'Measures', 'SIGN_FLOOR', 'angle_stats',
-           'angles_to_normal', 'error_summary', 'false_events', 'false_samples', 'measure',
-           'runs']
+__all__ = ['FALSE_ERROR', 'FELT_FORCE', 'MAX_ANGLE', 'Measures', 'STRONG_FORCE', 'SIGN_FLOOR',
+           'angle_stats', 'angles_to_normal', 'error_summary', 'false_events', 'false_samples',
+           'measure', 'runs']
 
 FALSE_ERROR = 1e-3  # [m] an answer farther than this from the truth is a false value
 FELT_FORCE = 0.01  # [N] weaker forces (the damper's residue as a contact ends) are not judged
+STRONG_FORCE = 0.05  # [N] every applied force this strong must point within MAX_ANGLE
+MAX_ANGLE = 5.0  # [deg] of the exact outward normal
 SIGN_FLOOR = 1e-9  # [m] nearer the surface than this, the sign is not judged
 
 
@@ -86,6 +88,7 @@ class Measures:
     paper_angles: np.ndarray
     ours_all_angles: np.ndarray
     paper_all_angles: np.ndarray
+    strong_angles: np.ndarray
     paper_missed: int
     paper_false_flags: int
     truth_contacts: int
@@ -109,10 +112,11 @@ def measure(recording: Recording, truth: Truth, replay: PaperReplay) -> Measures
         paper=error_summary(replay.signed, truth.distance),
         ours_events=false_events(session.distance, truth.distance),
         paper_events=false_events(replay.signed, truth.distance),
-        ours_angles=in_contact(session.force, FELT_FORCE),
+        ours_angles=in_contact(session.applied, FELT_FORCE),
         paper_angles=in_contact(replay.force, FELT_FORCE),
-        ours_all_angles=in_contact(session.force, MIN_FORCE),
+        ours_all_angles=in_contact(session.applied, MIN_FORCE),
         paper_all_angles=in_contact(replay.force, MIN_FORCE),
+        strong_angles=angles_to_normal(session.applied, truth.normal, min_force=STRONG_FORCE),
         paper_missed=int(np.count_nonzero(inside & ~replay.flag)),
         paper_false_flags=int(np.count_nonzero(~inside & replay.flag)),
         truth_contacts=len(runs(inside, CONTACT_SAMPLES)),

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 from report_experiments import Experiment, EXPERIMENTS, PAPER, PAPER_TABLE_3
 from report_format import format_length, format_number, markdown_table
-from report_metrics import (angle_stats, angles_to_normal, FALSE_ERROR, FELT_FORCE, Measures,
-                            SIGN_FLOOR)
+from report_metrics import (angle_stats, angles_to_normal, FALSE_ERROR, FELT_FORCE, MAX_ANGLE,
+                            Measures, SIGN_FLOOR, STRONG_FORCE)
 from report_paper_replay import PaperReplay
 from report_recordings import NO_FORCE_RUN, Recording
 from report_truth import Truth
@@ -23,7 +23,7 @@ from haptic_bringup.contacts import contact_intervals, MIN_FORCE
 
 __all__ = ['DEFINITIONS', 'counts_section', 'error_time_section', 'experiment_section',
            'extreme_section', 'force_effect_section', 'headline_section', 'identical_modes',
-           'interval_table', 'loop_section', 'provenance_section', 'skipped',
+           'interval_table', 'loop_section', 'provenance_section', 'servo_section', 'skipped',
            'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'tradeoff_section']
 
 
@@ -124,13 +124,14 @@ def experiment_section(recording: Recording, replay: PaperReplay, m: Measures,
         'false values.',
         f'- Force direction error in contact (forces of {FELT_FORCE * 1e3:g} mN or more): ours '
         f'mean {format_number(ours_angle[0])}°, max {format_number(ours_angle[1])}° '
-        f'({_worst(m.ours_angles, recording.session.time, recording.session.force)}); the '
+        f'({_worst(m.ours_angles, recording.session.time, recording.session.applied)}); the '
         f'paper\'s law mean {format_number(paper_angle[0])}°, max '
         f'{format_number(paper_angle[1])}° '
         f'({_worst(m.paper_angles, recording.session.time, replay.force)}). Over every force '
         f'above {MIN_FORCE:g} N the maxima are '
         f'{format_number(angle_stats(m.ours_all_angles)[1])}° (ours) and '
         f'{format_number(angle_stats(m.paper_all_angles)[1])}° (the paper\'s law).',
+        _strong_line(m.strong_angles),
     ]
     if loop:
         lines.append(
@@ -159,7 +160,7 @@ def interval_table(recording: Recording, truth: Truth, replay: PaperReplay) -> s
         if k < len(recording.contacts):
             c = recording.contacts[k]
             window = (session.time >= c.start) & (session.time <= c.end)
-            ours = angles_to_normal(session.force[window], truth.normal[window],
+            ours = angles_to_normal(session.applied[window], truth.normal[window],
                                     min_force=FELT_FORCE)
             law = angles_to_normal(replay.force[window], truth.normal[window],
                                    min_force=FELT_FORCE)
@@ -175,7 +176,7 @@ def interval_table(recording: Recording, truth: Truth, replay: PaperReplay) -> s
                     if k < len(paper.intervals) else [''] * 4)
         rows.append(row)
     inside = truth.distance < 0.0
-    mean_abs = np.nanmean(np.abs(session.force[inside]), axis=0)
+    mean_abs = np.nanmean(np.abs(session.applied[inside]), axis=0)
     law_abs = np.nanmean(np.abs(replay.force[inside]), axis=0)
     rows.append(['all', 'mean \\|F\\| in contact', *(format_number(f) for f in mean_abs), '',
                  *(format_number(f) for f in law_abs), ''] + (
@@ -227,7 +228,7 @@ def table_3(recording: Recording) -> str:
               'K x - C v N', 'F published N']
     rows = [[axis, *(format_number(value, 4) for value in (
         PAPER_TABLE_3['velocity'][i], PAPER_TABLE_3['distance_vector'][i],
-        PAPER_TABLE_3['force'][i], velocity[i], vector[i], law[i], session.force[k, i]))]
+        PAPER_TABLE_3['force'][i], velocity[i], vector[i], law[i], session.applied[k, i]))]
         for i, axis in enumerate('XYZ')]
     return markdown_table(header, rows)
 
@@ -324,6 +325,30 @@ def counts_section(recordings: dict) -> str:
                              for v in r.counts.get(t, (None, None)))
                   for r in recordings.values())] for t in topics]
     return markdown_table(header, rows)
+
+
+def _strong_line(angles: np.ndarray) -> str:
+    """Whether every applied force of STRONG_FORCE or more points within MAX_ANGLE."""
+    strong = angles[np.isfinite(angles)]
+    worst = float(strong.max()) if strong.size else math.nan
+    verdict = 'held' if strong.size and worst <= MAX_ANGLE else 'MISSED'
+    return (f'- Every applied force of {STRONG_FORCE * 1e3:g} mN or more ({strong.size} ticks) '
+            f'within {MAX_ANGLE:g}° of the exact outward normal: the largest angle is '
+            f'{format_number(worst)}° ({verdict}).')
+
+
+def servo_section(rows: list) -> str:
+    """Tabulate the servo rate's cost, the stiffest clean wall and the felt latency."""
+    stiffnesses = list(rows[0]['local_contacts'])
+    return markdown_table(
+        ['servo rate (Hz)', 'period p50 (µs)', 'period p99 (µs)', 'stiffest clean wall (N/m)',
+         'felt (ms)', 'contacts per tap, local / remote, at K = '
+         + ', '.join(f'{k:g}' for k in stiffnesses), 'felt, remote (ms)'],
+        [[f'{r["rate"]:.0f}', f'{r["cost_p50_us"]:.1f}', f'{r["cost_p99_us"]:.1f}',
+          f'{r["stiffest_clean"]:g}', f'{r["latency_ms"]:.3f}',
+          ' '.join(str(c) for c in r['local_contacts'].values()) + ' / '
+          + ' '.join(str(c) for c in r['remote_contacts'].values()),
+          f'{r["remote_latency_ms"]:.2f}'] for r in rows])
 
 
 def stiff_wall_section(rows: list) -> str:

@@ -2,7 +2,8 @@
 
 The paper's Tables 1 and 4 list, per contact interval, the mean force per axis; here each
 interval also says how far the force pointed from the surface normal, which the paper's
-centroid law got wrong by up to 45 degrees on a cube face.
+centroid law got wrong by up to 45 degrees on a cube face. The force is what the device applied
+(``wand/applied_wrench``), what the hand felt.
 """
 import dataclasses
 
@@ -58,7 +59,7 @@ def contact_intervals(session, *, min_samples: int = 3) -> list:
     intervals = []
     for first, stop in contacts(session.distance, min_samples=min_samples):
         window = slice(first, stop)
-        force = session.force[window]
+        force = session.applied[window]
         answered = np.all(np.isfinite(force), axis=1)
         force, normal = force[answered], session.normal[window][answered]
         magnitude = np.linalg.norm(force, axis=1)
