@@ -3,8 +3,9 @@
 A backend with a servo loop of its own (a Force Dimension or Quanser device, or the simulated
 wand's substeps) calls ``LocalRenderer.wrench`` every servo period with the device's current
 state; the driver hands it each new model as it arrives (``take``). What it renders is zero
-whenever the model is missing, expired (its deadline on the device's clock) or left behind (the
-tip beyond its ``valid_radius``): never a stale force. The port's passivity controller runs here,
+whenever the model is missing, expired (a servo period that would end after its deadline, on the
+device's clock, renders nothing) or left behind (the tip beyond its ``valid_radius``): never a
+stale force. The port's passivity controller runs here,
 at the servo rate, on the force the model gives, and the result is saturated to the device's and
 the model's force limits.
 
@@ -82,9 +83,9 @@ class LocalRenderer:
         position, velocity = coordinates[:3], rates[:3]
         force, torque = _ZERO, _ZERO
         limit = self.force_limit
-        if wrench is not None and time < deadline:
+        if wrench is not None and time + period <= deadline:
             force, torque = wrench
-        elif (model is not None and model.kind == Kind.PLANES and time < deadline
+        elif (model is not None and model.kind == Kind.PLANES and time + period <= deadline
                 and model.valid(position)):
             x, y, z = roll_axis(coordinates[4])
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])

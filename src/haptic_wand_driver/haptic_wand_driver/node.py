@@ -166,7 +166,7 @@ class WandDriverNode(Node):
             device_now = self._device_time()
             state = self._state = self.device.read(device_now)
             if self.renderer is None:
-                self._apply(now, device_now, state)
+                self._apply(now, state)
             self._publish(state, now_ns)
             self.stats.sent(now_ns)
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
@@ -181,6 +181,14 @@ class WandDriverNode(Node):
         A step of the system clock (NTP, a user) must not move or stall the wand.
         """
         return time.monotonic() - self._device_offset
+
+    def _ros_minus_device(self) -> float:
+        """Return ROS time minus the device's clock [s], both read back to back.
+
+        A deadline on a stamp (ROS time) goes to the device's clock through this: reading the
+        two clocks apart, a busy machine once slipped milliseconds between them into a deadline.
+        """
+        return self.get_clock().now().nanoseconds * 1e-9 - self._device_time()
 
     def _run(self) -> None:
         """Start the session: once a wrench answered a probe, or at once when open loop."""
@@ -208,28 +216,30 @@ class WandDriverNode(Node):
             if stamp_ns <= self._last_probe_ns:  # it answers a probe: the loop is closed
                 self._run()
             return
-        self.stats.answered(stamp_ns, now_ns)
+        if self.renderer is None:  # else the model is the answer the device uses
+            self.stats.answered(stamp_ns, now_ns)
         if self._phase is not Phase.RUNNING:
             return
-        device_now = self._device_time()
-        state = self._state = self.device.read(device_now)  # acts from now on
+        state = self._state = self.device.read(self._device_time())  # acts from now on
         refusal = self._take(wrench, stamp_ns * 1e-9, now)
         if refusal is not None:
             self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
         if self.renderer is None:
-            self._apply(now, device_now, state)
+            self._apply(now, state)
         elif self._model_unavailable:
             force, torque = self.wrench.current(now, state.yaw)
             self.renderer.take_wrench(force, torque,
-                                      device_now + (self.wrench.expiry - now))
+                                      self.wrench.expiry - self._ros_minus_device())
 
     def on_model(self, data: bytes) -> None:
         """Hand a contact model to the device's renderer; a bad one gives zero force."""
         if self._phase is not Phase.RUNNING:
             return
-        now = self.get_clock().now().nanoseconds * 1e-9
+        now_ns = self.get_clock().now().nanoseconds
+        fields = MODEL.decode(data)
+        self.stats.answered(fields[0] * 1_000_000_000 + fields[1], now_ns)
         try:
-            model = ContactModel.from_fields(MODEL.decode(data), self.params.frame_id)
+            model = ContactModel.from_fields(fields, self.params.frame_id)
         except ModelRefused as refusal:
             self._refused.add(f'model: {refusal.field}', refusal)
             self.renderer.clear()
@@ -240,18 +250,19 @@ class WandDriverNode(Node):
         self._model_stamp = model.stamp
         self._model_unavailable = model.kind == Kind.UNAVAILABLE
         if not self._model_unavailable:
-            self.renderer.take(model, self._device_time() + (model.stamp + model.valid_for - now))
+            self._state = self.device.read(self._device_time())  # up to now: the old model
+            self.renderer.take(model, model.stamp + model.valid_for - self._ros_minus_device())
 
-    def _apply(self, now: float, device_now: float, state) -> None:
+    def _apply(self, now: float, state) -> None:
         """Apply the held wrench, kept passive, armed with its deadline as the device watchdog.
 
-        ``now`` is ROS time, the clock of the stamps; ``device_now`` the device's clock.
+        ``now`` is ROS time, the clock of the stamps.
         """
         wrench = self.wrench
         force, torque = wrench.current(now, state.yaw)
         force = self.passivity.control(force, state.position, state.linear_velocity,
                                        self._period)
-        self.device.apply(force, torque, until=device_now + (wrench.expiry - now))
+        self.device.apply(force, torque, until=wrench.expiry - self._ros_minus_device())
 
     def _take(self, wrench: list, stamp: float, now: float) -> Refusal | None:
         """Hand a received wrench (``WRENCH`` leaves) to the command; return why it was refused."""
@@ -304,7 +315,7 @@ class WandDriverNode(Node):
     def _force_edges(self) -> dict:
         """Return the device's own record of its force switching on and off, ROS time [ns]."""
         edges = getattr(self.device, 'force_edges', [])
-        ros_minus_device = self.get_clock().now().nanoseconds * 1e-9 - self._device_time()
+        ros_minus_device = self._ros_minus_device()
         on = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if pushing]
         off = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if not pushing]
         return {'force_on_ns': np.array(on, dtype=np.int64),
