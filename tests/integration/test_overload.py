@@ -4,9 +4,9 @@ The full loop runs (three processes, the wand tapping the cuboid, rendering loca
 hog takes both cores and a second subscriber listens to the 1 kHz streams. At every instant the
 simulated device pushed (its own record of when its force switched on and off, one servo period
 coarse), the newest answer the driver had received by then must be stamped no earlier than the
-model's lifetime (10 ms) before: never a force from a stale state. (The driver's record of what it received is complete; a
-starved observer outside is not, so it only says what it saw.) The driver must also say, on
-``/diagnostics``, how far behind it fell.
+model's lifetime (10 ms) before: never a force from a stale state. (The driver's record of what
+it received is complete; a starved observer outside is not, so it only says what it saw.) The
+driver must also say, on ``/diagnostics``, how far behind it fell.
 """
 import subprocess
 import sys
