@@ -20,11 +20,10 @@ import stiffness_sweep
 from collision_engine import ConvexMesh, DistanceRequest, load_scene, Scene, STATUS_NOT_CONVERGED
 from collision_engine.scene import SceneObject
 
-__all__ = ['ITERATION_CAPS', 'LOOP_LAYOUTS', 'LOOP_RATES', 'STIFF_WALLS', 'TOLERANCES',
-           'colgate_bound', 'error_time_rows', 'loop_rows', 'stiff_wall_rows', 'tradeoff_rows']
+__all__ = ['ITERATION_CAPS', 'LOOP_LAYOUTS', 'STIFF_WALLS', 'TOLERANCES',
+           'colgate_bound', 'error_time_rows', 'floor_rows', 'stiff_wall_rows', 'tradeoff_rows']
 
 STIFF_WALLS = (160.0, 1e3, 5e3, 2e4, 1e5)  # [N/m] over the real loop
-LOOP_RATES = (500.0, 1000.0, 2000.0)  # [Hz]
 LOOP_LAYOUTS = ('separate', 'composed')
 TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 ITERATION_CAPS = (1, 2, 3, 4, 6, 8, 12, 16, 100)
@@ -148,26 +147,12 @@ def tradeoff_rows(points: int, seed: int = 0) -> list[dict]:
     return rows
 
 
-def loop_rows(duration: float, domain_id: int) -> list[dict]:
-    """One ``bench_loop.run_once`` per layout and pose rate (0.5, 1 and 2 kHz)."""
+def floor_rows(seconds: float, runs: int, domain_id: int) -> list[dict]:
+    """``bench_loop.compare`` per layout, recorder off and on: the loop against its floor."""
     import bench_loop
 
-    rows = []
-    for layout in LOOP_LAYOUTS:
-        for rate in LOOP_RATES:
-            row = {'layout': layout, 'rate': rate, 'duration': duration}
-            try:
-                record = bench_loop.run_once(layout, rate, duration, domain_id)
-            except RuntimeError as error:
-                rows.append({**row, 'failed': str(error)})
-                continue
-            latency = np.asarray(record['latencies'], dtype=float)
-            rows.append({**row, 'achieved': float(record['rate_hz']),
-                         'answered': float(record['answered_percent']),
-                         'cpu': float(record['cpu_percent']), 'n': int(latency.size),
-                         **{f'p{q}': float(np.percentile(latency, q)) for q in (50, 90, 99)},
-                         'max': float(latency.max())})
-    return rows
+    return [bench_loop.compare(layout, recorder, runs, seconds, domain_id, report=print)
+            for layout in LOOP_LAYOUTS for recorder in (False, True)]
 
 
 def stiff_wall_rows(duration: float, domain_id: int) -> list[dict]:

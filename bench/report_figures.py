@@ -8,7 +8,6 @@ import io
 from pathlib import Path
 
 import numpy as np
-from report_benchmarks import LOOP_LAYOUTS, LOOP_RATES
 from report_experiments import EXPERIMENTS, PAPER
 from report_format import format_length
 from report_metrics import angle_stats, FALSE_ERROR, FELT_FORCE, Measures
@@ -18,7 +17,7 @@ from report_truth import Truth
 import stiffness_sweep
 
 __all__ = ['ERROR_FLOOR', 'error_time_figure', 'experiment_figure', 'headline_figure',
-           'loop_figure', 'sweep_figure', 'tradeoff_figure']
+           'sweep_figure', 'tradeoff_figure']
 
 ERROR_FLOOR = 1e-18  # [m] log axes draw smaller errors (exact to rounding) here
 DPI = 90  # [dots per inch] with the figure sizes below, 700-1400 pixels wide
@@ -217,28 +216,6 @@ def tradeoff_figure(rows: list[dict], path: Path) -> None:
     axes.set_title('our GJK: accuracy against time as rel_tol = abs_tol (m) and the '
                    'iteration cap vary (labels)')
     axes.legend(fontsize=7)
-    _save(figure, path)
-
-
-def loop_figure(rows: list[dict], path: Path) -> None:
-    """Round trip p50, p99 and max against the pose rate set, per process layout."""
-    plt = _pyplot()
-    figure, axes = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
-    for k, layout in enumerate(LOOP_LAYOUTS):
-        chosen = [r for r in rows if r['layout'] == layout and 'p50' in r]
-        rates = [r['rate'] for r in chosen]
-        for key, style in (('p50', '-o'), ('p99', '--s'), ('max', ':^')):
-            axes.plot(rates, [1e3 * r[key] for r in chosen], style, c=f'C{k}',
-                      label=f'{layout}, {key}')
-    axes.set_xscale('log')
-    axes.set_yscale('log')
-    axes.set_xticks(LOOP_RATES, [f'{r:g}' for r in LOOP_RATES])
-    axes.minorticks_off()
-    axes.axhline(1.0, c='0.5', lw=0.6)
-    axes.set_xlabel('pose rate set, Hz')
-    axes.set_ylabel('round trip pose -> wrench, ms')
-    axes.set_title('end-to-end loop latency over ROS 2')
-    axes.legend(fontsize=8)
     _save(figure, path)
 
 

@@ -260,20 +260,27 @@ def tradeoff_section(rows: list[dict]) -> str:
         for r in rows])
 
 
-def loop_section(rows: list[dict]) -> str:
-    """Tabulate the loop's rate, answers, latency and CPU per layout and rate."""
-    header = ['layout', 'rate set Hz', 'achieved Hz', 'answered %', 'p50 ms', 'p90 ms',
-              'p99 ms', 'max ms', 'CPU % of a core']
+def loop_section(comparisons: list[dict]) -> str:
+    """Tabulate the loop against its floor: ratios, the loop's own figures, the targets."""
+    import bench_loop
+
     table = []
-    for r in rows:
-        if 'failed' in r:
-            table.append([r['layout'], f'{r["rate"]:g}', f'failed: {r["failed"]}'] + [''] * 6)
-            continue
-        table.append([r['layout'], f'{r["rate"]:g}', f'{r["achieved"]:.0f}',
-                      f'{r["answered"]:.2f}', *(f'{1e3 * r[k]:.3f}'
-                                                for k in ('p50', 'p90', 'p99', 'max')),
-                      f'{r["cpu"]:.0f}'])
-    return markdown_table(header, table)
+    for c in comparisons:
+        loop, floor, ratios = c['median']['loop'], c['median']['floor'], c['ratios']
+        held = all(ok for _, ok in bench_loop.verdicts(c))
+        table.append([c['layout'], 'on' if c['recorder'] else 'off',
+                      f'{loop["cpu"]:.0f} / {floor["cpu"]:.0f} = {ratios["cpu"]:.2f}',
+                      f'{loop["rate"]:.0f} / {floor["rate"]:.0f} = {ratios["rate"]:.3f}',
+                      f'{loop["answered"]:.2f} / {floor["answered"]:.2f}',
+                      f'{1e3 * loop["p50"]:.2f} / {1e3 * floor["p50"]:.2f} = '
+                      f'{ratios["p50"]:.2f}',
+                      f'{1e3 * loop["p99"]:.2f} / {1e3 * floor["p99"]:.2f} = '
+                      f'{ratios["p99"]:.2f}',
+                      'held' if held else 'missed: ' + '; '.join(
+                          what for what, ok in bench_loop.verdicts(c) if not ok)])
+    return markdown_table(['layout', 'recorder', 'CPU % loop / floor', 'pose Hz loop / floor',
+                           'answered % loop / floor', 'p50 ms loop / floor',
+                           'p99 ms loop / floor', 'targets'], table)
 
 
 def sweep_section(rows: list) -> str:
