@@ -127,6 +127,12 @@ def expected_endpoints(config: LoopConfig) -> dict:
     return endpoints
 
 
+def _finished(child) -> bool:
+    """Whether ``child`` is a driver that ended its experiment: it starts only once the loop is
+    closed, so its clean exit means the loop ran."""
+    return child.returncode == 0 and child.name in ('wand_driver', 'composed')
+
+
 class Loop:
     """Start the loop, wait until it is closed, and stop it cleanly (a context manager)."""
 
@@ -175,6 +181,8 @@ class Loop:
         finally:
             watcher.close()
         dead = self.exited()
+        if dead is not None and _finished(dead):
+            return  # a short experiment ran to its end before this watcher saw every endpoint
         if dead is not None:
             self.stop(gently=False)  # the others may still be importing
             raise RuntimeError(f'{dead.name} exited with code {dead.returncode} at start-up '

@@ -20,7 +20,6 @@ traceback, counts it, and goes on. Each node decides what a failed callback mean
 """
 import signal
 import sys
-import threading
 import traceback
 from typing import Callable, Iterable, Optional
 
@@ -37,6 +36,7 @@ __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'request_stop', 's
            'callback_errors', 'StartupError']
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
+SHUTDOWN_TIMEOUT = 1.0  # [s] for the executor to finish a callback in progress
 
 EXECUTORS = {'events': EventsExecutor, 'single_threaded': SingleThreadedExecutor}
 
@@ -48,19 +48,20 @@ class StartupError(RuntimeError):
 # What a wrong command line, parameter or parameter file raises while a node starts.
 _CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException, NameValidationException,
                          rclpy_implementation.RCLError)
-_stop_requested = threading.Event()
-_starting = threading.Event()  # set while nodes are being built: a signal interrupts that
+# Plain flags, not threading.Event: a signal handler that takes a lock deadlocks when a second
+# signal lands while the first handler holds it.
+_flags = {'stop': False, 'starting': False}  # 'starting' while nodes are built: a signal interrupts
 _errors: dict = {}  # (exception type, file, line) -> count
 
 
 def request_stop(*_) -> None:
     """Ask this process's loop to stop cleanly; safe from any callback, and idempotent."""
-    _stop_requested.set()
+    _flags['stop'] = True
 
 
 def stop_requested() -> bool:
     """Whether a stop was requested (a signal, or ``request_stop``)."""
-    return _stop_requested.is_set()
+    return _flags['stop']
 
 
 def callback_errors() -> int:
@@ -69,10 +70,10 @@ def callback_errors() -> int:
 
 
 def _on_signal(signum, frame) -> None:
-    first = not _stop_requested.is_set()
-    _stop_requested.set()
-    if first and _starting.is_set():
-        _starting.clear()
+    first = not _flags['stop']
+    _flags['stop'] = True
+    if first and _flags['starting']:
+        _flags['starting'] = False
         raise KeyboardInterrupt  # nodes are still being built: no rclpy callback is running
 
 
@@ -92,7 +93,7 @@ def spin(executor: Executor, stop: Optional[Future] = None) -> None:
     """
     stop = stop or Future()
     while (rclpy.ok(context=executor.context) and not stop.done()
-           and not _stop_requested.is_set()):
+           and not _flags['stop']):
         try:
             executor.spin_until_future_complete(stop, timeout_sec=SPIN_SLICE)
         except (KeyboardInterrupt, ExternalShutdownException):
@@ -121,13 +122,13 @@ def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
     """
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _on_signal)
-    _starting.set()
-    nodes = []
+    _flags['starting'] = True
+    nodes, spinner = [], None
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
         for factory in factories:
             nodes.append(factory())
-        _starting.clear()
+        _flags['starting'] = False
         spinner = make_executor(executor)
         for node in nodes:
             spinner.add_node(node)
@@ -138,7 +139,9 @@ def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        _starting.clear()
+        _flags['starting'] = False
+        if spinner is not None:  # it lets go of the nodes' entities before they are destroyed
+            spinner.shutdown(timeout_sec=SHUTDOWN_TIMEOUT)
         for node in nodes:
             node.destroy_node()
         rclpy.try_shutdown()
