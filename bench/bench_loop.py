@@ -3,6 +3,7 @@
     .venv/bin/python bench/bench_loop.py [--layouts separate composed] [--runs 3]
                                          [--seconds 8] [--recorder off on]
     .venv/bin/python bench/bench_loop.py --sweep [--rates 500 1000 2000] [--duration 10]
+    .venv/bin/python bench/bench_loop.py --cross-validation [--runs 3] [--seconds 8]
 
 The default compares the loop with its floor (``loop_floor.py``: the same topology with no work
 per hop), alternating floor and loop runs, each with one outside observer (a separate process
@@ -11,6 +12,10 @@ with the recorder. Per run: CPU of every process over the window (100 % = one co
 by the observer, the pose rate, the share of poses answered by a wrench, and pose -> wrench
 p50 and p99. Then the loop's figures as ratios to the floor's (medians over the runs), and
 whether each target of the CPU issue holds.
+
+``--cross-validation`` runs the loop on the hand (where an FCL query costs the most) with the
+scene's FCL cross-check on and off, alternated, seen by the same observer: the cross-check runs
+on a worker thread, so it must not show in the round trip.
 
 ``--sweep`` runs the loop alone at several rates and reads the driver's own round-trip record
 (every wrench carries the stamp of its pose, so latency is on one clock).
@@ -26,11 +31,14 @@ import time
 import machine
 import numpy as np
 import psutil
+import yaml
 
 from haptic_bringup.launcher import add_venv_prefix, Loop, loop_environment, LoopConfig
 from haptic_bringup.processes import start_child, stop_children
+from haptic_util.paths import package_file
 
 SCENE = 'package://collision_engine/scenes/cuboid.yaml'
+HAND = 'package://collision_engine/scenes/hand.yaml'
 CPU_WINDOW_SKIP = 1.0  # [s] CPU is measured inside the session, this far from either end
 FLOOR = pathlib.Path(__file__).resolve().parent / 'loop_floor.py'
 WARM_UP = 3.0  # [s] from start to the window: discovery, the driver's probe, first contacts
@@ -90,7 +98,8 @@ def _floor_children(layout: str, recorder: bool, folder: pathlib.Path, env: dict
     return children
 
 
-def session(kind: str, layout: str, recorder: bool, seconds: float, domain_id: int) -> dict:
+def session(kind: str, layout: str, recorder: bool, seconds: float, domain_id: int,
+            scene: str = SCENE, experiment: str = 'cuboid') -> dict:
     """One run of the floor or the loop with the outside observer; its figures."""
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
@@ -99,7 +108,7 @@ def session(kind: str, layout: str, recorder: bool, seconds: float, domain_id: i
         loop = None
         if kind == 'loop':
             loop = Loop(LoopConfig(
-                composed=layout == 'composed', scene=SCENE, experiment='cuboid',
+                composed=layout == 'composed', scene=scene, experiment=experiment,
                 record=str(folder / 'bag') if recorder else None, domain_id=domain_id,
                 run_dir=folder / 'launch', overrides={'collision_engine': {'marker_rate': 0.0},
                                                       'force_renderer': {'marker_rate': 0.0}}))
@@ -204,6 +213,8 @@ def main(argv=None) -> int:
     parser.add_argument('--runs', type=int, default=3, help='floor/loop pairs per case')
     parser.add_argument('--seconds', type=float, default=8.0, help='measured window per run')
     parser.add_argument('--sweep', action='store_true', help='the loop alone at --rates')
+    parser.add_argument('--cross-validation', action='store_true',
+                        help="the loop on the hand with the scene's FCL cross-check on and off")
     parser.add_argument('--rates', nargs='+', type=float, default=[1000.0])
     parser.add_argument('--duration', type=float, default=10.0, help='per --sweep run')
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
@@ -213,6 +224,8 @@ def main(argv=None) -> int:
     print(f'machine: {machine.line("rclpy", "numba")}')
     if args.sweep:
         return sweep(args)
+    if args.cross_validation:
+        return cross_validation(args)
     print(f'{args.runs} alternated floor/loop pair(s) of {args.seconds:g} s per case; CPU in % '
           'of one core; rate, answered and latency seen by the outside observer')
     table = []
@@ -233,6 +246,47 @@ def main(argv=None) -> int:
               f'{ratios["p50"]:6.2f} {ratios["p99"]:6.2f}  {"held" if held else "MISSED"}')
         for what, ok in verdicts(comparison):
             print(f'    {"ok  " if ok else "MISS"} {what}')
+    return 0
+
+
+def hand_scene(fcl: bool, folder: pathlib.Path) -> str:
+    """Write the shipped hand scene with its FCL cross-check on or off; return its path."""
+    shipped = package_file(HAND)
+    scene = yaml.safe_load(shipped.read_text())
+    scene['cross_validation']['fcl'] = fcl
+    for item in scene['objects']:
+        mesh = item['shape']['mesh']
+        mesh['file'] = str(shipped.parent / mesh['file'])
+    path = folder / f'hand_fcl_{"on" if fcl else "off"}.yaml'
+    path.write_text(yaml.safe_dump(scene))
+    return str(path)
+
+
+def cross_validation(args) -> int:
+    print(f'{args.runs} alternated pair(s) of {args.seconds:g} s, three processes on the hand; '
+          'rate, answered and latency seen by the outside observer')
+    results = {'off': [], 'on': []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for run in range(args.runs):
+            for state in ('off', 'on'):
+                result = session('loop', 'separate', False, args.seconds, args.domain_id,
+                                 scene=hand_scene(state == 'on', pathlib.Path(tmp)),
+                                 experiment='hand')
+                results[state].append(result)
+                print(_run_line(f'FCL cross-check {state} #{run + 1}', result), flush=True)
+    median = {state: {key: float(np.median([r[key] for r in runs]))
+                      for key in ('rate', 'answered', 'p50', 'p99')}
+              for state, runs in results.items()}
+    collision_cpu = {state: float(np.median([r['cpu']['collision_engine'] for r in runs]))
+                     for state, runs in results.items()}
+    print()
+    print(f'{"FCL cross-check":<16} {"collision CPU %":>15} {"answered %":>11} {"p50 ms":>7} '
+          f'{"p99 ms":>7}')
+    for state in ('off', 'on'):
+        m = median[state]
+        print(f'{state:<16} {collision_cpu[state]:15.0f} {m["answered"]:11.3f} '
+              f'{1e3 * m["p50"]:7.3f} {1e3 * m["p99"]:7.3f}')
+    print(f'p99 on/off: {median["on"]["p99"] / median["off"]["p99"]:.2f}')
     return 0
 
 

@@ -128,8 +128,10 @@ def expected_endpoints(config: LoopConfig) -> dict:
 
 
 def _finished(child) -> bool:
-    """Whether ``child`` is a driver that ended its experiment: it starts only once the loop is
-    closed, so its clean exit means the loop ran."""
+    """Whether ``child`` is a driver that ended its experiment, which means the loop ran.
+
+    A driver starts its experiment only once the loop is closed.
+    """
     return child.returncode == 0 and child.name in ('wand_driver', 'composed')
 
 

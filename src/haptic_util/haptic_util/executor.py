@@ -50,7 +50,8 @@ _CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException, NameValid
                          rclpy_implementation.RCLError)
 # Plain flags, not threading.Event: a signal handler that takes a lock deadlocks when a second
 # signal lands while the first handler holds it.
-_flags = {'stop': False, 'starting': False}  # 'starting' while nodes are built: a signal interrupts
+# 'starting' is set while nodes are being built: a signal interrupts that.
+_flags = {'stop': False, 'starting': False}
 _errors: dict = {}  # (exception type, file, line) -> count
 
 
