@@ -221,7 +221,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    print(f'machine: {machine.line("rclpy", "numba")}')
+    print(f'machine: {machine.line("ros-jazzy-rclpy", "numba")}')
     if args.sweep:
         return sweep(args)
     if args.cross_validation:

@@ -11,8 +11,8 @@ from report_format import format_utc
 __all__ = ['VERSIONED', 'provenance']
 
 ROOT = Path(__file__).resolve().parents[1]
-VERSIONED = ('numpy', 'scipy', 'numba', 'rclpy', 'python-fcl', 'coal', 'trimesh', 'rosbags',
-             'matplotlib')
+VERSIONED = ('numpy', 'scipy', 'numba', 'ros-jazzy-rclpy', 'python-fcl', 'coal', 'trimesh',
+             'rosbags', 'matplotlib')
 
 
 def _git(*args: str) -> str:

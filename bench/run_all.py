@@ -52,6 +52,7 @@ BENCHMARKS = (
     Benchmark('wand_driver', 'bench_wand_driver.py', ('--repeats', '2', '--seconds', '2')),
     Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3')),
     Benchmark('loop_stats', 'bench_loop_stats.py', ('--hours', '0.1', '1')),
+    Benchmark('stream_cost', 'stream_cost.py', ('--seconds', '2', '--runs', '1')),
     Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5')),
     Benchmark('servo_rate', 'servo_rate.py',
               ('--rates', '1000', '4000', '--stiffness', '5000', '100000')),

@@ -69,7 +69,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    print(f'machine: {machine.line("rclpy", "numba")}')
+    print(f'machine: {machine.line("ros-jazzy-rclpy", "numba")}')
     print(f'{"K N/m":>8} {"rendering":>9} {"contacts/tap":>12} {"net work mJ":>11} '
           f'{"depth mm":>8} {"peak N":>7} {"answered":>8}')
     for stiffness in args.stiffness:
