@@ -11,8 +11,9 @@ with a winding-number sign for the hand; it shares no code with the engine), rep
 paper's own collision code (``paper_method.py``, on the paper's STL objects) along the same
 trajectories, and writes ``README.md`` with PNG figures into ``--out``: the paper's Figures
 1-3 and Tables 1, 2, 4 with its reported values beside ours, error against run time for every
-method, our GJK's tolerance trade-off, the loop latency at 0.5, 1 and 2 kHz, the stiffness
-sweep, the extreme-geometry table, message counts, and the machine. Every number of ours is
+method, our GJK's tolerance trade-off, the loop against its floor, the stiffness sweep, the
+stiff wall over the loop (local against remote rendering), the servo rate, the extreme-geometry
+table, message counts, and the machine. Every number of ours is
 computed by the run; the paper's are typed in from it (``PAPER``) and labelled as such.
 
 ``--skip`` leaves out slow stages while iterating (their sections then say so); ``--quick``
