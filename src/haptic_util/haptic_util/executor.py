@@ -18,6 +18,7 @@ A callback that raises does not end its node: the spin logs the exception once, 
 traceback, counts it, and goes on. Each node decides what a failed callback means for its output
 (an invalid state, zero force); the count is in ``callback_errors()`` for its diagnostics.
 """
+import faulthandler
 import signal
 import sys
 import traceback
@@ -37,6 +38,7 @@ __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'request_stop', 's
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
 SHUTDOWN_TIMEOUT = 1.0  # [s] for the executor to finish a callback in progress
+TEARDOWN_LIMIT = 20.0  # [s] for nodes to say their last words and be destroyed
 
 EXECUTORS = {'events': EventsExecutor, 'single_threaded': SingleThreadedExecutor}
 
@@ -141,11 +143,17 @@ def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
         pass
     finally:
         _flags['starting'] = False
+        # A teardown that hangs in rclpy or Fast DDS (seen once in about a hundred stops, busy
+        # in Node.destroy_node) ends the process with every thread's traceback, never silently.
+        faulthandler.dump_traceback_later(TEARDOWN_LIMIT, exit=True)
         if spinner is not None:  # it lets go of the nodes' entities before they are destroyed
+            for node in nodes:
+                spinner.remove_node(node)
             spinner.shutdown(timeout_sec=SHUTDOWN_TIMEOUT)
         for node in nodes:
             node.destroy_node()
         rclpy.try_shutdown()
+        faulthandler.cancel_dump_traceback_later()
         # Python resets its handlers to the default at exit, where a late repeat would then
         # kill the process with SIGINT; an ignored signal it leaves alone.
         for signum in (signal.SIGINT, signal.SIGTERM):
