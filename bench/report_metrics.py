@@ -12,14 +12,13 @@ from report_paper_replay import PaperReplay
 from report_recordings import CONTACT_SAMPLES, Recording
 from report_truth import Truth
 
-from haptic_bringup.contacts import MIN_FORCE
+from haptic_bringup.contacts import FELT_FORCE, MIN_FORCE
 
 __all__ = ['FALSE_ERROR', 'FELT_FORCE', 'MAX_ANGLE', 'Measures', 'STRONG_FORCE', 'SIGN_FLOOR',
            'angle_stats', 'angles_to_normal', 'error_summary', 'false_events', 'false_samples',
            'measure', 'runs']
 
 FALSE_ERROR = 1e-3  # [m] an answer farther than this from the truth is a false value
-FELT_FORCE = 0.01  # [N] weaker forces (the damper's residue as a contact ends) are not judged
 STRONG_FORCE = 0.05  # [N] every applied force this strong must point within MAX_ANGLE
 MAX_ANGLE = 5.0  # [deg] of the exact outward normal
 SIGN_FLOOR = 1e-9  # [m] nearer the surface than this, the sign is not judged

@@ -71,8 +71,11 @@ class HannafordRyu2002:
         self.max_damping, self.period = max_damping, servo_period
         self.energy, self.damping, self._dissipation = 0.0, 0.0, 0.0
 
-    def control(self, force, velocity, position, now):
-        """Observe this step's power and return the force with the controller's damping."""
+    def control(self, force, velocity, position, now, axis=None):
+        """Observe this step's power and return the force with the controller's damping.
+
+        ``axis`` is taken for the interface and not used: the textbook damps along the velocity.
+        """
         if velocity is None:
             return force
         speed_squared = float(np.dot(velocity, velocity))

@@ -9,10 +9,11 @@ import dataclasses
 
 import numpy as np
 
-__all__ = ['ContactInterval', 'REBOUND_HEIGHT', 'contact_intervals', 'contacts',
+__all__ = ['ContactInterval', 'FELT_FORCE', 'REBOUND_HEIGHT', 'contact_intervals', 'contacts',
            'format_contacts']
 
 MIN_FORCE = 1e-6  # [N] below this a force has no direction worth measuring
+FELT_FORCE = 0.01  # [N] weaker forces (the damper's residue as a contact ends) are not judged
 # [m] a tip that leaves the surface by less before it re-enters is still in the same contact:
 # a felt rebound lifts by millimetres, a tip settling on a stiff wall by microns.
 REBOUND_HEIGHT = 1e-4
@@ -29,7 +30,7 @@ class ContactInterval:
     max_depth: float  # [m]
     mean_force: np.ndarray  # (3,) N
     peak_force: float  # [N]
-    normal_angle: float  # [deg] mean angle between the force and the outward normal
+    normal_angle: float  # [deg] mean angle of the forces >= FELT_FORCE to the outward normal
 
     @property
     def duration(self) -> float:
@@ -63,7 +64,7 @@ def contact_intervals(session, *, min_samples: int = 3) -> list:
         answered = np.all(np.isfinite(force), axis=1)
         force, normal = force[answered], session.normal[window][answered]
         magnitude = np.linalg.norm(force, axis=1)
-        felt = magnitude > MIN_FORCE
+        felt = magnitude >= FELT_FORCE
         cosine = np.einsum('ij,ij->i', force[felt], normal[felt]) / magnitude[felt]
         angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
         intervals.append(ContactInterval(
