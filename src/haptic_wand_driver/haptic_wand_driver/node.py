@@ -183,12 +183,30 @@ class WandDriverNode(Node):
         return time.monotonic() - self._device_offset
 
     def _ros_minus_device(self) -> float:
-        """Return ROS time minus the device's clock [s], both read back to back.
+        """Return ROS time minus the device's clock [s], never less than it truly is.
 
-        A deadline on a stamp (ROS time) goes to the device's clock through this: reading the
-        two clocks apart, a busy machine once slipped milliseconds between them into a deadline.
+        A deadline on a stamp (ROS time) goes to the device's clock through this. The device's
+        clock is read first: a pause between the two reads then makes the deadline early, never
+        late (read the other way round, a machine busy with two CPU hogs once let a model push
+        13 µs past its lifetime).
         """
-        return self.get_clock().now().nanoseconds * 1e-9 - self._device_time()
+        device = self._device_time()
+        return self.get_clock().now().nanoseconds * 1e-9 - device
+
+    def _ros_minus_device_estimate(self, reads: int = 100) -> float:
+        """Return ROS time minus the device's clock [s] as precisely as it can be read.
+
+        For a record, not a deadline: the midpoint of the narrowest of ``reads`` brackets of
+        ROS time between two readings of the device's clock.
+        """
+        width, estimate = math.inf, 0.0
+        for _ in range(reads):
+            before = self._device_time()
+            ros = self.get_clock().now().nanoseconds * 1e-9
+            after = self._device_time()
+            if after - before < width:
+                width, estimate = after - before, ros - 0.5 * (before + after)
+        return estimate
 
     def _run(self) -> None:
         """Start the session: once a wrench answered a probe, or at once when open loop."""
@@ -315,7 +333,7 @@ class WandDriverNode(Node):
     def _force_edges(self) -> dict:
         """Return the device's own record of its force switching on and off, ROS time [ns]."""
         edges = getattr(self.device, 'force_edges', [])
-        ros_minus_device = self._ros_minus_device()
+        ros_minus_device = self._ros_minus_device_estimate()
         on = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if pushing]
         off = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if not pushing]
         return {'force_on_ns': np.array(on, dtype=np.int64),
