@@ -74,6 +74,16 @@ def test_contact_damping_is_critical_on_the_device_mass_and_never_pulls(speed):
     assert force[2] == pytest.approx(max(0.0, 5.0 - damping * speed))
 
 
+def test_contact_damping_still_acts_on_a_wall_pressed_past_its_force_limit():
+    law = renderer(mass=(MASS,) * 3, contact_damping_ratio=1.0)
+    law.take(wall(stiffness=1e5), deadline=math.inf)  # at 0.3 mm the spring alone is 30 N
+    damping = 2.0 * math.sqrt(1e5 * MASS)  # 245 N*s/m
+    going_in = law.wrench(0.0, *at(-0.0003, -0.02), 2.5e-4)[0]
+    coming_out = law.wrench(0.0, *at(-0.0003, 0.02), 2.5e-4)[0]
+    assert going_in[2] == pytest.approx(10.0)
+    assert coming_out[2] == pytest.approx(10.0 - damping * 0.02)  # less out than in: dissipative
+
+
 def test_a_stiff_tap_rendered_on_the_device_stays_one_contact_and_gives_no_energy():
     local, remote = tap(1e5, local=True), tap(1e5, local=False)
     assert local.contacts == 1 and local.work <= 0.0, local

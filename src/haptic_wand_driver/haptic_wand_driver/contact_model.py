@@ -19,6 +19,7 @@ from typing import Sequence
 
 from force_renderer.spring_damper import unilateral_spring_damper
 from haptic_wand_driver.orientation import rotate
+from haptic_wand_driver.wrench_input import saturate_components
 
 __all__ = ['Kind', 'ModelRefused', 'Plane', 'ContactModel', 'MAX_PLANES', 'UNIT_TOLERANCE']
 
@@ -110,13 +111,16 @@ class ContactModel:
 
     def wrench(self, position: Sequence[float], velocity: Sequence[float], roll: float,
                yaw: float, angular_velocity: Sequence[float],
-               contact_damping=None) -> tuple[Vector3, Vector3]:
+               contact_damping=None, limit: float = math.inf) -> tuple[Vector3, Vector3]:
         """Force (N) and torque about the tip (N·m) of the planes on the tool, world frame.
 
         ``position``, ``velocity`` (3,) are the tip's; ``roll``, ``yaw`` (rad) its orientation;
-        ``angular_velocity`` (3,) rad/s, world frame. ``contact_damping(plane, normal)`` (N·s/m)
-        adds damping along a plane's normal while it pushes, never pulling (the device's own
-        choice, see ``local_rendering``); None adds none.
+        ``angular_velocity`` (3,) rad/s, world frame. ``contact_damping(plane)`` (N·s/m) adds
+        damping along a plane's normal while it pushes, never pulling (the device's own choice,
+        see ``local_rendering``); None adds none. It acts on the plane's force saturated to
+        ``limit`` (N): damping added to an unsaturated spring and then saturated is lost
+        whenever the spring alone passes the limit, and a deep tap then comes back out as hard
+        as it went in (at K = 1e5 N/m and 10 N the tool bounced off the wall).
         """
         fx = fy = fz = tx = ty = tz = 0.0
         for plane in self.planes:
@@ -132,7 +136,8 @@ class ContactModel:
             f = unilateral_spring_damper((depth * n[0], depth * n[1], depth * n[2]), n, speed,
                                          plane.stiffness, plane.damping)
             if contact_damping is not None:
-                f = _damped_along(f, n, speed, contact_damping(plane))
+                f = _damped_along(saturate_components(f, limit), n, speed,
+                                  contact_damping(plane))
             t = _cross(arm, f)
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]

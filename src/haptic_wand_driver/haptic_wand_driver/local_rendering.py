@@ -16,7 +16,8 @@ T a damper stays stable up to about m/T (0.15 kg at 4 kHz: 600 N·s/m), while ov
 (T = 1 ms plus the round trip) it would oscillate itself. So, along each plane's normal while it
 pushes, it adds ``contact_damping_ratio`` × 2 sqrt(K_n m_n) (1: critical), capped at
 ``MAX_DAMPING_PER_MASS`` × m_n / T, and never pulling: taps that stay in contact, as on a real
-rigid surface, and energy only ever taken out.
+rigid surface, and energy only ever taken out. It is taken off the plane's force already saturated
+to the limit, so a wall pressed past its force limit still takes energy out on the way back.
 
 Thread safety: ``take`` swaps one tuple, which a servo thread reads whole; the passivity books are
 the servo thread's alone.
@@ -89,9 +90,9 @@ class LocalRenderer:
                 and model.valid(position)):
             x, y, z = roll_axis(coordinates[4])
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
-            force, torque = model.wrench(position, velocity, coordinates[3], coordinates[4],
-                                         spin, self._contact_damping(period))
             limit = min(self.force_limit, model.force_limit)
+            force, torque = model.wrench(position, velocity, coordinates[3], coordinates[4],
+                                         spin, self._contact_damping(period), limit)
         force = self.passivity.control(force, position, velocity, period)
         return (saturate_components(force, limit),
                 saturate_components(torque, self.torque_limit))
