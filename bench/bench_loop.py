@@ -42,6 +42,7 @@ HAND = 'package://collision_engine/scenes/hand.yaml'
 CPU_WINDOW_SKIP = 1.0  # [s] CPU is measured inside the session, this far from either end
 FLOOR = pathlib.Path(__file__).resolve().parent / 'loop_floor.py'
 WARM_UP = 3.0  # [s] from start to the window: discovery, the driver's probe, first contacts
+TAIL = 3.0  # [s] of experiment after the window: the cuboid's 10 s script ended inside it
 TARGETS = {'cpu': 1.25, 'p99': 1.5, 'rate': 0.99, 'answered': 99.9}  # the CPU issue's
 
 
@@ -109,6 +110,7 @@ def session(kind: str, layout: str, recorder: bool, seconds: float, domain_id: i
         if kind == 'loop':
             loop = Loop(LoopConfig(
                 composed=layout == 'composed', scene=scene, experiment=experiment,
+                duration=WARM_UP + seconds + TAIL,
                 record=str(folder / 'bag') if recorder else None, domain_id=domain_id,
                 run_dir=folder / 'launch', overrides={'collision_engine': {'marker_rate': 0.0},
                                                       'force_renderer': {'marker_rate': 0.0}}))
