@@ -88,8 +88,9 @@ def _write_forever(path: str, counter: str) -> None:
     while True:
         writer.write('/wand/pose', time.time_ns(), pose_cdr(typestore, index))
         index += 1
-        if index % 50 == 0:
-            pathlib.Path(counter).write_text(str(index))
+        if index % 50 == 0:  # atomically: the kill may land in the middle of a write
+            pathlib.Path(f'{counter}.part').write_text(str(index))
+            os.replace(f'{counter}.part', counter)
         time.sleep(0.0005)
 
 

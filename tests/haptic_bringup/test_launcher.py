@@ -47,6 +47,6 @@ def test_the_loop_is_closed_when_every_stream_has_its_publisher_and_subscribers(
     full = expected_endpoints(LoopConfig(record='bag'))
     assert full['/wand/pose'] == (1, 2)  # the collision node and the recorder
     assert full['/collision/state'] == (1, 2)
-    assert full['/wand/wrench'] == (1, 1)
+    assert full['/wand/wrench'] == full['/wand/contact_model'] == (1, 1)  # the recorder
     partial = expected_endpoints(LoopConfig(nodes=('collision_engine', 'force_renderer')))
     assert partial['/wand/pose'] == (0, 1) and partial['/collision/state'] == (1, 1)

@@ -80,7 +80,7 @@ def test_the_fields_are_the_message_s_leaves_in_order():
 def test_a_fixed_array_of_messages_is_flattened_element_by_element():
     codec = MessageCodec(message_class('haptic_msgs/ContactModel'))
     assert codec.fields[6:9] == ('planes[0].point.x', 'planes[0].point.y', 'planes[0].point.z')
-    assert 'planes[2].tool_point.z' in codec.fields and len(codec.fields) == 6 + 45 + 6
+    assert 'planes[2].tool_point.z' in codec.fields and len(codec.fields) == 6 + 45 + 6 + 6
     values = list(range(len(codec.fields)))
     values[2], values[3] = 'world', 'hand'
     values[4:] = [float(v) if codec._codes[i + 4] == 'd' else v % 256

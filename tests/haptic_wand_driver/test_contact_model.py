@@ -24,6 +24,7 @@ from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
     (dict(radius=math.nan), 'valid_radius'),
     (dict(limit=-1.0), 'force_limit'),
     (dict(tip=(0.0, 0.0, math.inf)), 'tip'),
+    (dict(wrench=(0.0, math.nan, 0.0, 0.0, 0.0, 0.0)), 'wrench'),
 ])
 def test_a_bad_model_is_refused_naming_the_field(change, field):
     with pytest.raises(ModelRefused) as refused:

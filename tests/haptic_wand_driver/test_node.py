@@ -1,11 +1,13 @@
 """The driver node's wiring, in-process: what its clocks do, without a launched loop."""
 import itertools
 
+from contact_model_fields import fields
 import pytest
 import rclpy
 from rclpy.context import Context
 
-from haptic_wand_driver.node import WandDriverNode
+from haptic_wand_driver.contact_model import Kind
+from haptic_wand_driver.node import MODEL, WandDriverNode
 
 
 class JumpingClock:
@@ -39,3 +41,18 @@ def test_a_backward_step_of_the_system_clock_does_not_stop_the_wand(driver, monk
     for _ in range(100):  # through the step back at the 51st reading
         driver.tick()
     assert driver.stats.poses > 90
+
+
+def test_rendering_locally_it_takes_the_model_alone_and_holds_the_wrench_of_a_law_without_one(
+        driver):
+    assert {s.topic_name for s in driver.subscriptions} == {'/wand/contact_model'}
+    driver.tick()  # open loop: the session runs from the first tick
+    pose = driver._last_probe_ns  # the stamp of the pose just published, which it answers
+    model = MODEL.encode(fields(kind=Kind.UNAVAILABLE, stamp=divmod(pose, 1_000_000_000),
+                                wrench=(1.0, 0.0, -0.5, 0.0, 0.0, 0.0)))
+    driver.on_model(model)
+    state = driver.device.read(driver._device_time())
+    force, torque = driver.renderer.wrench(driver._device_time(), [*state.position, 0.0, 0.0],
+                                           [0.0] * 5, 2.5e-4)
+    assert force == pytest.approx((1.0, 0.0, -0.5)) and torque == (0.0, 0.0, 0.0)
+    assert driver.stats.answers == 1

@@ -37,6 +37,7 @@ PLANE_FIELDS = 15  # leaves of a ContactPlane
 STATE = MessageCodec(CollisionState)
 TWIST = MessageCodec(TwistStamped)
 WRENCH = MessageCodec(WrenchStamped)
+_NO_TORQUE = (0.0, 0.0, 0.0)  # the laws render a force at the tip
 
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -146,7 +147,7 @@ class ForceNode(Node):
         # Even the watchdog's zero carries the stamp of the state it judged, so it never
         # supersedes an answer to a newer pose still on its way to the driver.
         self._force = (float(force[0]), float(force[1]), float(force[2]))
-        self._wrench_pub.publish(WRENCH.encode((*self._header, *self._force, 0.0, 0.0, 0.0)))
+        self._wrench_pub.publish(WRENCH.encode((*self._header, *self._force, *_NO_TORQUE)))
         model = local_model(self.pipeline.law, self._contact, reason is Reason.OK,
                             self.params.model_radius)
         self._model_pub.publish(MODEL.encode(self._model_fields(model)))
@@ -159,7 +160,8 @@ class ForceNode(Node):
         planes += [0.0] * (PLANE_FIELDS * MAX_PLANES - len(planes))
         tip = self._contact.tip.tolist()
         return (*self._header, self._contact.object, model.kind, len(model.planes), *planes,
-                self.params.force_limit, self.params.model_lifetime, model.valid_radius, *tip)
+                self.params.force_limit, self.params.model_lifetime, model.valid_radius, *tip,
+                *self._force, *_NO_TORQUE)
 
     def check_stale(self) -> None:
         """Publish zero force while the collision state is stale (after the first one)."""

@@ -112,18 +112,21 @@ def node_parameters(config: LoopConfig) -> dict:
 
 
 def expected_endpoints(config: LoopConfig) -> dict:
-    """Topic → (publishers, subscribers) that make the loop closed."""
+    """Topic → (publishers, subscribers) that make the loop closed.
+
+    The driver's own subscription is not among them: it takes the model or the wrench, as its
+    device can render, and it waits for that answer itself (it probes the loop end to end).
+    """
     recording = 1 if config.record else 0
     running = set(config.nodes)
     endpoints = {}
     if 'wand_driver' in running:
         endpoints['/wand/pose'] = (1, recording + ('collision_engine' in running))
-        endpoints['/wand/wrench'] = (('force_renderer' in running), 1)
     if 'collision_engine' in running:
         endpoints['/collision/state'] = (1, recording + ('force_renderer' in running))
         endpoints.setdefault('/wand/pose', (0, 1))
     if 'force_renderer' in running:
-        endpoints.setdefault('/wand/wrench', (1, 0))
+        endpoints['/wand/wrench'] = endpoints['/wand/contact_model'] = (1, recording)
     return endpoints
 
 

@@ -69,6 +69,9 @@ class ContactModel:
         N, s, m.
     tip : (3,) float, m
         The tip the model was made for.
+    held_wrench : (6,) float
+        The message's ``wrench``, the law's force (N) and torque (N·m): what the device holds
+        when ``kind`` is ``UNAVAILABLE``.
     """
 
     stamp: float
@@ -78,6 +81,7 @@ class ContactModel:
     valid_for: float
     valid_radius: float
     tip: Vector3
+    held_wrench: tuple
 
     @classmethod
     def from_fields(cls, fields: Sequence, frame_id: str) -> 'ContactModel':
@@ -99,9 +103,11 @@ class ContactModel:
             _non_negative(name, value)
         tip = tuple(fields[54:57])
         _finite('tip', tip)
+        held_wrench = tuple(fields[57:63])
+        _finite('wrench', held_wrench)
         planes = tuple(_plane(k, fields[6 + 15 * k:21 + 15 * k]) for k in range(count))
         return cls(sec + nanosec * 1e-9, Kind(kind), planes if kind == Kind.PLANES else (),
-                   force_limit, valid_for, valid_radius, tip)
+                   force_limit, valid_for, valid_radius, tip, held_wrench)
 
     def valid(self, position: Sequence[float]) -> bool:
         """Whether ``position`` (3,) m is within ``valid_radius`` of the model's tip."""

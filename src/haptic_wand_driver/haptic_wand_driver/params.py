@@ -47,7 +47,8 @@ class WandDriverParams:
                                     low=0.0)
     min_subscribers: int = parameter(1, 'start only once wand/pose has this many matched '
                                      'subscribers', low=0)
-    wait_for_wrench: bool = parameter(True, 'start only once a wrench answered a pose (the loop '
+    wait_for_wrench: bool = parameter(True, 'start only once an answer (a wrench, or the model '
+                                      'when rendering locally) came back for a pose (the loop '
                                       'is closed end to end); false: open loop (replay)')
     wait_for_recorder: bool = parameter(False, 'start only once recorder/ready says every '
                                         'stream is being recorded')
