@@ -59,7 +59,7 @@ class HuntCrossley:
         finite_number(self.damping, 'HuntCrossley.damping', minimum=0.0)
 
     def normal_force(self, depth: float, depth_rate: float) -> float:
-        """Return the force (N, >= 0) at ``depth`` m (> 0 inside), going in at ``depth_rate`` m/s."""
+        """Return the force (N, >= 0) at ``depth`` m (> 0 inside), going in at ``depth_rate``."""
         if depth <= 0.0:
             return 0.0
         spring = depth ** self.exponent
