@@ -35,6 +35,17 @@ def test_a_constant_external_force_shifts_the_rest_point_by_force_over_stiffness
     np.testing.assert_array_equal(state.external_force, [0.0, 0.0, 5.0])
 
 
+def test_the_external_force_is_that_at_the_reported_position_and_velocity():
+    def spring(position, velocity):
+        return -400.0 * position - 3.0 * velocity
+
+    robot = ImpedanceRobot(environment=spring)
+    robot.read(0.0)
+    robot.command([0.0, 0.01, 0.02])
+    state = robot.read(0.0503)
+    np.testing.assert_array_equal(state.external_force, spring(state.position, state.velocity))
+
+
 def test_a_far_target_is_approached_at_the_speed_limit():
     robot = ImpedanceRobot(ImpedanceRobotConfig(max_speed=0.1))
     robot.read(0.0)
@@ -106,7 +117,5 @@ def test_bad_commands_and_clocks_are_refused():
     robot.read(1.0)
     with pytest.raises(ValueError, match='must not go back'):
         robot.read(0.5)
-    broken = ImpedanceRobot(environment=lambda p, v: np.full(3, math.nan))
-    broken.read(0.0)
     with pytest.raises(ValueError, match='environment force must be 3 finite numbers'):
-        broken.read(0.01)
+        ImpedanceRobot(environment=lambda p, v: np.full(3, math.nan))

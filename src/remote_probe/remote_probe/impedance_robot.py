@@ -106,8 +106,8 @@ class RobotState:
     orientation : (4,) float
         Unit quaternion x, y, z, w.
     external_force : (3,) float, N
-        The environment's force on the TCP at the last substep: what a force sensor at the probe
-        mount measures (the probe taken as weightless).
+        The environment's force on the TCP at this position and velocity: what a force sensor
+        at the probe mount measures (the probe taken as weightless).
     """
 
     time: float
@@ -133,7 +133,7 @@ class ImpedanceRobot:
         self._environment = environment
         self._position = config.initial_position.copy()
         self._velocity = np.zeros(3)
-        self._external_force = np.zeros(3)
+        self._external_force = self._environment_force()
         self._target = config.initial_position.copy()
         self._start: float | None = None
         self._steps_done = 0
@@ -187,9 +187,6 @@ class ImpedanceRobot:
         """One semi-implicit Euler step: speed limited, then the workspace walls stop the TCP."""
         config = self._config
         step = config.step
-        if self._environment is not None:
-            self._external_force = finite_vector(
-                self._environment(self._position, self._velocity), 3, 'environment force')
         force = config.stiffness * (self._target - self._position) + self._external_force
         velocity = ((self._velocity + step * force / config.mass)
                     / (1.0 + step * config.damping / config.mass))
@@ -202,3 +199,11 @@ class ImpedanceRobot:
         velocity[(position >= upper) & (velocity > 0.0)] = 0.0
         self._position = np.clip(position, lower, upper)
         self._velocity = velocity
+        self._external_force = self._environment_force()
+
+    def _environment_force(self) -> np.ndarray:
+        """Return the environment's force at the current state (and for the next substep)."""
+        if self._environment is None:
+            return np.zeros(3)
+        return finite_vector(self._environment(self._position, self._velocity), 3,
+                             'environment force')
