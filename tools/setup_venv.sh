@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up everything the toolkit needs on a fresh clone: the venv with pinned wheels (ROS 2 Jazzy
 # from PyPI included), the CMake path fix those wheels need, the haptic_msgs interface package
-# built into the venv, and the four Python packages installed (code editable, data files copied).
+# built into the venv, and the Python packages installed (code editable, data files copied).
 # Re-running it is safe. Usage: tools/setup_venv.sh [VENV_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,7 +40,8 @@ cmake -S src/msgs -B build/haptic_msgs -DCMAKE_INSTALL_PREFIX="$venv" -DBUILD_TE
 make -C build/haptic_msgs -j2 install >build/haptic_msgs.make.log 2>&1 \
   || { tail -50 build/haptic_msgs.make.log; exit 1; }
 
-for pkg in haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup; do
+for pkg in haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup \
+    remote_probe; do
   step "installing $pkg"
   # compat mode puts src/<pkg> on sys.path, so a tests/<pkg>/ folder can never shadow it.
   "${pip[@]}" install -q --no-deps --no-build-isolation --use-pep517 -e "src/$pkg" \
@@ -52,7 +53,7 @@ for pkg in haptic_util collision_engine force_renderer haptic_wand_driver haptic
 done
 
 "$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, collision_engine, force_renderer, \
-haptic_wand_driver, haptic_bringup" || { echo "[setup] import check failed"; exit 1; }
+haptic_wand_driver, haptic_bringup, remote_probe" || { echo "[setup] import check failed"; exit 1; }
 step "compiling the collision kernels once (numba caches them for every later start)"
 "$venv/bin/python" -c "
 import pathlib

@@ -1,0 +1,158 @@
+"""Safety at the patient: a bounded pressing force, and a robot that lets go when the link fails.
+
+Why: the operator is far away, behind a link that delays, drops and may go silent, so the limits
+that protect the patient must hold at the robot's side, on its own measurements, whatever arrives.
+
+- **Force bound.** An impedance-controlled robot presses with its spring, K·(x_t − x). Keeping
+  the target within ``max_patient_force`` / K of the TCP bounds that spring in every direction,
+  so no target, however deep, can press harder; it needs no model of the patient, whose
+  stiffness the robot does not know. The force along the surface (a sweep's drag) is bounded
+  with it, and ``force_margin`` keeps the spring that much below the limit.
+  The bound is exact at rest. In motion, the robot's momentum adds an impact force of about
+  v·sqrt(k·m) on a surface of stiffness k: nothing on soft, damped tissue (the abdomen peaks at
+  the bound), tens of newtons on a stiff one (20 kN/m at 0.18 m/s), which this bound does not
+  cover; a speed limit near contact would.
+- **Link watchdog.** When nothing has come from the operator for longer than ``link_timeout``
+  (never heard counts as silent), the robot stops following the operator: it holds its last
+  safe target, so the TCP stays where it is, then draws that target back along the measured
+  force's direction (out of the patient, as the tissue pushes) at ``retract_speed`` until the
+  measured force is below ``release_force``. Targets are followed again as soon as a message
+  comes.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+from remote_probe._checks import finite_number, finite_vector
+
+__all__ = ['LinkWatchdog', 'PatientSafety', 'SafetyConfig', 'within_force_bound']
+
+
+@dataclass(frozen=True)
+class SafetyConfig:
+    """Parameters of the patient-side safety.
+
+    Parameters
+    ----------
+    robot_stiffness : float, N/m
+        The impedance spring of the robot (``ImpedanceRobotConfig.stiffness``).
+    max_patient_force : float, N
+        The force the patient may feel at most.
+    force_margin : float, N
+        How far below ``max_patient_force`` the spring stays, for what the bound does not see
+        (a stiffer spot, the robot's momentum).
+    link_timeout : float, s
+        Silence after which the robot holds and retracts.
+    release_force : float, N
+        The retraction stops once the measured force is below this.
+    retract_speed : float, m/s
+    """
+
+    robot_stiffness: float
+    max_patient_force: float = 20.0
+    force_margin: float = 1.0
+    link_timeout: float = 0.1
+    release_force: float = 1.0
+    retract_speed: float = 0.02
+
+    def __post_init__(self):
+        for name in ('robot_stiffness', 'max_patient_force', 'link_timeout', 'retract_speed'):
+            finite_number(getattr(self, name), f'SafetyConfig.{name}', minimum=0.0, strict=True)
+        finite_number(self.force_margin, 'SafetyConfig.force_margin', minimum=0.0,
+                      maximum=self.max_patient_force)
+        finite_number(self.release_force, 'SafetyConfig.release_force', minimum=0.0,
+                      maximum=self.max_patient_force)
+
+    @property
+    def spring_reach(self) -> float:
+        """How far (m) the target may lie from the TCP: (max force − margin) / stiffness."""
+        return (self.max_patient_force - self.force_margin) / self.robot_stiffness
+
+
+def within_force_bound(target: np.ndarray, tcp: np.ndarray, reach: float) -> np.ndarray:
+    """Return ``target`` (3,) m moved toward ``tcp`` (3,) m until it is within ``reach`` m."""
+    offset = target - tcp
+    length = float(np.linalg.norm(offset))
+    if length <= reach:
+        return target
+    return tcp + offset * (reach / length)
+
+
+class LinkWatchdog:
+    """Whether the link has been silent for longer than ``timeout`` seconds."""
+
+    def __init__(self, timeout: float) -> None:
+        self.timeout = finite_number(timeout, 'LinkWatchdog.timeout', minimum=0.0, strict=True)
+        self._last_heard = -math.inf
+
+    def heard(self, time: float) -> None:
+        """Note a message received at ``time`` s (a stale one does not move the time back)."""
+        time = finite_number(time, 'LinkWatchdog.heard time')
+        self._last_heard = max(self._last_heard, time)
+
+    def silent(self, now: float) -> bool:
+        """Whether nothing was heard in the ``timeout`` before ``now`` s (or ever)."""
+        return now - self._last_heard > self.timeout
+
+
+class PatientSafety:
+    """Turns the operator's target into one that is safe for the patient, at every control tick.
+
+    Parameters
+    ----------
+    config : SafetyConfig
+    """
+
+    def __init__(self, config: SafetyConfig) -> None:
+        self.config = config
+        self.watchdog = LinkWatchdog(config.link_timeout)
+        self._hold: np.ndarray | None = None  # the held target while the link is silent
+        self._last_target: np.ndarray | None = None
+        self._last_tick: float | None = None
+
+    @property
+    def holding(self) -> bool:
+        """True while the robot holds (and retracts) because the link is silent."""
+        return self._hold is not None
+
+    def heard(self, time: float) -> None:
+        """Note a message from the operator received at ``time`` s."""
+        self.watchdog.heard(time)
+
+    def safe_target(self, now: float, target, tcp, measured_force) -> np.ndarray:
+        """Return the target (3,) m to command now.
+
+        Parameters
+        ----------
+        now : float, s
+        target : (3,) float, m
+            The operator's latest target.
+        tcp : (3,) float, m
+            The TCP's position now.
+        measured_force : (3,) float, N
+            The F/T sensor's force on the probe (pointing out of the patient).
+        """
+        now = finite_number(now, 'PatientSafety.safe_target now')
+        target = finite_vector(target, 3, 'PatientSafety.safe_target target')
+        tcp = finite_vector(tcp, 3, 'PatientSafety.safe_target tcp')
+        measured_force = finite_vector(measured_force, 3, 'PatientSafety.safe_target force')
+        elapsed = 0.0 if self._last_tick is None else max(now - self._last_tick, 0.0)
+        self._last_tick = now
+        if self.watchdog.silent(now):
+            if self._hold is None:
+                self._hold = tcp if self._last_target is None else self._last_target
+            self._hold = target = self._retracted(self._hold, measured_force, elapsed)
+        else:
+            self._hold = None
+        self._last_target = within_force_bound(target, tcp, self.config.spring_reach)
+        return self._last_target
+
+    def _retracted(self, hold: np.ndarray, measured_force: np.ndarray,
+                   elapsed: float) -> np.ndarray:
+        """Move ``hold`` out along the force while the force is above the release threshold."""
+        magnitude = float(np.linalg.norm(measured_force))
+        if magnitude <= self.config.release_force:
+            return hold
+        return hold + measured_force * (self.config.retract_speed * elapsed / magnitude)

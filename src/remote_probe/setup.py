@@ -1,0 +1,25 @@
+from setuptools import find_packages, setup
+
+package_name = 'remote_probe'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+    ],
+    install_requires=['setuptools', 'numpy'],
+    extras_require={'phantom': ['trimesh']},
+    zip_safe=False,
+    maintainer='Haptic toolkit maintainers',
+    maintainer_email='maintainers@haptic-telesono.invalid',
+    description='Remote site of telerobotic ultrasound: robot probe, F/T sensor, patient, link.',
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'make_phantom = remote_probe.phantom:main',
+        ],
+    },
+)
