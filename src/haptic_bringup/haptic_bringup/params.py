@@ -3,7 +3,7 @@ from dataclasses import dataclass
 
 from haptic_util.parameters import parameter
 
-__all__ = ['RecorderParams', 'LOOP_TOPICS', 'LATCHED_TOPICS']
+__all__ = ['RecorderParams', 'LOOP_TOPICS', 'LATCHED_TOPICS', 'RELIABLE_TOPICS']
 
 # What a haptic session is: the loop's streams, the scene it ran against, and what each node
 # said about itself (its last report carries its final counts), with their types, so that the
@@ -19,6 +19,7 @@ LOOP_TOPICS = {
     '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
 }
 LATCHED_TOPICS = ('/scene/description',)
+RELIABLE_TOPICS = ('/diagnostics',)  # a node's last report, with its final counts, must arrive
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,8 @@
 Subscriptions are raw, so no message is converted to Python; each one is written with its
 receive time, as ``ros2 bag record`` does. The loop's topics are subscribed at once; another
 topic's type is taken from the graph once a publisher appears. Latched topics (the scene
-description) are subscribed transient-local.
+description) are subscribed transient-local, and reliable ones (the nodes' reports) reliably, so
+that a node's last report is acknowledged before the node goes.
 Once every topic has a matched publisher it says so on ``recorder/ready`` (latched), so that a
 driver can hold its session until nothing it publishes can be missed. On SIGINT or SIGTERM the
 bag is closed and complete; after ``kill -9`` it is recoverable up to the last flush (see
@@ -14,14 +15,14 @@ import pathlib
 
 from ament_index_python.packages import get_package_share_directory
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool
 
 from haptic_bringup.bag import BagWriter, typestore_with
-from haptic_bringup.params import LATCHED_TOPICS, LOOP_TOPICS, RecorderParams
+from haptic_bringup.params import LATCHED_TOPICS, LOOP_TOPICS, RecorderParams, RELIABLE_TOPICS
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
-from haptic_util.qos import LATCHED_QOS, RECORDER_QOS
+from haptic_util.qos import LATCHED_QOS, RECORDER_QOS, RELIABLE_RECORDER_QOS
 
 __all__ = ['BagRecorder', 'main', 'custom_definitions']
 
@@ -62,24 +63,24 @@ class BagRecorder(Node):
         self._ready_pub = self.create_publisher(Bool, 'recorder/ready', LATCHED_QOS)
         self._ready_pub.publish(Bool(data=False))
         for topic in [t for t in topics if t in LOOP_TOPICS]:
-            self._subscribe(topic, LOOP_TOPICS[topic], topic in LATCHED_TOPICS)
+            self._subscribe(topic, LOOP_TOPICS[topic], (
+                LATCHED_QOS if topic in LATCHED_TOPICS else
+                RELIABLE_RECORDER_QOS if topic in RELIABLE_TOPICS else RECORDER_QOS))
         self._pending = [t for t in topics if t not in LOOP_TOPICS]
         self._poll = self.create_timer(GRAPH_POLL_PERIOD, self.subscribe_new_topics)
         self.get_logger().info(f'recording {", ".join(topics)} to {output}')
 
-    def _subscribe(self, topic: str, type_name: str, latched: bool) -> None:
+    def _subscribe(self, topic: str, type_name: str, qos) -> None:
         self.bag.add_topic(topic, type_name)
         self._subscribed.append(self.create_subscription(
-            message_class(type_name), topic, self._writer_for(topic),
-            LATCHED_QOS if latched else RECORDER_QOS, raw=True))
+            message_class(type_name), topic, self._writer_for(topic), qos, raw=True))
 
     def subscribe_new_topics(self) -> None:
         """Subscribe the topics of unknown type once the graph shows them; say when ready."""
         types = dict(self.get_topic_names_and_types())
         for topic in [t for t in self._pending if t in types]:
-            publishers = self.get_publishers_info_by_topic(topic)
-            self._subscribe(topic, types[topic][0], any(
-                p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers))
+            self._subscribe(topic, types[topic][0],
+                            _matching_qos(self.get_publishers_info_by_topic(topic)))
             self._pending.remove(topic)
         if not self._pending and all(s.get_publisher_count() for s in self._subscribed):
             self._poll.cancel()
@@ -105,6 +106,16 @@ class BagRecorder(Node):
         counts = ', '.join(f'{t}: {n}' for t, n in self.bag.counts.items())
         self.get_logger().info(f'closed {self.bag.path} ({counts})')
         return super().destroy_node()
+
+
+def _matching_qos(publishers) -> QoSProfile:
+    """The recorder's QoS for a topic of these publishers: latched or reliable if they all are."""
+    qos = [p.qos_profile for p in publishers]
+    if any(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in qos):
+        return LATCHED_QOS
+    if qos and all(q.reliability == ReliabilityPolicy.RELIABLE for q in qos):
+        return RELIABLE_RECORDER_QOS
+    return RECORDER_QOS
 
 
 def main(args=None) -> int:

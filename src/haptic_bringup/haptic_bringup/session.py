@@ -14,9 +14,11 @@ from haptic_util.stamps import to_nanoseconds
 __all__ = ['Session', 'read_session', 'topic_counts', 'published_counts', 'applied_work',
            'PUBLISHERS']
 
-# Which node publishes each stream, by its name in /diagnostics reports.
+# Which node publishes each stream, by its name in /diagnostics reports (a node publishes each
+# of its streams once per count).
 PUBLISHERS = {'/wand/pose': 'wand_driver', '/wand/twist': 'wand_driver',
-              '/collision/state': 'collision_engine', '/wand/wrench': 'force_renderer'}
+              '/wand/applied_wrench': 'wand_driver', '/collision/state': 'collision_engine',
+              '/wand/wrench': 'force_renderer', '/wand/contact_model': 'force_renderer'}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

@@ -8,7 +8,8 @@ transient-local, so that a late subscriber, such as a recorder or RViz, still re
 """
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-__all__ = ['HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'RECORDER_QOS', 'MARKER_QOS']
+__all__ = ['HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'RECORDER_QOS', 'RELIABLE_RECORDER_QOS',
+           'MARKER_QOS']
 
 STREAM_DEPTH = 10
 
@@ -24,6 +25,15 @@ RECORDER_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=2000,
     reliability=ReliabilityPolicy.BEST_EFFORT,
+    durability=DurabilityPolicy.VOLATILE,
+)
+
+# For what is published reliably (reports): a best-effort reader may lose a node's last report
+# and never be told; a reliable one acknowledges it before the node goes.
+RELIABLE_RECORDER_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=RECORDER_QOS.depth,
+    reliability=ReliabilityPolicy.RELIABLE,
     durability=DurabilityPolicy.VOLATILE,
 )
 
