@@ -9,6 +9,7 @@ for scenes that turn on cross-validation; no ROS. Typical use::
     result.distance, result.normal              # signed (negative inside), unit outward
 """
 
+from collision_engine.convex_pair import distance_between, PairResult
 from collision_engine.distance import distance, DistanceRequest, DistanceResult
 from collision_engine.errors import MeshError, SceneError
 from collision_engine.gjk import (STATUS_INVALID_INPUT, STATUS_NO_OBJECT, STATUS_NOT_CONVERGED,
@@ -21,7 +22,8 @@ from collision_engine.transforms import Pose
 
 __all__ = [
     'BatchResult', 'Box', 'Capsule', 'ConvexMesh', 'Cylinder', 'DistanceRequest',
-    'DistanceResult', 'MeshError', 'Pose', 'QueryResult', 'Scene', 'SceneError', 'SceneObject',
-    'SceneSpec', 'Sphere', 'STATUS_INVALID_INPUT', 'STATUS_NO_OBJECT', 'STATUS_NOT_CONVERGED',
-    'STATUS_OK', 'TriangleMesh', 'distance', 'load_scene', 'read_scene',
+    'DistanceResult', 'MeshError', 'PairResult', 'Pose', 'QueryResult', 'Scene', 'SceneError',
+    'SceneObject', 'SceneSpec', 'Sphere', 'STATUS_INVALID_INPUT', 'STATUS_NO_OBJECT',
+    'STATUS_NOT_CONVERGED', 'STATUS_OK', 'TriangleMesh', 'distance', 'distance_between',
+    'load_scene', 'read_scene',
 ]

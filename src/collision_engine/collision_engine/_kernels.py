@@ -35,12 +35,12 @@ import numpy as np
 
 from collision_engine import bvh
 from collision_engine._jit import jit
-from collision_engine.epa import epa, scratch_size
-from collision_engine.gjk import (gjk, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
-                                  STATUS_NOT_CONVERGED, STATUS_OK)
-from collision_engine.norms import norm3, unit3
-from collision_engine.support import (CAPSULE, CONVEX_MESH, CYLINDER, interior, pack_convex,
-                                      POINT, TRIANGLE_MESH)
+from collision_engine.epa import scratch_size
+from collision_engine.gjk import (STATUS_INVALID_INPUT, STATUS_NO_OBJECT, STATUS_NOT_CONVERGED,
+                                  STATUS_OK)
+from collision_engine.narrowphase import point_distance
+from collision_engine.norms import norm3
+from collision_engine.support import pack_convex, TRIANGLE_MESH
 
 __all__ = ['OUT_SIZE', 'OBJECT_FLOATS', 'pack_scene', 'place_object', 'query_point',
            'query_points', 'query_each_object', 'query_shape']
@@ -110,53 +110,6 @@ def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
 
 
 @jit
-def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, radius, gx, gy, gz,
-                     rel_tol, abs_tol, max_iter, max_epa_iter, W):
-    """Signed distance to a convex shape: GJK outside, exact interior or EPA inside.
-
-    (cx, cy, cz) and ``radius`` are the shape's bounding sphere, (gx, gy, gz) a first search
-    direction (zero: from the shape's core toward q); W is GJK's scratch (``_GJK_SCRATCH``).
-    Returns (status, distance, lower bound, x, y, z, nx, ny, nz, iterations), local frame.
-    """
-    s, x, y, z, nx, ny, nz = 0.0, qx, qy, qz, 1.0, 0.0, 0.0
-    if kind != CONVEX_MESH:
-        s, x, y, z, nx, ny, nz = interior(kind, floats, fo, qx, qy, qz)
-        if s <= 0.0:
-            return STATUS_OK, s, s, x, y, z, nx, ny, nz, 0
-    if gx == 0.0 and gy == 0.0 and gz == 0.0:
-        gx, gy, gz = qx - cx, qy - cy, qz - cz
-        if kind == CYLINDER or kind == CAPSULE:
-            gz = qz - min(max(qz, -floats[fo + 1]), floats[fo + 1])
-    shape, point, simplex, supports, rel = _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W)
-    status, contact, count, vx, vy, vz, lower, iterations, inv, x, y, z = gjk(
-        shape, point, rel, gx, gy, gz, radius, rel_tol, abs_tol, max_iter, simplex, supports)
-    if not contact:
-        ux, uy, uz = unit3(vx, vy, vz)
-        return status, norm3(vx, vy, vz), lower, x, y, z, -ux, -uy, -uz, iterations
-    if kind != CONVEX_MESH:
-        # Within rounding of a primitive's surface: its exact interior formula holds there.
-        return STATUS_OK, s, s, x, y, z, nx, ny, nz, iterations
-    epa_floats, epa_ints = _epa_scratch(floats, ints)
-    status, depth, bound, x, y, z, nx, ny, nz, more = epa(
-        shape, point, rel, simplex, supports, count, inv, rel_tol, abs_tol, max_epa_iter,
-        epa_floats, epa_ints)
-    return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
-
-
-@jit
-def _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W):
-    """Pose the point q as GJK's B against the packed shape, and split W into GJK's scratch.
-
-    Returns (shape, point, simplex, supports, rel): ``rel`` holds q as the point's pose.
-    """
-    rel = W[24:36]
-    rel[0], rel[1], rel[2], rel[3], rel[4], rel[5], rel[6], rel[7], rel[8] = (
-        1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-    rel[9], rel[10], rel[11] = qx, qy, qz
-    return (kind, floats, fo, ints, io), (POINT, floats, 0, ints, 0), W[:12], W[12:24], rel
-
-
-@jit
 def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2):
     """Signed distance from the world point p to object k, in the world frame.
 
@@ -178,10 +131,11 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2
         lx = floats[r] * gx + floats[r + 3] * gy + floats[r + 6] * gz
         ly = floats[r + 1] * gx + floats[r + 4] * gy + floats[r + 7] * gz
         lz = floats[r + 2] * gx + floats[r + 5] * gy + floats[r + 8] * gz
-        status, distance, lower, x, y, z, nx, ny, nz, iterations = _convex_distance(
+        epa_floats, epa_ints = _epa_scratch(floats, ints)
+        status, distance, lower, x, y, z, nx, ny, nz, iterations = point_distance(
             kind, floats, fo, ints, io, qx, qy, qz,
             floats[r + 12], floats[r + 13], floats[r + 14], floats[r + 18], lx, ly, lz,
-            floats[1], floats[2], ints[1], ints[2], W)
+            floats[1], floats[2], ints[1], ints[2], W, epa_floats, epa_ints)
     wx = floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9]
     wy = floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10]
     wz = floats[r + 6] * x + floats[r + 7] * y + floats[r + 8] * z + floats[r + 11]
