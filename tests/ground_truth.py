@@ -20,8 +20,10 @@ __all__ = [
     'exact_unit',
     'hand_mesh_path',
     'mesh_signed_distance',
+    'polytope_pair_distance',
     'sample_near_surface',
     'scene_path',
+    'segment_distance',
     'simplex_distance',
     'triangles_meet',
     'sphere_signed_distance',
@@ -468,6 +470,43 @@ def outward_hull(cloud: np.ndarray) -> tuple:
     inward = np.einsum('ij,ij->i', normals, hull.equations[:, :3]) < 0.0
     faces[inward] = faces[inward][:, ::-1]
     return faces, hull.equations
+
+
+def polytope_pair_distance(vertices_a: np.ndarray, vertices_b: np.ndarray) -> float:
+    """Signed distance between the convex hulls of two point sets, same frame, m.
+
+    The origin against the hull of the Minkowski difference {a - b} (scipy's ConvexHull): its
+    exact point-to-facet distance when outside (the separation), minus its distance to the
+    nearest facet when inside (the penetration depth).
+    """
+    a, b = _as_points(vertices_a), _as_points(vertices_b)
+    difference = (a[:, None, :] - b[None, :, :]).reshape(-1, 3)
+    faces, _ = outward_hull(difference)
+    return float(mesh_signed_distance(np.zeros(3), difference, faces)[0])
+
+
+def segment_distance(p0, p1, q0, q1) -> float:
+    """Distance between the segments p0 p1 and q0 q1, m.
+
+    The least of the four endpoint-to-segment distances and, when the lines' common
+    perpendicular meets both segments inside, its length.
+    """
+    p0, p1, q0, q1 = (np.asarray(v, dtype=np.float64) for v in (p0, p1, q0, q1))
+
+    def to_segment(x, s0, s1):
+        edge = s1 - s0
+        t = np.clip((x - s0) @ edge / (edge @ edge), 0.0, 1.0)
+        return float(_length(x - (s0 + t * edge)))
+
+    best = min(to_segment(p0, q0, q1), to_segment(p1, q0, q1), to_segment(q0, p0, p1),
+               to_segment(q1, p0, p1))
+    u, v, w = p1 - p0, q1 - q0, p0 - q0
+    system = np.array([[u @ u, -(u @ v)], [u @ v, -(v @ v)]])
+    if abs(np.linalg.det(system)) > 1e-12 * (u @ u) * (v @ v):
+        s, t = np.linalg.solve(system, [-(u @ w), -(v @ w)])
+        if 0.0 < s < 1.0 and 0.0 < t < 1.0:
+            best = min(best, float(_length(p0 + s * u - q0 - t * v)))
+    return best
 
 
 def scene_path(name: str) -> Path:
