@@ -38,12 +38,15 @@ from collision_engine._jit import jit
 from collision_engine.epa import scratch_size
 from collision_engine.gjk import (STATUS_INVALID_INPUT, STATUS_NO_OBJECT, STATUS_NOT_CONVERGED,
                                   STATUS_OK)
-from collision_engine.narrowphase import point_distance
+from collision_engine.narrowphase import pair_distance, point_distance
 from collision_engine.norms import norm3
 from collision_engine.support import pack_convex, TRIANGLE_MESH
+from collision_engine.tool import FLOAT_HEADER as TOOL_FLOAT_HEADER
+from collision_engine.tool import INT_HEADER as TOOL_INT_HEADER
+from collision_engine.tool_mesh import mesh_tool_distance
 
-__all__ = ['OUT_SIZE', 'OBJECT_FLOATS', 'pack_scene', 'place_object', 'query_point',
-           'query_points', 'query_each_object', 'query_shape']
+__all__ = ['OUT_SIZE', 'OBJECT_FLOATS', 'QUATERNION_TOLERANCE', 'pack_scene', 'place_object',
+           'query_point', 'query_points', 'query_each_object', 'query_shape', 'query_tool']
 
 OUT_SIZE = 15
 OBJECT_FLOATS = 19
@@ -51,6 +54,7 @@ _HEADER_FLOATS = 4
 _HEADER_INTS = 4
 _OBJECT_INTS = 5
 _GJK_SCRATCH = 36  # simplex (12), A's support points (12), B's pose in A's frame (12)
+QUATERNION_TOLERANCE = 1e-6  # a tool pose's quaternion norm may be off 1 by this much
 
 
 def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, abs_tol: float,
@@ -258,3 +262,86 @@ def query_shape(floats, ints, out, px, py, pz, gx, gy, gz):
         floats, ints, 0, px, py, pz, gx, gy, gz, W, stack, stack_d2)
     _write(out, 0, d - floats[0], x, y, z, nx, ny, nz, 0, iterations, status, px, py, pz,
            t, lower - floats[0])
+
+
+@jit
+def _unit_quaternion(qx, qy, qz, qw):
+    """Whether the quaternion is a unit one, and its rotation matrix (row-major).
+
+    A quaternion whose norm is off 1 by more than ``QUATERNION_TOLERANCE``, or with NaN or
+    infinite parts, is refused: it is a corrupt pose, not a rotation to renormalise.
+    """
+    norm = norm3(qx, qy, norm3(qz, qw, 0.0))
+    valid = abs(norm - 1.0) <= QUATERNION_TOLERANCE
+    if not valid:
+        norm = 1.0
+    x, y, z, w = qx / norm, qy / norm, qz / norm, qw / norm
+    rotation = (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w),
+                2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w),
+                2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y))
+    return valid, rotation
+
+
+@jit
+def _tool_in_object(floats, r, R, px, py, pz, rel):
+    """Write the tool's pose (R, p: scene frame) in the frame of the object at record r."""
+    dx, dy, dz = px - floats[r + 9], py - floats[r + 10], pz - floats[r + 11]
+    for i in range(3):
+        for j in range(3):
+            rel[3 * i + j] = (floats[r + i] * R[j] + floats[r + 3 + i] * R[3 + j]
+                              + floats[r + 6 + i] * R[6 + j])
+        rel[9 + i] = floats[r + i] * dx + floats[r + 3 + i] * dy + floats[r + 6 + i] * dz
+
+
+@jit
+def query_tool(floats, ints, tool_floats, tool_ints, out, px, py, pz, qx, qy, qz, qw):
+    """Nearest object to the tool posed at p with quaternion q (scene frame), to ``out``.
+
+    The tool is packed by ``tool.pack_tool``. The output row is that of the point queries with
+    the tool's witness point in place of the tip (``Scene.query_tool``).
+    """
+    valid, R = _unit_quaternion(qx, qy, qz, qw)
+    if not valid or _invalid(out, 0, px, py, pz):
+        _write(out, 0, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, -1, 0,
+               STATUS_INVALID_INPUT, px, py, pz, -1, np.nan)
+        return
+    W, stack, stack_d2 = _scratch(floats, ints)
+    epa_floats, epa_ints = _epa_scratch(floats, ints)
+    rel = tool_floats[int(tool_floats[7]):int(tool_floats[7]) + 12]
+    tool = (tool_ints[0], tool_floats, TOOL_FLOAT_HEADER, tool_ints, TOOL_INT_HEADER)
+    bound = tool_floats[1]
+    cx = R[0] * tool_floats[2] + R[1] * tool_floats[3] + R[2] * tool_floats[4] + px
+    cy = R[3] * tool_floats[2] + R[4] * tool_floats[3] + R[5] * tool_floats[4] + py
+    cz = R[6] * tool_floats[2] + R[7] * tool_floats[3] + R[8] * tool_floats[4] + pz
+    best = best_lower = np.inf
+    best_status, best_k, best_t, total = STATUS_NO_OBJECT, -1, -1, 0
+    x = y = z = nx = ny = nz = np.nan
+    for k in range(ints[0]):
+        entry = _HEADER_INTS + _OBJECT_INTS * k
+        kind, r, fo, io = ints[entry], ints[entry + 1], ints[entry + 2], ints[entry + 3]
+        reach = norm3(cx - floats[r + 15], cy - floats[r + 16], cz - floats[r + 17])
+        if reach - floats[r + 18] - bound >= best:
+            continue
+        _tool_in_object(floats, r, R, px, py, pz, rel)
+        size = floats[r + 18] + bound
+        t = -1
+        if kind == TRIANGLE_MESH:
+            status, d, lower, ox, oy, oz, mx, my, mz, iterations, t, leaf_t = mesh_tool_distance(
+                floats, fo, ints, io, tool_floats, tool_ints, tool_ints[0], rel, ints[entry + 4],
+                size, floats[1], floats[2], ints[1], W, stack, stack_d2)
+            ints[entry + 4] = leaf_t
+        else:
+            status, d, lower, ox, oy, oz, mx, my, mz, iterations = pair_distance(
+                (kind, floats, fo, ints, io), tool, rel, 0.0, 0.0, 0.0, size, floats[1],
+                floats[2], ints[1], ints[2], W, epa_floats, epa_ints)
+        total += iterations
+        if d < best:
+            best, best_lower, best_status, best_k, best_t = d, lower, status, k, t
+            x = floats[r] * ox + floats[r + 1] * oy + floats[r + 2] * oz + floats[r + 9]
+            y = floats[r + 3] * ox + floats[r + 4] * oy + floats[r + 5] * oz + floats[r + 10]
+            z = floats[r + 6] * ox + floats[r + 7] * oy + floats[r + 8] * oz + floats[r + 11]
+            nx = floats[r] * mx + floats[r + 1] * my + floats[r + 2] * mz
+            ny = floats[r + 3] * mx + floats[r + 4] * my + floats[r + 5] * mz
+            nz = floats[r + 6] * mx + floats[r + 7] * my + floats[r + 8] * mz
+    _write(out, 0, best, x, y, z, nx, ny, nz, best_k, total, best_status,
+           x + best * nx, y + best * ny, z + best * nz, best_t, best_lower)

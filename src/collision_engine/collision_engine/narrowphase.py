@@ -29,7 +29,7 @@ from collision_engine.norms import norm3, unit3
 from collision_engine.support import (CAPSULE, CONVEX_MESH, CYLINDER, interior, POINT, SEGMENT,
                                       SPHERE)
 
-__all__ = ['pair_distance', 'point_distance']
+__all__ = ['core_of', 'pair_distance', 'point_distance', 'radius_of']
 
 
 @jit
@@ -81,7 +81,7 @@ def _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W):
 
 
 @jit
-def _radius(shape):
+def radius_of(shape):
     """The radius a sphere or capsule is dilated by (0 for the other shapes)."""
     if shape[0] == SPHERE or shape[0] == CAPSULE:
         return shape[1][shape[2]]
@@ -89,7 +89,7 @@ def _radius(shape):
 
 
 @jit
-def _core(shape):
+def core_of(shape):
     """The shape without its radius: a capsule's segment (spheres never get here)."""
     if shape[0] == CAPSULE:
         return (SEGMENT, shape[1], shape[2], shape[3], shape[4])
@@ -109,7 +109,7 @@ def pair_distance(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter, max_e
     B's witness is a + distance n.
     """
     if b[0] == SPHERE:
-        return _against_point(a, rel[9], rel[10], rel[11], _radius(b), gx, gy, gz, size,
+        return _against_point(a, rel[9], rel[10], rel[11], radius_of(b), gx, gy, gz, size,
                               rel_tol, abs_tol, max_iter, max_epa_iter, W, epa_floats, epa_ints)
     if a[0] == SPHERE:
         return _sphere_against(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter,
@@ -140,7 +140,7 @@ def _sphere_against(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter, max
     hy = -(rel[1] * gx + rel[4] * gy + rel[7] * gz)
     hz = -(rel[2] * gx + rel[5] * gy + rel[8] * gz)
     status, d, lower, x, y, z, mx, my, mz, iterations = _against_point(
-        b, qx, qy, qz, _radius(a), hx, hy, hz, size, rel_tol, abs_tol, max_iter, max_epa_iter,
+        b, qx, qy, qz, radius_of(a), hx, hy, hz, size, rel_tol, abs_tol, max_iter, max_epa_iter,
         W, epa_floats, epa_ints)
     # (x, y, z) is B's witness and m points from B toward A, in B's frame: A's witness is
     # x + d m, and the normal from A toward B is -m, both taken to A's frame.
@@ -158,7 +158,7 @@ def _sphere_against(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter, max
 def _between_cores(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter, max_epa_iter, W,
                    epa_floats, epa_ints):
     """GJK on the cores (EPA in contact), then the radii subtracted (module docstring)."""
-    core_a, core_b = _core(a), _core(b)
+    core_a, core_b = core_of(a), core_of(b)
     if gx == 0.0 and gy == 0.0 and gz == 0.0:
         gx, gy, gz = rel[9], rel[10], rel[11]
     simplex, supports = W[:12], W[12:24]
@@ -175,7 +175,7 @@ def _between_cores(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter, max_
             core_a, core_b, rel, simplex, supports, count, inv, rel_tol, abs_tol, max_epa_iter,
             epa_floats, epa_ints)
         d, lower, iterations = -depth, -bound, iterations + more
-    ra, rb = _radius(a), _radius(b)
+    ra, rb = radius_of(a), radius_of(b)
     return (status, d - ra - rb, lower - ra - rb, x + ra * nx, y + ra * ny, z + ra * nz,
             nx, ny, nz, iterations)
 

@@ -13,21 +13,25 @@ import sys
 from typing import Callable
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from collision_engine import _kernels
 from collision_engine._jit import compiling
 from collision_engine.distance import DistanceRequest
 from collision_engine.errors import MeshError
 from collision_engine.gjk import STATUS_INVALID_INPUT
-from collision_engine.results import BatchResult, QueryResult
+from collision_engine.results import BatchResult, QueryResult, ToolResult
 from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CrossValidationSpec,
                                          CylinderSpec, MaterialSpec, read_scene, SphereSpec)
 from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, TriangleMesh
+from collision_engine.tool import DEFAULT_SHELL_SPACING, pack_tool
 from collision_engine.transforms import Pose
 
 __all__ = ['Scene', 'SceneObject', 'load_scene']
 
 _LOG = logging.getLogger(__name__)
+
+DEFAULT_WORKSPACE_SIZE = 0.3  # m: the default wand workspace's largest edge
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,6 +58,19 @@ def _point(point) -> tuple[float, float, float]:
         raise ValueError(f'point must be 3 numbers (m), got {point!r}') from None
 
 
+def _pose_values(pose) -> tuple:
+    """Position (3 floats) and quaternion (4 floats, x y z w) of a tool pose (``query_tool``)."""
+    if isinstance(pose, Pose):
+        return pose.translation.tolist(), Rotation.from_matrix(pose.rotation).as_quat().tolist()
+    try:
+        position, quaternion = pose
+        qx, qy, qz, qw = quaternion
+        return _point(position), (float(qx), float(qy), float(qz), float(qw))
+    except (TypeError, ValueError):
+        raise ValueError(f'tool pose must be a Pose or (position (3,), quaternion (4,)), '
+                         f'got {pose!r}') from None
+
+
 def _invalid(point) -> ValueError:
     return ValueError(f'point must be finite, got {list(point)}')
 
@@ -75,16 +92,27 @@ class Scene:
     cross_validation : CrossValidationSpec, optional
         With ``fcl`` true, every ``every``-th ``query`` is checked against FCL, on a worker
         thread (``cross_validation.CrossValidationWorker``): call ``close`` when done.
+    workspace_size : float, m
+        The largest tool ``query_tool`` accepts (its bounding diameter): the workspace's size.
+    shell_spacing : float, m
+        The point shell's spacing of a tool against a non-convex mesh (``tool``).
     """
 
     def __init__(self, objects, *, frame_id: str = 'world', tip_radius: float = 0.0,
                  request: DistanceRequest | None = None,
-                 cross_validation: CrossValidationSpec | None = None) -> None:
+                 cross_validation: CrossValidationSpec | None = None,
+                 workspace_size: float = DEFAULT_WORKSPACE_SIZE,
+                 shell_spacing: float = DEFAULT_SHELL_SPACING) -> None:
         self.objects = tuple(objects)
         self.frame_id = frame_id
         if not (tip_radius >= 0.0 and math.isfinite(tip_radius)):
             raise ValueError(f'tip_radius must be a finite number >= 0 (m), got {tip_radius!r}')
         self.tip_radius = float(tip_radius)
+        for name, value in (('workspace_size', workspace_size), ('shell_spacing', shell_spacing)):
+            if not (value > 0.0 and math.isfinite(value)):
+                raise ValueError(f'{name} must be a positive finite number (m), got {value!r}')
+        self.workspace_size = float(workspace_size)
+        self.shell_spacing = float(shell_spacing)
         self.request = request or DistanceRequest()
         self._names = tuple(o.name for o in self.objects)
         shapes = [o.shape for o in self.objects]
@@ -208,6 +236,44 @@ class Scene:
         rows = rows[rows[:, 0] <= radius]
         rows = rows[np.argsort(rows[:, 0], kind='stable')]
         return [QueryResult(row, self._names) for row in rows.tolist()]
+
+    def query_tool(self, tool, pose) -> ToolResult:
+        """Signed distance from a convex tool to the nearest object, with both witnesses.
+
+        Convex objects are measured by the pair query (``narrowphase``: GJK apart, EPA or a
+        closed form in overlap); a non-convex mesh by its tree and GJK per triangle apart, and
+        in overlap by the deepest point of the tool's point shell (``tool_mesh``). One
+        compiled call; the tool is validated and packed on its first query and kept.
+
+        Parameters
+        ----------
+        tool : Box, Sphere, Cylinder, Capsule or ConvexMesh
+            In its own frame (``tool.load_tool`` reads one from a mesh file).
+        pose : Pose, or (position (3,), quaternion (4,))
+            The tool's frame in the scene frame: m, and (x, y, z, w) of norm 1 within 1e-6.
+            The pair form is the fast one (a ``Pose`` is converted to it on every call).
+
+        Returns
+        -------
+        ToolResult
+
+        Raises
+        ------
+        ValueError
+            If the tool is not convex or is larger than ``workspace_size``, or the pose has
+            NaN or infinite values or a quaternion that is not of unit norm.
+        """
+        tool_floats, tool_ints = pack_tool(tool, spacing=self.shell_spacing,
+                                           workspace_size=self.workspace_size)
+        (px, py, pz), (qx, qy, qz, qw) = _pose_values(pose)
+        row = self._row
+        _kernels.query_tool(self._floats, self._ints, tool_floats, tool_ints, row, px, py, pz,
+                            qx, qy, qz, qw)
+        values = row.tolist()
+        if values[9] == STATUS_INVALID_INPUT:
+            raise ValueError(f'tool pose must be a finite position and a unit quaternion '
+                             f'(x, y, z, w), got {[px, py, pz]}, {[qx, qy, qz, qw]}')
+        return ToolResult(values, self._names)
 
     def __repr__(self) -> str:
         return f'Scene(frame_id={self.frame_id!r}, objects={list(self._names)})'
