@@ -36,7 +36,8 @@ from collision_engine.pseudonormals import pseudonormals
 from collision_engine.signed_volumes import closest_point_on_triangle
 
 __all__ = ['FAR', 'LEAF_SIZE', 'box_distance2', 'build_tree', 'layout', 'mesh_distance',
-           'pack_triangle_mesh', 'pseudonormal', 'search_stack_size', 'tree_depth']
+           'nearest_triangle', 'pack_triangle_mesh', 'pseudonormal', 'search_stack_size',
+           'tree_depth', 'triangle_distance2']
 
 LEAF_SIZE = 4
 FAR = 2.0 ** 26  # mesh radii: beyond, a query is answered from a nearer point on its ray
@@ -203,7 +204,8 @@ def box_distance2(floats, b, qx, qy, qz):
 
 
 @jit
-def _triangle_distance2(floats, corners, t, qx, qy, qz):
+def triangle_distance2(floats, corners, t, qx, qy, qz):
+    """Closest point of triangle t (leaf order) to q: ``closest_point_on_triangle``'s tuple."""
     c = corners + 9 * t
     return closest_point_on_triangle(
         floats[c] - qx, floats[c + 1] - qy, floats[c + 2] - qz,
@@ -240,8 +242,8 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     if reach > FAR * scale:
         pull = FAR * scale / reach
         sx, sy, sz = cx + (qx - cx) * pull, cy + (qy - cy) * pull, cz + (qz - cz) * pull
-    best_d2, best_t, feature, which, vx, vy, vz, tested = _nearest_triangle(
-        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2)
+    best_d2, best_t, feature, which, vx, vy, vz, tested = nearest_triangle(
+        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2, np.inf)
     if reach > FAR * scale:
         x, y, z = sx + vx, sy + vy, sz + vz
         nx, ny, nz = unit3(qx - x, qy - y, qz - z)
@@ -262,22 +264,24 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
 
 
 @jit
-def _nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
-                      stack_d2):
+def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
+                     stack_d2, limit2):
     """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
 
-    Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
-    tested) with v from q to the nearest point and the feature as ``closest_point_on_triangle``'s.
+    Only triangles nearer than ``sqrt(limit2)`` are searched for (inf: all); with none, the
+    triangle returned is -1. Returns (squared distance, triangle in leaf order, feature, which,
+    vx, vy, vz, triangles tested) with v from q to the nearest point and the feature as
+    ``closest_point_on_triangle``'s.
     """
-    best_d2 = np.inf
+    best_d2 = limit2
     best_t, feature, which = -1, 0, 0
     vx = vy = vz = 0.0
     tested = 0
     if 0 <= hint < n_tri:
-        best_d2, vx, vy, vz, feature, which = _triangle_distance2(
-            floats, corners, hint, qx, qy, qz)
-        best_t = hint
+        d2, ux, uy, uz, f, w = triangle_distance2(floats, corners, hint, qx, qy, qz)
         tested = 1
+        if d2 < best_d2:
+            best_d2, vx, vy, vz, feature, which, best_t = d2, ux, uy, uz, f, w, hint
     stack[0] = 0
     stack_d2[0] = box_distance2(floats, boxes, qx, qy, qz)
     top = 1
@@ -291,7 +295,7 @@ def _nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hi
             first = ints[nodes + 3 * node + 1]
             tested += ints[nodes + 3 * node + 2]
             for t in range(first, first + ints[nodes + 3 * node + 2]):
-                d2, ux, uy, uz, f, w = _triangle_distance2(floats, corners, t, qx, qy, qz)
+                d2, ux, uy, uz, f, w = triangle_distance2(floats, corners, t, qx, qy, qz)
                 if d2 < best_d2:
                     best_d2, vx, vy, vz, feature, which, best_t = d2, ux, uy, uz, f, w, t
             continue

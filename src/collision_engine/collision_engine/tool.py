@@ -23,12 +23,13 @@ from collision_engine.errors import MeshError
 from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere
 from collision_engine.support import pack_convex
 
-__all__ = ['DEFAULT_SHELL_SPACING', 'FLOAT_HEADER', 'INT_HEADER', 'load_tool', 'pack_tool',
-           'point_shell']
+__all__ = ['BOX_FLOATS', 'DEFAULT_SHELL_SPACING', 'FLOAT_HEADER', 'INT_HEADER', 'load_tool',
+           'pack_tool', 'point_shell']
 
 DEFAULT_SHELL_SPACING = 0.005  # m
 FLOAT_HEADER = 8  # radius, bounding radius, bounding centre (3), spacing, shell at, work at
 INT_HEADER = 2  # kind, shell points
+BOX_FLOATS = 25  # the tool's extents in an object's frame (``tool_mesh._set_tool_box``)
 _CONVEX = (Box, Sphere, Cylinder, Capsule, ConvexMesh)
 _PACKED = weakref.WeakKeyDictionary()
 
@@ -114,7 +115,8 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
 
     Layout: floats = [radius, bounding radius, bounding centre (3), spacing, shell offset,
     work offset], the shape's float block, the shell (n, 3), then work space: the tool's pose
-    in an object's frame (12) and the shell points measured so far with their distances (4 n).
+    in an object's frame (12), its extents there (``BOX_FLOATS``) and the shell points measured
+    so far with bounds on their distances (4 n).
     ints = [kind, n], the shape's int block.
 
     Raises
@@ -133,7 +135,8 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
     shell_at = FLOAT_HEADER + len(shape_floats)
     work_at = shell_at + shell.size
     header = [radius, bounding, *centre, spacing, shell_at, work_at]
-    floats = np.concatenate((header, shape_floats, shell.ravel(), np.zeros(12 + 4 * len(shell))))
+    work = np.zeros(12 + BOX_FLOATS + 4 * len(shell))
+    floats = np.concatenate((header, shape_floats, shell.ravel(), work))
     ints = np.concatenate(([kind, len(shell)], shape_ints)).astype(np.int64)
     packed = (floats, ints)
     _PACKED[shape] = packed
