@@ -25,6 +25,7 @@ __all__ = [
     'scene_path',
     'segment_distance',
     'simplex_distance',
+    'tool_poses_near_surface',
     'triangles_meet',
     'sphere_signed_distance',
     'winding_number',
@@ -507,6 +508,43 @@ def segment_distance(p0, p1, q0, q1) -> float:
         if 0.0 < s < 1.0 and 0.0 < t < 1.0:
             best = min(best, float(_length(p0 + s * u - q0 - t * v)))
     return best
+
+
+def tool_poses_near_surface(vertices: np.ndarray, faces: np.ndarray, size, n: int, band: float,
+                            rng: np.random.Generator, tilt: float = np.radians(20.0)) -> tuple:
+    """Poses of a box tool held face down on a mesh, its lowest corner within ``band`` of it.
+
+    A site is drawn uniformly by area, and the box's -z face turned toward it along the face
+    normal, spun about it at random and tilted up to ``tilt`` rad; its lowest corner along the
+    normal is then put at a height uniform in [-band, band] above the site. Near, not exact:
+    the surface curves under the box.
+
+    Returns
+    -------
+    rotations : (n, 3, 3) float, tool to mesh frame
+    positions : (n, 3) float, m, mesh frame
+    """
+    from scipy.spatial.transform import Rotation
+
+    corners = _triangle_corners(vertices, faces)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    doubled_area = _length(normals)
+    normals /= doubled_area[:, None]
+    face = rng.choice(len(corners), n, p=doubled_area / doubled_area.sum())
+    weights = rng.dirichlet([1.0, 1.0, 1.0], n)
+    sites = np.einsum('ki,kij->kj', weights, corners[face])
+    up = np.array([0.0, 0.0, 1.0])
+    rotations = np.empty((n, 3, 3))
+    positions = np.empty((n, 3))
+    box = (np.array(list(np.ndindex(2, 2, 2))) - 0.5) * np.asarray(size, dtype=np.float64)
+    for k in range(n):
+        turn = Rotation.align_vectors([normals[face[k]]], [up])[0]
+        spin = Rotation.from_rotvec(rng.uniform(0.0, 2.0 * np.pi) * up)
+        lean = Rotation.from_rotvec(tilt * rng.uniform(-1.0, 1.0) * np.array([1.0, 0.0, 0.0]))
+        rotations[k] = (turn * spin * lean).as_matrix()
+        lowest = (box @ rotations[k].T @ normals[face[k]]).min()
+        positions[k] = sites[k] + (rng.uniform(-band, band) - lowest) * normals[face[k]]
+    return rotations, positions
 
 
 def scene_path(name: str) -> Path:

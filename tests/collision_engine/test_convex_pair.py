@@ -295,7 +295,8 @@ def test_fcl_agrees_on_separated_pairs():
         objects = [fcl.CollisionObject(model(s), fcl.Transform(p.rotation, p.translation))
                    for s, p in zip(pair, poses_)]
         theirs = fcl.distance(*objects, fcl.DistanceRequest(), fcl.DistanceResult())
-        # FCL's GJK stops at a relative gap (cross_validation: up to ~3 % of the distance).
-        assert theirs == pytest.approx(ours.distance, rel=0.03, abs=1e-9)
+        # FCL's GJK stops at a relative gap (cross_validation: up to ~3 % of the distance),
+        # from above: its distance is between two points of the shapes, never below ours.
+        assert ours.distance - 1e-9 <= theirs <= ours.distance * 1.03 + 1e-9
         compared += 1
     assert compared > 100

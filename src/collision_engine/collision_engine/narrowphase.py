@@ -90,7 +90,9 @@ def radius_of(shape):
 
 @jit
 def core_of(shape):
-    """The shape without its radius: a capsule's segment (spheres never get here)."""
+    """The shape without its radius: a sphere's centre, a capsule's segment, else itself."""
+    if shape[0] == SPHERE:
+        return (POINT, shape[1], shape[2], shape[3], shape[4])
     if shape[0] == CAPSULE:
         return (SEGMENT, shape[1], shape[2], shape[3], shape[4])
     return shape

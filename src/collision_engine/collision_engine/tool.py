@@ -102,8 +102,8 @@ def _refuse(shape, workspace_size: float) -> None:
     """Raise a ValueError that says why ``shape`` cannot be a tool, if it cannot."""
     if not isinstance(shape, _CONVEX):
         named = getattr(shape, 'name', None)
-        raise ValueError(f'the tool must be convex (Box, Sphere, Cylinder, Capsule or '
-                         f'ConvexMesh), got {shape!r}' + (f' from {named}' if named else ''))
+        raise ValueError((f'{named}: ' if named else '') + 'the tool must be convex (Box, '
+                         f'Sphere, Cylinder, Capsule or ConvexMesh), got {shape!r}')
     centre, radius = shape.bounding_sphere()
     if 2.0 * radius > workspace_size:
         raise ValueError(f'the tool {shape!r} is {2.0 * radius:.6g} m across, larger than the '
