@@ -9,14 +9,15 @@ polytope truth. Every case within 1e-9 m.
 
 from itertools import product
 
-from ground_truth import (box_signed_distance, mesh_signed_distance, polytope_pair_distance,
-                          scene_path, tool_poses_near_surface)
+from ground_truth import (box_signed_distance, cylinder_signed_distance, mesh_signed_distance,
+                          outward_hull, polytope_pair_distance, scene_path,
+                          tool_poses_near_surface)
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from collision_engine import (Box, Capsule, ConvexMesh, MeshError, Pose, Sphere, STATUS_OK,
-                              TriangleMesh)
+from collision_engine import (Box, Capsule, ConvexMesh, Cylinder, MeshError, Pose, Sphere,
+                              STATUS_OK, TriangleMesh)
 from collision_engine.scene import load_scene, Scene, SceneObject
 from collision_engine.tool import load_tool, point_shell
 
@@ -234,3 +235,41 @@ def test_the_shell_lies_on_the_probe_within_its_spacing():
             np.asarray(PROBE.size)[axis]
         gaps = np.min(np.linalg.norm(surface[:, None] - shell[None], axis=2), axis=1)
         assert gaps.max() <= spacing
+
+
+@pytest.mark.parametrize('tool, truth', [
+    (Cylinder(0.008, 0.03), lambda p: cylinder_signed_distance(p, 0.008, 0.03)),
+    (Capsule(0.004, 0.03), lambda p: np.hypot(p[:, 0], p[:, 1])),
+    (Sphere(0.01), lambda p: np.linalg.norm(p, axis=1)),
+    (ConvexMesh(np.random.default_rng(37).normal(size=(40, 3)) * 0.01), None),
+])
+def test_every_shell_lies_on_its_core(tool, truth):
+    # The core: a sphere's centre, a capsule's axis, else the surface itself.
+    shell = point_shell(tool, 0.004)
+    if truth is None:
+        faces, _ = outward_hull(tool.vertices)
+        truth = (lambda p: mesh_signed_distance(p, tool.vertices, faces)[0])
+    assert np.all(np.abs(truth(shell)) <= 1e-15)
+    assert len(np.unique(shell, axis=0)) == len(shell)
+
+
+def test_a_capsule_tool_apart_from_the_hand_is_its_segment_minus_the_radius(hand):
+    mesh, pose = hand.objects[0].shape, hand.objects[0].pose
+    tool = Capsule(0.004, 0.03)
+    rotations, positions = tool_poses_near_surface(mesh.vertices, mesh.faces,
+                                                   (0.008, 0.008, 0.038), 30, 0.004,
+                                                   np.random.default_rng(38))
+    checked = 0
+    for rotation, position in zip(rotations, positions):
+        world = Pose(pose.rotation @ rotation, pose.to_world(position))
+        result = hand.query_tool(tool, quaternion_pose(world.rotation, world.translation))
+        if result.distance <= 0.0:
+            continue
+        ends = np.array([[0.0, 0.0, -0.015], [0.0, 0.0, 0.015]]) @ rotation.T + position
+        triangles = mesh.vertices[mesh.faces]
+        near = np.linalg.norm(triangles.mean(axis=1) - position, axis=1) <= 0.04
+        truth = min(polytope_pair_distance(t, ends) for t in triangles[near]) - 0.004
+        assert result.distance == pytest.approx(truth, abs=TOLERANCE)
+        check_witnesses(result)
+        checked += 1
+    assert checked >= 5

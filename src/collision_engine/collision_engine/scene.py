@@ -2,7 +2,8 @@
 
 ``load_scene`` builds only what the file declares: a scene of primitives imports neither trimesh
 nor fcl and builds no tree; a convex mesh is queried by GJK on its hull, without a tree; fcl is
-imported only when the file turns cross-validation on. Every query is one compiled call.
+imported only when the file turns cross-validation on. Every query is one compiled call: of a
+point (the wand's tip, ``query``) or of a convex tool (the probe, ``query_tool``).
 """
 
 from dataclasses import dataclass
@@ -153,17 +154,20 @@ class Scene:
         if self._validator is not None:
             self._validator.close()
 
-    def warm_up(self, announce: Callable[[str], None] = _LOG.info) -> None:
+    def warm_up(self, announce: Callable[[str], None] = _LOG.info, *, tool=None) -> None:
         """Compile (or load from cache) every kernel, so that the first real query is fast.
 
         The first call in a process takes seconds without numba's cache and about half a
-        second with it; call this before a real-time loop starts (``load_scene`` does).
+        second with it; call this before a real-time loop starts (``load_scene`` does, without
+        a tool). ``tool``: also ``query_tool``'s kernel, and the tool's pack (``tool``).
         ``announce`` gets one line when this process is the one that compiles.
         """
         with compiling(announce):
             self.query_many(np.zeros((1, 3)))
             _kernels.query_point(self._floats, self._ints, self._row, 0.0, 0.0, 0.0)
             self.query_within((0.0, 0.0, 0.0), 0.0)
+            if tool is not None:
+                self.query_tool(tool, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))
 
     def query(self, point) -> QueryResult:
         """Signed distance from one tip position to the nearest object.
