@@ -216,6 +216,26 @@ def test_underflowing_and_huge_first_directions(guess):
         assert np.all(np.isfinite(guided.witness_points)) and np.all(np.isfinite(guided.normal))
 
 
+@pytest.mark.parametrize('offset', [[1e300, 0.0, 0.0], [1e300, 1e300, -1e300],
+                                    [1.0, 1e-300, 5e-324], [5e-324, 0.0, 0.0],
+                                    [1e-300, -1e-300, 1e-300], [1.0 + 2e-16, 5e-324, 0.0]])
+def test_huge_and_underflowing_offsets(offset):
+    # Unit cubes, and a cube against a unit ball: their closed forms at any offset (the
+    # squares of the offsets here underflow to 0 or overflow to inf).
+    cube, ball = Box([1.0, 1.0, 1.0]), Sphere(0.5)
+    offset = np.array(offset)
+    gaps = np.maximum(np.abs(offset) - 1.0, 0.0)
+    box_box = float(np.hypot(np.hypot(gaps[0], gaps[1]), gaps[2]))
+    if box_box == 0.0:
+        box_box = float(np.max(np.abs(offset)) - 1.0)  # overlap: the least push out
+    for pair, truth in (((cube, cube), box_box),
+                        ((cube, ball), float(box_signed_distance(offset, cube.size)) - 0.5)):
+        result = distance_between(pair[0], Pose(), pair[1], Pose(translation=offset))
+        assert result.status == STATUS_OK
+        assert result.distance == pytest.approx(truth, rel=1e-15, abs=1e-15)
+        assert np.all(np.isfinite(result.witness_points)) and np.all(np.isfinite(result.normal))
+
+
 def test_a_non_convex_mesh_is_refused():
     tetrahedron = TriangleMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
                                [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
