@@ -273,3 +273,28 @@ def test_a_capsule_tool_apart_from_the_hand_is_its_segment_minus_the_radius(hand
         check_witnesses(result)
         checked += 1
     assert checked >= 5
+
+
+def test_a_tool_wholly_inside_a_mesh_reports_its_deepest_shell_point():
+    # No triangle touches the tool: the sign of its witness says it is inside.
+    slab = TriangleMesh(corners([0.3, 0.3, 0.05]), _box_faces(), name='slab')
+    scene = Scene([SceneObject('slab', slab, Pose())])
+    tool = Box([0.02, 0.01, 0.01])
+    rng = np.random.default_rng(39)
+    for _ in range(10):
+        rotation = Rotation.from_rotvec(rng.uniform(-1.0, 1.0, 3)).as_matrix()
+        position = rng.uniform(-0.005, 0.005, 3)
+        result = scene.query_tool(tool, quaternion_pose(rotation, position))
+        shell = point_shell(tool, scene.shell_spacing) @ rotation.T + position
+        truth = mesh_signed_distance(shell, slab.vertices, slab.faces)[0].min()
+        assert truth < -0.005
+        assert result.distance == pytest.approx(truth, abs=TOLERANCE)
+        check_witnesses(result)
+
+
+def test_a_pose_object_gives_the_quaternion_form_s_answer(hand):
+    pose = Pose.from_rpy([0.01, 0.02, -0.05], [0.2, -0.1, 0.4])
+    quaternion = Rotation.from_matrix(pose.rotation).as_quat()
+    by_pose = hand.query_tool(PROBE, pose)
+    by_pair = hand.query_tool(PROBE, (tuple(pose.translation), tuple(quaternion)))
+    assert by_pose.distance == by_pair.distance

@@ -64,9 +64,8 @@ def _pose_values(pose) -> tuple:
     if isinstance(pose, Pose):
         return pose.translation.tolist(), Rotation.from_matrix(pose.rotation).as_quat().tolist()
     try:
-        position, quaternion = pose
-        qx, qy, qz, qw = quaternion
-        return _point(position), (float(qx), float(qy), float(qz), float(qw))
+        (px, py, pz), (qx, qy, qz, qw) = pose
+        return (float(px), float(py), float(pz)), (float(qx), float(qy), float(qz), float(qw))
     except (TypeError, ValueError):
         raise ValueError(f'tool pose must be a Pose or (position (3,), quaternion (4,)), '
                          f'got {pose!r}') from None
@@ -123,6 +122,7 @@ class Scene:
             abs_tol=self.request.abs_tol, max_iterations=self.request.max_iterations,
             max_epa_iterations=self.request.max_epa_iterations)
         self._row = np.empty(_kernels.OUT_SIZE)
+        self._tool = self._tool_pack = None
         self._validator = None
         if cross_validation is not None and cross_validation.fcl and self.objects:
             from collision_engine.cross_validation import CrossValidationWorker, FclCrossValidator
@@ -267,8 +267,11 @@ class Scene:
             If the tool is not convex or is larger than ``workspace_size``, or the pose has
             NaN or infinite values or a quaternion that is not of unit norm.
         """
-        tool_floats, tool_ints = pack_tool(tool, spacing=self.shell_spacing,
-                                           workspace_size=self.workspace_size)
+        if tool is not self._tool:  # one tool a loop, mostly: its pack is kept at hand
+            self._tool_pack = pack_tool(tool, spacing=self.shell_spacing,
+                                        workspace_size=self.workspace_size)
+            self._tool = tool
+        tool_floats, tool_ints = self._tool_pack
         (px, py, pz), (qx, qy, qz, qw) = _pose_values(pose)
         row = self._row
         _kernels.query_tool(self._floats, self._ints, tool_floats, tool_ints, row, px, py, pz,

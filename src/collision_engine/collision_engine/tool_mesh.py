@@ -254,15 +254,20 @@ def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
 
 
 @jit
-def _lipschitz_bound(tool_floats, work, measured, px, py, pz):
-    """Lower bound on the signed distance at p from the points measured so far."""
-    bound = -math.inf
-    for j in range(measured):
+def _ruled_out(tool_floats, work, measured, px, py, pz, best):
+    """Whether a point measured so far rules p out: its signed distance minus its distance to p
+    (a lower bound on p's, the signed distance being 1-Lipschitz) is not below ``best``.
+
+    The latest points, the neighbours of p in the shell's order, are tried first.
+    """
+    for j in range(measured - 1, -1, -1):
         w = work + 4 * j
-        bound = max(bound, tool_floats[w + 3] - norm3(px - tool_floats[w],
-                                                      py - tool_floats[w + 1],
-                                                      pz - tool_floats[w + 2]))
-    return bound
+        reach = tool_floats[w + 3] - best
+        if reach >= 0.0:
+            dx, dy, dz = px - tool_floats[w], py - tool_floats[w + 1], pz - tool_floats[w + 2]
+            if dx * dx + dy * dy + dz * dz <= reach * reach:
+                return True
+    return False
 
 
 @jit
@@ -285,7 +290,7 @@ def _deepest_shell_point(floats, fo, ints, io, lay, tool_floats, tool_ints, rel,
         i = first if step == 0 else (step - 1 if step - 1 < first else step)
         px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
                               tool_floats[shell + 3 * i + 2])
-        if _lipschitz_bound(tool_floats, work, measured, px, py, pz) >= best:
+        if _ruled_out(tool_floats, work, measured, px, py, pz, best):
             continue
         # A triangle nearer than the deepest depth so far: p is not deeper. Its distance then
         # bounds p's signed distance from below, for the Lipschitz test. The last nearest
