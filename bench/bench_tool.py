@@ -53,7 +53,7 @@ def _box_corners(size) -> np.ndarray:
 
 
 def _surface(shape) -> tuple[np.ndarray, np.ndarray]:
-    """The object's surface as triangles (vertices, faces), local frame."""
+    """Return the object's surface as triangles (vertices, faces), local frame."""
     if isinstance(shape, TriangleMesh):
         return shape.vertices, shape.faces
     faces, _ = ground_truth.outward_hull(_box_corners(shape.size))

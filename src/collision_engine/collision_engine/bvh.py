@@ -179,7 +179,7 @@ def layout(floats, fo, ints, io):
 @jit
 def pseudonormal(floats, ints, face_normals, edge_normals, vertex_normals, faces, face_edges,
                  t, feature, which):
-    """The angle-weighted pseudonormal of a feature of triangle t (leaf order).
+    """Return the angle-weighted pseudonormal of a feature of triangle t (leaf order).
 
     It signs the distance of every point whose nearest surface point lies on that feature.
     ``feature`` and ``which`` are ``closest_point_on_triangle``'s: 3 face, 2 edge (opposite

@@ -82,7 +82,7 @@ def _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W):
 
 @jit
 def radius_of(shape):
-    """The radius a sphere or capsule is dilated by (0 for the other shapes)."""
+    """Return the radius a sphere or capsule is dilated by (0 for the other shapes)."""
     if shape[0] == SPHERE or shape[0] == CAPSULE:
         return shape[1][shape[2]]
     return 0.0
@@ -90,7 +90,7 @@ def radius_of(shape):
 
 @jit
 def core_of(shape):
-    """The shape without its radius: a sphere's centre, a capsule's segment, else itself."""
+    """Return the shape without its radius: a sphere's centre, a capsule's segment, or it."""
     if shape[0] == SPHERE:
         return (POINT, shape[1], shape[2], shape[3], shape[4])
     if shape[0] == CAPSULE:
@@ -123,7 +123,7 @@ def pair_distance(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter, max_e
 @jit
 def _against_point(a, qx, qy, qz, radius, gx, gy, gz, size, rel_tol, abs_tol, max_iter,
                    max_epa_iter, W, epa_floats, epa_ints):
-    """A against a sphere of ``radius`` centred at q (A's frame): the point query, minus it."""
+    """Measure A against a sphere of ``radius`` at q (A's frame): the point query minus it."""
     status, d, lower, x, y, z, nx, ny, nz, iterations = point_distance(
         a[0], a[1], a[2], a[3], a[4], qx, qy, qz, 0.0, 0.0, 0.0, size, gx, gy, gz, rel_tol,
         abs_tol, max_iter, max_epa_iter, W, epa_floats, epa_ints)
@@ -184,7 +184,7 @@ def _between_cores(a, b, rel, gx, gy, gz, size, rel_tol, abs_tol, max_iter, max_
 
 @jit
 def _crossing_normal(rel):
-    """Common perpendicular of two crossing segments (A's axis z, B's R e_z), toward B.
+    """Return the common perpendicular of crossing segments (A's axis z, B's R e_z), to B.
 
     Parallel segments have no single one: any perpendicular of A's axis serves.
     """

@@ -74,7 +74,7 @@ def _hull_shell(shape: ConvexMesh, spacing: float) -> np.ndarray:
 
 
 def point_shell(shape, spacing: float = DEFAULT_SHELL_SPACING) -> np.ndarray:
-    """The tool core's point shell (module docstring).
+    """Return the tool core's point shell (module docstring).
 
     Parameters
     ----------

@@ -42,7 +42,7 @@ _UNIT_AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 @jit
 def _to_mesh(rel, x, y, z):
-    """A point of the tool's frame in the mesh's frame (``rel``: the tool's pose there)."""
+    """Return a point of the tool's frame in the mesh's frame (``rel``: the tool's pose there)."""
     return (rel[0] * x + rel[1] * y + rel[2] * z + rel[9],
             rel[3] * x + rel[4] * y + rel[5] * z + rel[10],
             rel[6] * x + rel[7] * y + rel[8] * z + rel[11])
@@ -50,7 +50,7 @@ def _to_mesh(rel, x, y, z):
 
 @jit
 def _extent(core, ux, uy, uz, offset):
-    """The core's extent along the direction u (tool frame), plus ``offset``: (lo, hi)."""
+    """Return the core's extent along u (tool frame), plus ``offset``: (lo, hi)."""
     sx, sy, sz, _ = support(core[0], core[1], core[2], core[3], core[4], ux, uy, uz, 0)
     tx, ty, tz, _ = support(core[0], core[1], core[2], core[3], core[4], -ux, -uy, -uz, 0)
     return ux * tx + uy * ty + uz * tz + offset, ux * sx + uy * sy + uz * sz + offset
@@ -96,7 +96,7 @@ def _gap2(lo_a, hi_a, lo_b, hi_b):
 
 @jit
 def _on_axis(box, k, x, y, z):
-    """The point's coordinate along the tool's axis k."""
+    """Return the point's coordinate along the tool's axis k."""
     return box[6 + 3 * k] * x + box[7 + 3 * k] * y + box[8 + 3 * k] * z
 
 
@@ -238,7 +238,9 @@ def _outside(floats, ints, lay, t, ax, ay, az, vx, vy, vz):
 
 @jit
 def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
-    """The shell point deepest below the plane through a with normal n: measured first.
+    """Return the shell point deepest below the plane through a with normal n.
+
+    It is measured first.
 
     The others follow in the shell's own order, in which neighbours follow each other, so
     that each search starts from its neighbour's nearest triangle.
@@ -255,10 +257,11 @@ def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
 
 @jit
 def _ruled_out(tool_floats, work, measured, px, py, pz, best):
-    """Whether a point measured so far rules p out: its signed distance minus its distance to p
-    (a lower bound on p's, the signed distance being 1-Lipschitz) is not below ``best``.
+    """Return whether a point measured so far rules p out.
 
-    The latest points, the neighbours of p in the shell's order, are tried first.
+    It does when its signed distance minus its distance to p (a lower bound on p's, the signed
+    distance being 1-Lipschitz) is not below ``best``. The latest points, the neighbours of p
+    in the shell's order, are tried first.
     """
     for j in range(measured - 1, -1, -1):
         w = work + 4 * j
@@ -273,7 +276,7 @@ def _ruled_out(tool_floats, work, measured, px, py, pz, best):
 @jit
 def _deepest_shell_point(floats, fo, ints, io, lay, tool_floats, tool_ints, rel, nx, ny, nz,
                          ax, ay, az, hint, stack, stack_d2):
-    """The shell point of least signed distance, if any is inside (module docstring).
+    """Find the shell point of least signed distance, if any is inside (module docstring).
 
     (nx, ny, nz) is the contact's outward normal and a a point on the surface there, which
     order the shell. Returns (found, distance, x, y, z, normal x, y, z, leaf triangle,
