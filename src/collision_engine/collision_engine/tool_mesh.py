@@ -11,9 +11,9 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   points) and along the tool's own axes (against its extents along them): the distance is at
   least the root sum of squares of the gaps along any three orthogonal axes; and, once a
   triangle is measured, the gap along the direction from it to the tool, which prunes the
-  surface that curves away from the nearest point. The nearest
-  triangle's distance is the separation, exact to GJK's tolerance, and its feature's
-  pseudonormal at the tool's witness says whether the tool is outside.
+  surface that curves away from the nearest point. The nearest triangle's distance is the
+  separation, exact to GJK's tolerance, and its feature's pseudonormal at the tool's witness
+  says whether the tool is outside.
 * Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
   point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). The
   signed distance is 1-Lipschitz, so a shell point closer to an already measured one than that
