@@ -6,7 +6,7 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   is the mesh's exact point query at its centre, minus its radius.
 * Separation: the mesh's AABB tree is searched depth-first, nearer child first, skipping every
   node, and every triangle, whose lower bound is not below the nearest triangle so far; each
-  other triangle is measured by GJK against the tool. The bound is the larger of two
+  other triangle is measured by GJK against the tool. The bound is the largest of these
   separating-axis bounds, along the mesh's axes (against the tool's box there, from six support
   points) and along the tool's own axes (against its extents along them): the distance is at
   least the root sum of squares of the gaps along any three orthogonal axes; and, once a
