@@ -20,9 +20,12 @@ __all__ = [
     'exact_unit',
     'hand_mesh_path',
     'mesh_signed_distance',
+    'polytope_pair_distance',
     'sample_near_surface',
     'scene_path',
+    'segment_distance',
     'simplex_distance',
+    'tool_poses_near_surface',
     'triangles_meet',
     'sphere_signed_distance',
     'winding_number',
@@ -468,6 +471,80 @@ def outward_hull(cloud: np.ndarray) -> tuple:
     inward = np.einsum('ij,ij->i', normals, hull.equations[:, :3]) < 0.0
     faces[inward] = faces[inward][:, ::-1]
     return faces, hull.equations
+
+
+def polytope_pair_distance(vertices_a: np.ndarray, vertices_b: np.ndarray) -> float:
+    """Signed distance between the convex hulls of two point sets, same frame, m.
+
+    The origin against the hull of the Minkowski difference {a - b} (scipy's ConvexHull): its
+    exact point-to-facet distance when outside (the separation), minus its distance to the
+    nearest facet when inside (the penetration depth).
+    """
+    a, b = _as_points(vertices_a), _as_points(vertices_b)
+    difference = (a[:, None, :] - b[None, :, :]).reshape(-1, 3)
+    faces, _ = outward_hull(difference)
+    return float(mesh_signed_distance(np.zeros(3), difference, faces)[0])
+
+
+def segment_distance(p0, p1, q0, q1) -> float:
+    """Distance between the segments p0 p1 and q0 q1, m.
+
+    The least of the four endpoint-to-segment distances and, when the lines' common
+    perpendicular meets both segments inside, its length.
+    """
+    p0, p1, q0, q1 = (np.asarray(v, dtype=np.float64) for v in (p0, p1, q0, q1))
+
+    def to_segment(x, s0, s1):
+        edge = s1 - s0
+        t = np.clip((x - s0) @ edge / (edge @ edge), 0.0, 1.0)
+        return float(_length(x - (s0 + t * edge)))
+
+    best = min(to_segment(p0, q0, q1), to_segment(p1, q0, q1), to_segment(q0, p0, p1),
+               to_segment(q1, p0, p1))
+    u, v, w = p1 - p0, q1 - q0, p0 - q0
+    system = np.array([[u @ u, -(u @ v)], [u @ v, -(v @ v)]])
+    if abs(np.linalg.det(system)) > 1e-12 * (u @ u) * (v @ v):
+        s, t = np.linalg.solve(system, [-(u @ w), -(v @ w)])
+        if 0.0 < s < 1.0 and 0.0 < t < 1.0:
+            best = min(best, float(_length(p0 + s * u - q0 - t * v)))
+    return best
+
+
+def tool_poses_near_surface(vertices: np.ndarray, faces: np.ndarray, size, n: int, band: float,
+                            rng: np.random.Generator, tilt: float = np.radians(20.0)) -> tuple:
+    """Poses of a box tool held face down on a mesh, its lowest corner within ``band`` of it.
+
+    A site is drawn uniformly by area, and the box's -z face turned toward it along the face
+    normal, spun about it at random and tilted up to ``tilt`` rad; its lowest corner along the
+    normal is then put at a height uniform in [-band, band] above the site. Near, not exact:
+    the surface curves under the box.
+
+    Returns
+    -------
+    rotations : (n, 3, 3) float, tool to mesh frame
+    positions : (n, 3) float, m, mesh frame
+    """
+    from scipy.spatial.transform import Rotation
+
+    corners = _triangle_corners(vertices, faces)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    doubled_area = _length(normals)
+    normals /= doubled_area[:, None]
+    face = rng.choice(len(corners), n, p=doubled_area / doubled_area.sum())
+    weights = rng.dirichlet([1.0, 1.0, 1.0], n)
+    sites = np.einsum('ki,kij->kj', weights, corners[face])
+    up = np.array([0.0, 0.0, 1.0])
+    rotations = np.empty((n, 3, 3))
+    positions = np.empty((n, 3))
+    box = (np.array(list(np.ndindex(2, 2, 2))) - 0.5) * np.asarray(size, dtype=np.float64)
+    for k in range(n):
+        turn = Rotation.align_vectors([normals[face[k]]], [up])[0]
+        spin = Rotation.from_rotvec(rng.uniform(0.0, 2.0 * np.pi) * up)
+        lean = Rotation.from_rotvec(tilt * rng.uniform(-1.0, 1.0) * np.array([1.0, 0.0, 0.0]))
+        rotations[k] = (turn * spin * lean).as_matrix()
+        lowest = (box @ rotations[k].T @ normals[face[k]]).min()
+        positions[k] = sites[k] + (rng.uniform(-band, band) - lowest) * normals[face[k]]
+    return rotations, positions
 
 
 def scene_path(name: str) -> Path:

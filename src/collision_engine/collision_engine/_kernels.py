@@ -35,15 +35,18 @@ import numpy as np
 
 from collision_engine import bvh
 from collision_engine._jit import jit
-from collision_engine.epa import epa, scratch_size
-from collision_engine.gjk import (gjk, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
-                                  STATUS_NOT_CONVERGED, STATUS_OK)
-from collision_engine.norms import norm3, unit3
-from collision_engine.support import (CAPSULE, CONVEX_MESH, CYLINDER, interior, pack_convex,
-                                      POINT, TRIANGLE_MESH)
+from collision_engine.epa import scratch_size
+from collision_engine.gjk import (STATUS_INVALID_INPUT, STATUS_NO_OBJECT, STATUS_NOT_CONVERGED,
+                                  STATUS_OK)
+from collision_engine.narrowphase import pair_distance, point_distance
+from collision_engine.norms import norm3
+from collision_engine.support import pack_convex, TRIANGLE_MESH
+from collision_engine.tool import FLOAT_HEADER as TOOL_FLOAT_HEADER
+from collision_engine.tool import INT_HEADER as TOOL_INT_HEADER
+from collision_engine.tool_mesh import mesh_tool_distance
 
-__all__ = ['OUT_SIZE', 'OBJECT_FLOATS', 'pack_scene', 'place_object', 'query_point',
-           'query_points', 'query_each_object', 'query_shape']
+__all__ = ['OUT_SIZE', 'OBJECT_FLOATS', 'QUATERNION_TOLERANCE', 'pack_scene', 'place_object',
+           'query_point', 'query_points', 'query_each_object', 'query_shape', 'query_tool']
 
 OUT_SIZE = 15
 OBJECT_FLOATS = 19
@@ -51,6 +54,7 @@ _HEADER_FLOATS = 4
 _HEADER_INTS = 4
 _OBJECT_INTS = 5
 _GJK_SCRATCH = 36  # simplex (12), A's support points (12), B's pose in A's frame (12)
+QUATERNION_TOLERANCE = 1e-6  # a tool pose's quaternion norm may be off 1 by this much
 
 
 def pack_scene(shapes: list, poses: list, *, tip_radius: float, rel_tol: float, abs_tol: float,
@@ -110,53 +114,6 @@ def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
 
 
 @jit
-def _convex_distance(kind, floats, fo, ints, io, qx, qy, qz, cx, cy, cz, radius, gx, gy, gz,
-                     rel_tol, abs_tol, max_iter, max_epa_iter, W):
-    """Signed distance to a convex shape: GJK outside, exact interior or EPA inside.
-
-    (cx, cy, cz) and ``radius`` are the shape's bounding sphere, (gx, gy, gz) a first search
-    direction (zero: from the shape's core toward q); W is GJK's scratch (``_GJK_SCRATCH``).
-    Returns (status, distance, lower bound, x, y, z, nx, ny, nz, iterations), local frame.
-    """
-    s, x, y, z, nx, ny, nz = 0.0, qx, qy, qz, 1.0, 0.0, 0.0
-    if kind != CONVEX_MESH:
-        s, x, y, z, nx, ny, nz = interior(kind, floats, fo, qx, qy, qz)
-        if s <= 0.0:
-            return STATUS_OK, s, s, x, y, z, nx, ny, nz, 0
-    if gx == 0.0 and gy == 0.0 and gz == 0.0:
-        gx, gy, gz = qx - cx, qy - cy, qz - cz
-        if kind == CYLINDER or kind == CAPSULE:
-            gz = qz - min(max(qz, -floats[fo + 1]), floats[fo + 1])
-    shape, point, simplex, supports, rel = _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W)
-    status, contact, count, vx, vy, vz, lower, iterations, inv, x, y, z = gjk(
-        shape, point, rel, gx, gy, gz, radius, rel_tol, abs_tol, max_iter, simplex, supports)
-    if not contact:
-        ux, uy, uz = unit3(vx, vy, vz)
-        return status, norm3(vx, vy, vz), lower, x, y, z, -ux, -uy, -uz, iterations
-    if kind != CONVEX_MESH:
-        # Within rounding of a primitive's surface: its exact interior formula holds there.
-        return STATUS_OK, s, s, x, y, z, nx, ny, nz, iterations
-    epa_floats, epa_ints = _epa_scratch(floats, ints)
-    status, depth, bound, x, y, z, nx, ny, nz, more = epa(
-        shape, point, rel, simplex, supports, count, inv, rel_tol, abs_tol, max_epa_iter,
-        epa_floats, epa_ints)
-    return status, -depth, -bound, x, y, z, nx, ny, nz, iterations + more
-
-
-@jit
-def _point_pair(kind, floats, fo, ints, io, qx, qy, qz, W):
-    """Pose the point q as GJK's B against the packed shape, and split W into GJK's scratch.
-
-    Returns (shape, point, simplex, supports, rel): ``rel`` holds q as the point's pose.
-    """
-    rel = W[24:36]
-    rel[0], rel[1], rel[2], rel[3], rel[4], rel[5], rel[6], rel[7], rel[8] = (
-        1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-    rel[9], rel[10], rel[11] = qx, qy, qz
-    return (kind, floats, fo, ints, io), (POINT, floats, 0, ints, 0), W[:12], W[12:24], rel
-
-
-@jit
 def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2):
     """Signed distance from the world point p to object k, in the world frame.
 
@@ -178,10 +135,11 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2
         lx = floats[r] * gx + floats[r + 3] * gy + floats[r + 6] * gz
         ly = floats[r + 1] * gx + floats[r + 4] * gy + floats[r + 7] * gz
         lz = floats[r + 2] * gx + floats[r + 5] * gy + floats[r + 8] * gz
-        status, distance, lower, x, y, z, nx, ny, nz, iterations = _convex_distance(
+        epa_floats, epa_ints = _epa_scratch(floats, ints)
+        status, distance, lower, x, y, z, nx, ny, nz, iterations = point_distance(
             kind, floats, fo, ints, io, qx, qy, qz,
             floats[r + 12], floats[r + 13], floats[r + 14], floats[r + 18], lx, ly, lz,
-            floats[1], floats[2], ints[1], ints[2], W)
+            floats[1], floats[2], ints[1], ints[2], W, epa_floats, epa_ints)
     wx = floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9]
     wy = floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10]
     wz = floats[r + 6] * x + floats[r + 7] * y + floats[r + 8] * z + floats[r + 11]
@@ -304,3 +262,86 @@ def query_shape(floats, ints, out, px, py, pz, gx, gy, gz):
         floats, ints, 0, px, py, pz, gx, gy, gz, W, stack, stack_d2)
     _write(out, 0, d - floats[0], x, y, z, nx, ny, nz, 0, iterations, status, px, py, pz,
            t, lower - floats[0])
+
+
+@jit
+def _unit_quaternion(qx, qy, qz, qw):
+    """Whether the quaternion is a unit one, and its rotation matrix (row-major).
+
+    A quaternion whose norm is off 1 by more than ``QUATERNION_TOLERANCE``, or with NaN or
+    infinite parts, is refused: it is a corrupt pose, not a rotation to renormalise.
+    """
+    norm = norm3(qx, qy, norm3(qz, qw, 0.0))
+    valid = abs(norm - 1.0) <= QUATERNION_TOLERANCE
+    if not valid:
+        norm = 1.0
+    x, y, z, w = qx / norm, qy / norm, qz / norm, qw / norm
+    rotation = (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w),
+                2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w),
+                2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y))
+    return valid, rotation
+
+
+@jit
+def _tool_in_object(floats, r, R, px, py, pz, rel):
+    """Write the tool's pose (R, p: scene frame) in the frame of the object at record r."""
+    dx, dy, dz = px - floats[r + 9], py - floats[r + 10], pz - floats[r + 11]
+    for i in range(3):
+        for j in range(3):
+            rel[3 * i + j] = (floats[r + i] * R[j] + floats[r + 3 + i] * R[3 + j]
+                              + floats[r + 6 + i] * R[6 + j])
+        rel[9 + i] = floats[r + i] * dx + floats[r + 3 + i] * dy + floats[r + 6 + i] * dz
+
+
+@jit
+def query_tool(floats, ints, tool_floats, tool_ints, out, px, py, pz, qx, qy, qz, qw):
+    """Nearest object to the tool posed at p with quaternion q (scene frame), to ``out``.
+
+    The tool is packed by ``tool.pack_tool``. The output row is that of the point queries with
+    the tool's witness point in place of the tip (``Scene.query_tool``).
+    """
+    valid, R = _unit_quaternion(qx, qy, qz, qw)
+    if not valid or _invalid(out, 0, px, py, pz):
+        _write(out, 0, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, -1, 0,
+               STATUS_INVALID_INPUT, px, py, pz, -1, np.nan)
+        return
+    W, stack, stack_d2 = _scratch(floats, ints)
+    epa_floats, epa_ints = _epa_scratch(floats, ints)
+    rel = tool_floats[int(tool_floats[7]):int(tool_floats[7]) + 12]
+    tool = (tool_ints[0], tool_floats, TOOL_FLOAT_HEADER, tool_ints, TOOL_INT_HEADER)
+    bound = tool_floats[1]
+    cx = R[0] * tool_floats[2] + R[1] * tool_floats[3] + R[2] * tool_floats[4] + px
+    cy = R[3] * tool_floats[2] + R[4] * tool_floats[3] + R[5] * tool_floats[4] + py
+    cz = R[6] * tool_floats[2] + R[7] * tool_floats[3] + R[8] * tool_floats[4] + pz
+    best = best_lower = np.inf
+    best_status, best_k, best_t, total = STATUS_NO_OBJECT, -1, -1, 0
+    x = y = z = nx = ny = nz = np.nan
+    for k in range(ints[0]):
+        entry = _HEADER_INTS + _OBJECT_INTS * k
+        kind, r, fo, io = ints[entry], ints[entry + 1], ints[entry + 2], ints[entry + 3]
+        reach = norm3(cx - floats[r + 15], cy - floats[r + 16], cz - floats[r + 17])
+        if reach - floats[r + 18] - bound >= best:
+            continue
+        _tool_in_object(floats, r, R, px, py, pz, rel)
+        size = floats[r + 18] + bound
+        t = -1
+        if kind == TRIANGLE_MESH:
+            status, d, lower, ox, oy, oz, mx, my, mz, iterations, t, leaf_t = mesh_tool_distance(
+                floats, fo, ints, io, tool_floats, tool_ints, tool_ints[0], rel, ints[entry + 4],
+                size, floats[1], floats[2], ints[1], W, stack, stack_d2)
+            ints[entry + 4] = leaf_t
+        else:
+            status, d, lower, ox, oy, oz, mx, my, mz, iterations = pair_distance(
+                (kind, floats, fo, ints, io), tool, rel, 0.0, 0.0, 0.0, size, floats[1],
+                floats[2], ints[1], ints[2], W, epa_floats, epa_ints)
+        total += iterations
+        if d < best:
+            best, best_lower, best_status, best_k, best_t = d, lower, status, k, t
+            x = floats[r] * ox + floats[r + 1] * oy + floats[r + 2] * oz + floats[r + 9]
+            y = floats[r + 3] * ox + floats[r + 4] * oy + floats[r + 5] * oz + floats[r + 10]
+            z = floats[r + 6] * ox + floats[r + 7] * oy + floats[r + 8] * oz + floats[r + 11]
+            nx = floats[r] * mx + floats[r + 1] * my + floats[r + 2] * mz
+            ny = floats[r + 3] * mx + floats[r + 4] * my + floats[r + 5] * mz
+            nz = floats[r + 6] * mx + floats[r + 7] * my + floats[r + 8] * mz
+    _write(out, 0, best, x, y, z, nx, ny, nz, best_k, total, best_status,
+           x + best * nx, y + best * ny, z + best * nz, best_t, best_lower)

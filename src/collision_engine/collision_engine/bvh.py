@@ -35,8 +35,9 @@ from collision_engine.norms import norm3, unit3
 from collision_engine.pseudonormals import pseudonormals
 from collision_engine.signed_volumes import closest_point_on_triangle
 
-__all__ = ['FAR', 'LEAF_SIZE', 'build_tree', 'mesh_distance', 'pack_triangle_mesh',
-           'search_stack_size', 'tree_depth']
+__all__ = ['FAR', 'LEAF_SIZE', 'box_distance2', 'build_tree', 'layout', 'mesh_distance',
+           'nearest_triangle', 'pack_triangle_mesh', 'pseudonormal', 'search_stack_size',
+           'tree_depth', 'triangle_distance2']
 
 LEAF_SIZE = 4
 FAR = 2.0 ** 26  # mesh radii: beyond, a query is answered from a nearer point on its ray
@@ -156,7 +157,45 @@ def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndar
 
 
 @jit
-def _box_distance2(floats, b, qx, qy, qz):
+def layout(floats, fo, ints, io):
+    """Offsets of one packed mesh's blocks (module docstring), and its triangle count.
+
+    Returns (triangles, corners, face normals, edge normals, vertex normals, boxes; faces,
+    face edges, original index, nodes): the first six index ``floats``, the last four ``ints``.
+    """
+    n_tri, n_edge, n_vert = ints[io], ints[io + 1], ints[io + 2]
+    corners = fo + 1
+    face_normals = corners + 9 * n_tri
+    edge_normals = face_normals + 3 * n_tri
+    vertex_normals = edge_normals + 3 * n_edge
+    boxes = vertex_normals + 3 * n_vert
+    faces = io + 5
+    face_edges = faces + 3 * n_tri
+    original = face_edges + 3 * n_tri
+    return (n_tri, corners, face_normals, edge_normals, vertex_normals, boxes, faces, face_edges,
+            original, original + n_tri)
+
+
+@jit
+def pseudonormal(floats, ints, face_normals, edge_normals, vertex_normals, faces, face_edges,
+                 t, feature, which):
+    """Return the angle-weighted pseudonormal of a feature of triangle t (leaf order).
+
+    It signs the distance of every point whose nearest surface point lies on that feature.
+    ``feature`` and ``which`` are ``closest_point_on_triangle``'s: 3 face, 2 edge (opposite
+    vertex ``which``), 1 vertex ``which``.
+    """
+    if feature == 3:
+        p = face_normals + 3 * t
+    elif feature == 2:
+        p = edge_normals + 3 * ints[face_edges + 3 * t + which]
+    else:
+        p = vertex_normals + 3 * ints[faces + 3 * t + which]
+    return floats[p], floats[p + 1], floats[p + 2]
+
+
+@jit
+def box_distance2(floats, b, qx, qy, qz):
     """Squared distance from q to the box at floats[b:b + 6] (0 inside)."""
     dx = max(floats[b] - qx, 0.0, qx - floats[b + 3])
     dy = max(floats[b + 1] - qy, 0.0, qy - floats[b + 4])
@@ -165,7 +204,8 @@ def _box_distance2(floats, b, qx, qy, qz):
 
 
 @jit
-def _triangle_distance2(floats, corners, t, qx, qy, qz):
+def triangle_distance2(floats, corners, t, qx, qy, qz):
+    """Closest point of triangle t (leaf order) to q: ``closest_point_on_triangle``'s tuple."""
     c = corners + 9 * t
     return closest_point_on_triangle(
         floats[c] - qx, floats[c + 1] - qy, floats[c + 2] - qz,
@@ -190,16 +230,9 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     Returns (distance, closest x, y, z, outward normal x, y, z, triangle in leaf order,
     original triangle index, triangles tested), m; the distance is negative inside.
     """
-    n_tri, n_edge, n_vert = ints[io], ints[io + 1], ints[io + 2]
     scale = floats[fo]
-    corners = fo + 1
-    face_normals = corners + 9 * n_tri
-    edge_normals = face_normals + 3 * n_tri
-    vertex_normals = edge_normals + 3 * n_edge
-    boxes = vertex_normals + 3 * n_vert
-    faces = io + 5
-    face_edges = faces + 3 * n_tri
-    nodes = face_edges + 3 * n_tri + n_tri
+    (n_tri, corners, face_normals, edge_normals, vertex_normals, boxes, faces, face_edges,
+     original, nodes) = layout(floats, fo, ints, io)
 
     cx, cy, cz = (0.5 * (floats[boxes] + floats[boxes + 3]),
                   0.5 * (floats[boxes + 1] + floats[boxes + 4]),
@@ -209,22 +242,16 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
     if reach > FAR * scale:
         pull = FAR * scale / reach
         sx, sy, sz = cx + (qx - cx) * pull, cy + (qy - cy) * pull, cz + (qz - cz) * pull
-    best_d2, best_t, feature, which, vx, vy, vz, tested = _nearest_triangle(
-        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2)
-    original = face_edges + 3 * n_tri
+    best_d2, best_t, feature, which, vx, vy, vz, tested = nearest_triangle(
+        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2, np.inf)
     if reach > FAR * scale:
         x, y, z = sx + vx, sy + vy, sz + vz
         nx, ny, nz = unit3(qx - x, qy - y, qz - z)
         return (norm3(qx - x, qy - y, qz - z), x, y, z, nx, ny, nz, best_t,
                 ints[original + best_t], tested)
 
-    if feature == 3:
-        p = face_normals + 3 * best_t
-    elif feature == 2:
-        p = edge_normals + 3 * ints[face_edges + 3 * best_t + which]
-    else:
-        p = vertex_normals + 3 * ints[faces + 3 * best_t + which]
-    px, py, pz = floats[p], floats[p + 1], floats[p + 2]
+    px, py, pz = pseudonormal(floats, ints, face_normals, edge_normals, vertex_normals, faces,
+                              face_edges, best_t, feature, which)
     distance = norm3(vx, vy, vz)
     inside = vx * px + vy * py + vz * pz > 0.0
     sign = -1.0 if inside else 1.0
@@ -237,24 +264,26 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
 
 
 @jit
-def _nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
-                      stack_d2):
+def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
+                     stack_d2, limit2):
     """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
 
-    Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
-    tested) with v from q to the nearest point and the feature as ``closest_point_on_triangle``'s.
+    Only triangles nearer than ``sqrt(limit2)`` are searched for (inf: all); with none, the
+    triangle returned is -1. Returns (squared distance, triangle in leaf order, feature, which,
+    vx, vy, vz, triangles tested) with v from q to the nearest point and the feature as
+    ``closest_point_on_triangle``'s.
     """
-    best_d2 = np.inf
+    best_d2 = limit2
     best_t, feature, which = -1, 0, 0
     vx = vy = vz = 0.0
     tested = 0
     if 0 <= hint < n_tri:
-        best_d2, vx, vy, vz, feature, which = _triangle_distance2(
-            floats, corners, hint, qx, qy, qz)
-        best_t = hint
+        d2, ux, uy, uz, f, w = triangle_distance2(floats, corners, hint, qx, qy, qz)
         tested = 1
+        if d2 < best_d2:
+            best_d2, vx, vy, vz, feature, which, best_t = d2, ux, uy, uz, f, w, hint
     stack[0] = 0
-    stack_d2[0] = _box_distance2(floats, boxes, qx, qy, qz)
+    stack_d2[0] = box_distance2(floats, boxes, qx, qy, qz)
     top = 1
     while top > 0:
         top -= 1
@@ -266,12 +295,12 @@ def _nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hi
             first = ints[nodes + 3 * node + 1]
             tested += ints[nodes + 3 * node + 2]
             for t in range(first, first + ints[nodes + 3 * node + 2]):
-                d2, ux, uy, uz, f, w = _triangle_distance2(floats, corners, t, qx, qy, qz)
+                d2, ux, uy, uz, f, w = triangle_distance2(floats, corners, t, qx, qy, qz)
                 if d2 < best_d2:
                     best_d2, vx, vy, vz, feature, which, best_t = d2, ux, uy, uz, f, w, t
             continue
-        near_d2 = _box_distance2(floats, boxes + 6 * child, qx, qy, qz)
-        far_d2 = _box_distance2(floats, boxes + 6 * (child + 1), qx, qy, qz)
+        near_d2 = box_distance2(floats, boxes + 6 * child, qx, qy, qz)
+        far_d2 = box_distance2(floats, boxes + 6 * (child + 1), qx, qy, qz)
         near, far = child, child + 1
         if far_d2 < near_d2:
             near, far, near_d2, far_d2 = far, near, far_d2, near_d2

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ['QueryResult', 'BatchResult']
+__all__ = ['QueryResult', 'BatchResult', 'ToolResult']
 
 _NAN = float('nan')
 
@@ -168,3 +168,89 @@ class BatchResult:
     def in_collision(self) -> np.ndarray:
         """(n,) bool: ``distance <= 0``."""
         return self.distance <= 0.0
+
+
+class ToolResult:
+    """The nearest object to a convex tool (``Scene.query_tool``), from one packed output row.
+
+    The distance is positive apart and minus the penetration depth in overlap (against a
+    non-convex mesh: the depth of the tool's deepest shell point, ``tool_mesh``); the normal is
+    outward from the object, and ``tool_point - point = distance * normal``. Scene frame, m.
+    """
+
+    __slots__ = ('_row', '_names')
+
+    def __init__(self, row: list, names: tuple) -> None:
+        self._row = row
+        self._names = names
+
+    @property
+    def row(self) -> list:
+        """Return the packed output: as ``QueryResult.row``, the tool's witness for the tip."""
+        return self._row
+
+    @property
+    def distance(self) -> float:
+        """Signed distance from the tool to the nearest object, m (``inf`` when none)."""
+        return self._row[0]
+
+    @property
+    def point(self) -> np.ndarray:
+        """(3,) the witness point on the object's surface, m."""
+        return np.array(self._row[1:4])
+
+    @property
+    def tool_point(self) -> np.ndarray:
+        """(3,) the witness point of the tool (its deepest point in overlap), m."""
+        return np.array(self._row[10:13])
+
+    @property
+    def witness_points(self) -> np.ndarray:
+        """(2, 3) ``point`` and ``tool_point``, m."""
+        return np.array([self._row[1:4], self._row[10:13]])
+
+    @property
+    def normal(self) -> np.ndarray:
+        """(3,) unit normal, outward from the object at ``point``."""
+        return np.array(self._row[4:7])
+
+    @property
+    def object_index(self) -> int:
+        """Index of the nearest object in ``Scene.objects`` (-1 for none)."""
+        return int(self._row[7])
+
+    @property
+    def object(self) -> str | None:
+        """Name of the nearest object, as in the scene file (None for none)."""
+        index = int(self._row[7])
+        return self._names[index] if index >= 0 else None
+
+    @property
+    def iterations(self) -> int:
+        """GJK and EPA iterations, and triangles tested by the shell's point queries."""
+        return int(self._row[8])
+
+    @property
+    def status(self) -> int:
+        """0 OK, 1 NOT_CONVERGED (the distance is then the best bound found), 2 NO_OBJECT."""
+        return int(self._row[9])
+
+    @property
+    def triangle(self) -> int:
+        """The mesh triangle the object's witness lies on (-1 for other shapes)."""
+        return int(self._row[13])
+
+    @property
+    def lower_bound(self) -> float:
+        """Proven lower bound on the distance, m (equal to it when converged)."""
+        return self._row[14]
+
+    @property
+    def in_collision(self) -> bool:
+        """``distance <= 0``."""
+        return self._row[0] <= 0.0
+
+    def __repr__(self) -> str:
+        return (f'ToolResult(object={self.object!r}, distance={self.distance!r}, '
+                f'point={self._row[1:4]}, tool_point={self._row[10:13]}, '
+                f'normal={self._row[4:7]}, status={self.status})')

@@ -2,7 +2,8 @@
 
 ``load_scene`` builds only what the file declares: a scene of primitives imports neither trimesh
 nor fcl and builds no tree; a convex mesh is queried by GJK on its hull, without a tree; fcl is
-imported only when the file turns cross-validation on. Every query is one compiled call.
+imported only when the file turns cross-validation on. Every query is one compiled call: of a
+point (the wand's tip, ``query``) or of a convex tool (the probe, ``query_tool``).
 """
 
 from dataclasses import dataclass
@@ -13,21 +14,25 @@ import sys
 from typing import Callable
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from collision_engine import _kernels
 from collision_engine._jit import compiling
 from collision_engine.distance import DistanceRequest
 from collision_engine.errors import MeshError
 from collision_engine.gjk import STATUS_INVALID_INPUT
-from collision_engine.results import BatchResult, QueryResult
+from collision_engine.results import BatchResult, QueryResult, ToolResult
 from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CrossValidationSpec,
                                          CylinderSpec, MaterialSpec, read_scene, SphereSpec)
 from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, TriangleMesh
+from collision_engine.tool import DEFAULT_SHELL_SPACING, pack_tool
 from collision_engine.transforms import Pose
 
 __all__ = ['Scene', 'SceneObject', 'load_scene']
 
 _LOG = logging.getLogger(__name__)
+
+DEFAULT_WORKSPACE_SIZE = 0.3  # m: the default wand workspace's largest edge
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,6 +59,18 @@ def _point(point) -> tuple[float, float, float]:
         raise ValueError(f'point must be 3 numbers (m), got {point!r}') from None
 
 
+def _pose_values(pose) -> tuple:
+    """Position (3 floats) and quaternion (4 floats, x y z w) of a tool pose (``query_tool``)."""
+    if isinstance(pose, Pose):
+        return pose.translation.tolist(), Rotation.from_matrix(pose.rotation).as_quat().tolist()
+    try:
+        (px, py, pz), (qx, qy, qz, qw) = pose
+        return (float(px), float(py), float(pz)), (float(qx), float(qy), float(qz), float(qw))
+    except (TypeError, ValueError):
+        raise ValueError(f'tool pose must be a Pose or (position (3,), quaternion (4,)), '
+                         f'got {pose!r}') from None
+
+
 def _invalid(point) -> ValueError:
     return ValueError(f'point must be finite, got {list(point)}')
 
@@ -75,16 +92,27 @@ class Scene:
     cross_validation : CrossValidationSpec, optional
         With ``fcl`` true, every ``every``-th ``query`` is checked against FCL, on a worker
         thread (``cross_validation.CrossValidationWorker``): call ``close`` when done.
+    workspace_size : float, m
+        The largest tool ``query_tool`` accepts (its bounding diameter): the workspace's size.
+    shell_spacing : float, m
+        The point shell's spacing of a tool against a non-convex mesh (``tool``).
     """
 
     def __init__(self, objects, *, frame_id: str = 'world', tip_radius: float = 0.0,
                  request: DistanceRequest | None = None,
-                 cross_validation: CrossValidationSpec | None = None) -> None:
+                 cross_validation: CrossValidationSpec | None = None,
+                 workspace_size: float = DEFAULT_WORKSPACE_SIZE,
+                 shell_spacing: float = DEFAULT_SHELL_SPACING) -> None:
         self.objects = tuple(objects)
         self.frame_id = frame_id
         if not (tip_radius >= 0.0 and math.isfinite(tip_radius)):
             raise ValueError(f'tip_radius must be a finite number >= 0 (m), got {tip_radius!r}')
         self.tip_radius = float(tip_radius)
+        for name, value in (('workspace_size', workspace_size), ('shell_spacing', shell_spacing)):
+            if not (value > 0.0 and math.isfinite(value)):
+                raise ValueError(f'{name} must be a positive finite number (m), got {value!r}')
+        self.workspace_size = float(workspace_size)
+        self.shell_spacing = float(shell_spacing)
         self.request = request or DistanceRequest()
         self._names = tuple(o.name for o in self.objects)
         shapes = [o.shape for o in self.objects]
@@ -94,6 +122,7 @@ class Scene:
             abs_tol=self.request.abs_tol, max_iterations=self.request.max_iterations,
             max_epa_iterations=self.request.max_epa_iterations)
         self._row = np.empty(_kernels.OUT_SIZE)
+        self._tool = self._tool_pack = None
         self._validator = None
         if cross_validation is not None and cross_validation.fcl and self.objects:
             from collision_engine.cross_validation import CrossValidationWorker, FclCrossValidator
@@ -125,17 +154,20 @@ class Scene:
         if self._validator is not None:
             self._validator.close()
 
-    def warm_up(self, announce: Callable[[str], None] = _LOG.info) -> None:
+    def warm_up(self, announce: Callable[[str], None] = _LOG.info, *, tool=None) -> None:
         """Compile (or load from cache) every kernel, so that the first real query is fast.
 
         The first call in a process takes seconds without numba's cache and about half a
-        second with it; call this before a real-time loop starts (``load_scene`` does).
+        second with it; call this before a real-time loop starts (``load_scene`` does, without
+        a tool). ``tool``: also ``query_tool``'s kernel, and the tool's pack (``tool``).
         ``announce`` gets one line when this process is the one that compiles.
         """
         with compiling(announce):
             self.query_many(np.zeros((1, 3)))
             _kernels.query_point(self._floats, self._ints, self._row, 0.0, 0.0, 0.0)
             self.query_within((0.0, 0.0, 0.0), 0.0)
+            if tool is not None:
+                self.query_tool(tool, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))
 
     def query(self, point) -> QueryResult:
         """Signed distance from one tip position to the nearest object.
@@ -208,6 +240,47 @@ class Scene:
         rows = rows[rows[:, 0] <= radius]
         rows = rows[np.argsort(rows[:, 0], kind='stable')]
         return [QueryResult(row, self._names) for row in rows.tolist()]
+
+    def query_tool(self, tool, pose) -> ToolResult:
+        """Signed distance from a convex tool to the nearest object, with both witnesses.
+
+        Convex objects are measured by the pair query (``narrowphase``: GJK apart, EPA or a
+        closed form in overlap); a non-convex mesh by its tree and GJK per triangle apart, and
+        in overlap by the deepest point of the tool's point shell (``tool_mesh``). One
+        compiled call; the tool is validated and packed on its first query and kept.
+
+        Parameters
+        ----------
+        tool : Box, Sphere, Cylinder, Capsule or ConvexMesh
+            In its own frame (``tool.load_tool`` reads one from a mesh file).
+        pose : Pose, or (position (3,), quaternion (4,))
+            The tool's frame in the scene frame: m, and (x, y, z, w) of norm 1 within 1e-6.
+            The pair form is the fast one (a ``Pose`` is converted to it on every call).
+
+        Returns
+        -------
+        ToolResult
+
+        Raises
+        ------
+        ValueError
+            If the tool is not convex or is larger than ``workspace_size``, or the pose has
+            NaN or infinite values or a quaternion that is not of unit norm.
+        """
+        if tool is not self._tool:  # one tool a loop, mostly: its pack is kept at hand
+            self._tool_pack = pack_tool(tool, spacing=self.shell_spacing,
+                                        workspace_size=self.workspace_size)
+            self._tool = tool
+        tool_floats, tool_ints = self._tool_pack
+        (px, py, pz), (qx, qy, qz, qw) = _pose_values(pose)
+        row = self._row
+        _kernels.query_tool(self._floats, self._ints, tool_floats, tool_ints, row, px, py, pz,
+                            qx, qy, qz, qw)
+        values = row.tolist()
+        if values[9] == STATUS_INVALID_INPUT:
+            raise ValueError(f'tool pose must be a finite position and a unit quaternion '
+                             f'(x, y, z, w), got {[px, py, pz]}, {[qx, qy, qz, qw]}')
+        return ToolResult(values, self._names)
 
     def __repr__(self) -> str:
         return f'Scene(frame_id={self.frame_id!r}, objects={list(self._names)})'

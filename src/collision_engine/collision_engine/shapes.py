@@ -242,7 +242,7 @@ class TriangleMesh:
         that traverse it in opposite directions, and no face may have zero area: the sign of the
         distance (pseudonormals) needs both.
     name : str, optional
-        Names the mesh (e.g. its file) in error messages.
+        Names the mesh (e.g. its file) in error messages; kept as ``name``.
 
     Raises
     ------
@@ -250,7 +250,7 @@ class TriangleMesh:
         When the surface is open, non-manifold, inconsistently wound or has a degenerate face.
     """
 
-    __slots__ = ('vertices', 'faces', '_sphere', '__weakref__')
+    __slots__ = ('vertices', 'faces', 'name', '_sphere', '__weakref__')
     kind = _support.TRIANGLE_MESH
 
     def __init__(self, vertices, faces, *, name: str = 'TriangleMesh') -> None:
@@ -266,6 +266,7 @@ class TriangleMesh:
         _check_closed_and_wound(vertices, faces, name)
         self.vertices = vertices
         self.faces = faces
+        self.name = name
         self._sphere = None
 
     def support(self, direction) -> np.ndarray:

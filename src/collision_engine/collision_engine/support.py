@@ -14,7 +14,11 @@ CONVEX_MESH    n vertices x, y, z                              n, then CSR verte
                                                                n + 1 offsets, then neighbours
 POINT          (none): the point is the local origin            (none)
 TRIANGLE       corners a, b, c (9)                             (none)
+SEGMENT        (radius, ignored), half length (axis z)         (none)
 =============  ==============================================  ===================================
+
+A ``SEGMENT`` reads a capsule's own block without its radius: the capsule's core, which the pair
+query (``convex_pair``) measures before subtracting the radius.
 
 All vectors are in the shape's local frame, in metres.
 """
@@ -26,7 +30,7 @@ from collision_engine.norms import norm2, norm3, scaled3, unit2, unit3
 
 __all__ = [
     'BOX', 'SPHERE', 'CYLINDER', 'CAPSULE', 'CONVEX_MESH', 'TRIANGLE_MESH', 'POINT', 'TRIANGLE',
-    'pack_convex', 'support', 'support_point', 'interior',
+    'SEGMENT', 'pack_convex', 'support', 'support_point', 'interior',
 ]
 
 BOX = 0
@@ -37,6 +41,7 @@ CONVEX_MESH = 4
 TRIANGLE_MESH = 5
 POINT = 6
 TRIANGLE = 7
+SEGMENT = 8
 
 
 def pack_convex(shape) -> tuple[int, np.ndarray, np.ndarray]:
@@ -106,6 +111,8 @@ def support(kind, floats, fo, ints, io, dx, dy, dz, start):
         return r * ux, r * uy, z + r * uz, -1
     if kind == POINT:
         return 0.0, 0.0, 0.0, -1
+    if kind == SEGMENT:
+        return 0.0, 0.0, floats[fo + 1] if dz >= 0.0 else -floats[fo + 1], -1
     sx, sy, sz = scaled3(dx, dy, dz)
     if kind == TRIANGLE:
         return _farthest_corner(floats, fo, sx, sy, sz)

@@ -1,0 +1,364 @@
+"""A convex tool against a closed, non-convex triangle mesh, compiled.
+
+Sign rule as everywhere: negative in overlap; the normal is outward from the mesh.
+
+* The tool is measured by its core and the core's radius subtracted (``narrowphase``): a sphere
+  is the mesh's exact point query at its centre, minus its radius.
+* Separation: the mesh's AABB tree is searched depth-first, nearer child first, skipping every
+  node, and every triangle, whose lower bound is not below the nearest triangle so far; each
+  other triangle is measured by GJK against the tool. The bound is the largest of these
+  separating-axis bounds, along the mesh's axes (against the tool's box there, from six support
+  points) and along the tool's own axes (against its extents along them): the distance is at
+  least the root sum of squares of the gaps along any three orthogonal axes; and, once a
+  triangle is measured, the gap along the direction from it to the tool, which prunes the
+  surface that curves away from the nearest point. The nearest triangle's distance is the
+  separation, exact to GJK's tolerance, and its feature's pseudonormal at the tool's witness
+  says whether the tool is outside.
+* Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
+  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). The
+  signed distance is 1-Lipschitz, so a shell point closer to an already measured one than that
+  one's distance above the deepest so far cannot be deeper, and is skipped; so is one with a
+  triangle nearer than the deepest depth so far (a search bounded by that radius). The first
+  point measured is the one deepest along the contact triangle's normal. When no shell point is
+  inside (a feature of the mesh reaches into the tool between shell points), the answer is the
+  contact itself: depth zero at GJK's contact point, with that triangle's normal.
+"""
+
+import math
+
+from collision_engine import bvh
+from collision_engine._jit import jit
+from collision_engine.gjk import gjk, STATUS_NOT_CONVERGED, STATUS_OK
+from collision_engine.narrowphase import core_of
+from collision_engine.norms import norm3, unit3
+from collision_engine.signed_volumes import closest_point_on_triangle
+from collision_engine.support import POINT, support, TRIANGLE
+from collision_engine.tool import BOX_FLOATS, FLOAT_HEADER, INT_HEADER
+
+__all__ = ['mesh_tool_distance']
+
+_UNIT_AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+@jit
+def _to_mesh(rel, x, y, z):
+    """Return a point of the tool's frame in the mesh's frame (``rel``: the tool's pose there)."""
+    return (rel[0] * x + rel[1] * y + rel[2] * z + rel[9],
+            rel[3] * x + rel[4] * y + rel[5] * z + rel[10],
+            rel[6] * x + rel[7] * y + rel[8] * z + rel[11])
+
+
+@jit
+def _extent(core, ux, uy, uz, offset):
+    """Return the core's extent along u (tool frame), plus ``offset``: (lo, hi)."""
+    sx, sy, sz, _ = support(core[0], core[1], core[2], core[3], core[4], ux, uy, uz, 0)
+    tx, ty, tz, _ = support(core[0], core[1], core[2], core[3], core[4], -ux, -uy, -uz, 0)
+    return ux * tx + uy * ty + uz * tz + offset, ux * sx + uy * sy + uz * sz + offset
+
+
+@jit
+def _set_tool_box(core, rel, box):
+    """Write the core's extents in the mesh's frame to ``box`` (``tool.BOX_FLOATS``).
+
+    [0:3] and [3:6]: its box along the mesh's axes (lo, hi); [6:15]: its own axes there (the
+    rotation's columns); [15:21]: lo and hi along each of them; [21:25]: a unit direction n
+    and the tool's least extent along it (``_set_direction``; none yet: zero).
+    """
+    box[21] = box[22] = box[23] = box[24] = 0.0
+    for k in range(3):
+        # Mesh axis k in the tool's frame is row k of the rotation.
+        box[k], box[3 + k] = _extent(core, rel[3 * k], rel[3 * k + 1], rel[3 * k + 2],
+                                     rel[9 + k])
+        box[6 + 3 * k], box[7 + 3 * k], box[8 + 3 * k] = rel[k], rel[3 + k], rel[6 + k]
+        offset = rel[k] * rel[9] + rel[3 + k] * rel[10] + rel[6 + k] * rel[11]
+        ex, ey, ez = _UNIT_AXES[k]
+        box[15 + 2 * k], box[16 + 2 * k] = _extent(core, ex, ey, ez, offset)
+
+
+@jit
+def _set_direction(core, rel, box, nx, ny, nz):
+    """Store the unit direction n (mesh frame) and the core's least extent along it."""
+    # -n in the tool's frame is R^T (-n); its support point, back in the mesh's frame, on n.
+    dx = -(rel[0] * nx + rel[3] * ny + rel[6] * nz)
+    dy = -(rel[1] * nx + rel[4] * ny + rel[7] * nz)
+    dz = -(rel[2] * nx + rel[5] * ny + rel[8] * nz)
+    sx, sy, sz, _ = support(core[0], core[1], core[2], core[3], core[4], dx, dy, dz, 0)
+    x, y, z = _to_mesh(rel, sx, sy, sz)
+    box[21], box[22], box[23], box[24] = nx, ny, nz, nx * x + ny * y + nz * z
+
+
+@jit
+def _gap2(lo_a, hi_a, lo_b, hi_b):
+    """Squared gap between the intervals [lo_a, hi_a] and [lo_b, hi_b] (0 when they meet)."""
+    gap = max(lo_a - hi_b, 0.0, lo_b - hi_a)
+    return gap * gap
+
+
+@jit
+def _on_axis(box, k, x, y, z):
+    """Return the point's coordinate along the tool's axis k."""
+    return box[6 + 3 * k] * x + box[7 + 3 * k] * y + box[8 + 3 * k] * z
+
+
+@jit
+def _node_bound2(floats, b, box):
+    """Lower bound on the squared distance from the tool to the node box at floats[b:b + 6]."""
+    lx, ly, lz = floats[b], floats[b + 1], floats[b + 2]
+    hx, hy, hz = floats[b + 3], floats[b + 4], floats[b + 5]
+    mesh_axes = (_gap2(lx, hx, box[0], box[3]) + _gap2(ly, hy, box[1], box[4])
+                 + _gap2(lz, hz, box[2], box[5]))
+    own = 0.0
+    for k in range(3):
+        centre = _on_axis(box, k, 0.5 * (lx + hx), 0.5 * (ly + hy), 0.5 * (lz + hz))
+        reach = 0.5 * ((hx - lx) * abs(box[6 + 3 * k]) + (hy - ly) * abs(box[7 + 3 * k])
+                       + (hz - lz) * abs(box[8 + 3 * k]))
+        own += _gap2(centre - reach, centre + reach, box[15 + 2 * k], box[16 + 2 * k])
+    highest = (box[21] * 0.5 * (lx + hx) + box[22] * 0.5 * (ly + hy) + box[23] * 0.5 * (lz + hz)
+               + 0.5 * ((hx - lx) * abs(box[21]) + (hy - ly) * abs(box[22])
+                        + (hz - lz) * abs(box[23])))
+    along = max(box[24] - highest, 0.0)
+    return max(mesh_axes, own, along * along)
+
+
+@jit
+def _triangle_bound2(floats, c, box):
+    """Lower bound on the squared distance from the tool to the triangle at floats[c:c + 9]."""
+    mesh_axes = own = 0.0
+    for k in range(3):
+        a, b, d = floats[c + k], floats[c + 3 + k], floats[c + 6 + k]
+        mesh_axes += _gap2(min(a, b, d), max(a, b, d), box[k], box[3 + k])
+        a = _on_axis(box, k, floats[c], floats[c + 1], floats[c + 2])
+        b = _on_axis(box, k, floats[c + 3], floats[c + 4], floats[c + 5])
+        d = _on_axis(box, k, floats[c + 6], floats[c + 7], floats[c + 8])
+        own += _gap2(min(a, b, d), max(a, b, d), box[15 + 2 * k], box[16 + 2 * k])
+    highest = -math.inf
+    for corner in range(3):
+        p = c + 3 * corner
+        highest = max(highest, box[21] * floats[p] + box[22] * floats[p + 1]
+                      + box[23] * floats[p + 2])
+    along = max(box[24] - highest, 0.0)
+    return max(mesh_axes, own, along * along)
+
+
+@jit
+def _nearest_triangle(floats, ints, corners, boxes, nodes, n_tri, core, rel, box, hint, size,
+                      rel_tol, abs_tol, max_iter, W, stack, stack_d2):
+    """Search the tree for the triangle nearest the core; stop at the first one in contact.
+
+    The hint triangle is measured first. Returns (contact, triangle, distance, a, v, status,
+    lower, iterations) with a on the triangle and v = a - b (module docstring).
+    """
+    centre = (0.5 * (box[0] + box[3]), 0.5 * (box[1] + box[4]), 0.5 * (box[2] + box[5]))
+    state = (math.inf, -1, STATUS_OK, 0.0, math.inf, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, False)
+    if 0 <= hint < n_tri:
+        state = _measure(floats, ints, corners, hint, 1, core, rel, box, centre, size, rel_tol,
+                         abs_tol, max_iter, W, state)
+    stack[0], stack_d2[0] = 0, _node_bound2(floats, boxes, box)
+    top = 1
+    while top > 0 and not state[12]:
+        top -= 1
+        node = stack[top]
+        best2 = state[0] * state[0]
+        if stack_d2[top] >= best2:
+            continue
+        child = ints[nodes + 3 * node]
+        if child < 0:
+            state = _measure(floats, ints, corners, ints[nodes + 3 * node + 1],
+                             ints[nodes + 3 * node + 2], core, rel, box, centre, size, rel_tol,
+                             abs_tol, max_iter, W, state)
+            continue
+        near_d2 = _node_bound2(floats, boxes + 6 * child, box)
+        far_d2 = _node_bound2(floats, boxes + 6 * (child + 1), box)
+        near, far = child, child + 1
+        if far_d2 < near_d2:
+            near, far, near_d2, far_d2 = far, near, far_d2, near_d2
+        if far_d2 < best2:
+            stack[top], stack_d2[top] = far, far_d2
+            top += 1
+        if near_d2 < best2:
+            stack[top], stack_d2[top] = near, near_d2
+            top += 1
+    best, best_t, status, lower, unsure, ax, ay, az, vx, vy, vz, total, contact = state
+    if unsure < best:
+        status, lower = STATUS_NOT_CONVERGED, min(lower, unsure)
+    return contact, best_t, best, ax, ay, az, vx, vy, vz, status, lower, total
+
+
+@jit
+def _measure(floats, ints, corners, first, count, core, rel, box, centre, size, rel_tol,
+             abs_tol, max_iter, W, state):
+    """Measure triangles first..first + count by GJK and fold them into the search's state.
+
+    ``state`` is (best distance, its triangle, status, lower bound, least lower bound of an
+    unconverged triangle, a (3), v (3), GJK iterations, contact); a contact ends the search.
+    A triangle whose bound (``_triangle_bound2``) is not below the best is skipped.
+    """
+    best, best_t, status, lower, unsure, ax, ay, az, vx, vy, vz, total, contact = state
+    cx, cy, cz = centre
+    for t in range(first, first + count):
+        c = corners + 9 * t
+        if _triangle_bound2(floats, c, box) >= best * best:
+            continue
+        # The search starts along the nearest triangle's direction so far, else toward the
+        # tool's centre.
+        gx, gy, gz = -vx, -vy, -vz
+        if best_t < 0:
+            gx, gy, gz = cx - floats[c], cy - floats[c + 1], cz - floats[c + 2]
+        s, touch, _, ux, uy, uz, low, iterations, _, px, py, pz = gjk(
+            (TRIANGLE, floats, c, ints, 0), core, rel, gx, gy, gz, size, rel_tol, abs_tol,
+            max_iter, W[:12], W[12:24])
+        total += iterations
+        if touch:
+            return best, t, STATUS_OK, 0.0, unsure, px, py, pz, ux, uy, uz, total, True
+        d = norm3(ux, uy, uz)
+        if s != STATUS_OK:
+            unsure = min(unsure, low)
+        if d < best:
+            best, best_t, status, lower = d, t, s, low
+            ax, ay, az, vx, vy, vz = px, py, pz, ux, uy, uz
+            nx, ny, nz = unit3(-vx, -vy, -vz)
+            _set_direction(core, rel, box, nx, ny, nz)
+    return best, best_t, status, lower, unsure, ax, ay, az, vx, vy, vz, total, contact
+
+
+@jit
+def _outside(floats, ints, lay, t, ax, ay, az, vx, vy, vz):
+    """Whether the core's witness b = a - v lies outside the mesh (a: its nearest point)."""
+    _, corners, face_normals, edge_normals, vertex_normals, _, faces, face_edges, _, _ = lay
+    bx, by, bz = ax - vx, ay - vy, az - vz
+    c = corners + 9 * t
+    _, ux, uy, uz, feature, which = closest_point_on_triangle(
+        floats[c] - bx, floats[c + 1] - by, floats[c + 2] - bz,
+        floats[c + 3] - bx, floats[c + 4] - by, floats[c + 5] - bz,
+        floats[c + 6] - bx, floats[c + 7] - by, floats[c + 8] - bz)
+    px, py, pz = bvh.pseudonormal(floats, ints, face_normals, edge_normals, vertex_normals,
+                                  faces, face_edges, t, feature, which)
+    return ux * px + uy * py + uz * pz <= 0.0
+
+
+@jit
+def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
+    """Return the shell point deepest below the plane through a with normal n.
+
+    It is measured first.
+
+    The others follow in the shell's own order, in which neighbours follow each other, so
+    that each search starts from its neighbour's nearest triangle.
+    """
+    first, deepest = 0, -math.inf
+    for i in range(n_shell):
+        px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
+                              tool_floats[shell + 3 * i + 2])
+        depth = nx * (ax - px) + ny * (ay - py) + nz * (az - pz)
+        if depth > deepest:
+            first, deepest = i, depth
+    return first
+
+
+@jit
+def _ruled_out(tool_floats, work, measured, px, py, pz, best):
+    """Return whether a point measured so far rules p out.
+
+    It does when its signed distance minus its distance to p (a lower bound on p's, the signed
+    distance being 1-Lipschitz) is not below ``best``. The latest points, the neighbours of p
+    in the shell's order, are tried first.
+    """
+    for j in range(measured - 1, -1, -1):
+        w = work + 4 * j
+        reach = tool_floats[w + 3] - best
+        if reach >= 0.0:
+            dx, dy, dz = px - tool_floats[w], py - tool_floats[w + 1], pz - tool_floats[w + 2]
+            if dx * dx + dy * dy + dz * dz <= reach * reach:
+                return True
+    return False
+
+
+@jit
+def _deepest_shell_point(floats, fo, ints, io, lay, tool_floats, tool_ints, rel, nx, ny, nz,
+                         ax, ay, az, hint, stack, stack_d2):
+    """Find the shell point of least signed distance, if any is inside (module docstring).
+
+    (nx, ny, nz) is the contact's outward normal and a a point on the surface there, which
+    order the shell. Returns (found, distance, x, y, z, normal x, y, z, leaf triangle,
+    original triangle, triangles tested).
+    """
+    n_tri, corners, _, _, _, boxes, _, _, _, nodes = lay
+    n_shell, shell = tool_ints[1], int(tool_floats[6])
+    work = int(tool_floats[7]) + 12 + BOX_FLOATS
+    first = _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az)
+    best, found, measured, tested = 0.0, False, 0, 0
+    x = y = z = mx = my = mz = 0.0
+    leaf_t = triangle = -1
+    for step in range(n_shell):
+        i = first if step == 0 else (step - 1 if step - 1 < first else step)
+        px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
+                              tool_floats[shell + 3 * i + 2])
+        if _ruled_out(tool_floats, work, measured, px, py, pz, best):
+            continue
+        # A triangle nearer than the deepest depth so far: p is not deeper. Its distance then
+        # bounds p's signed distance from below, for the Lipschitz test. The last nearest
+        # triangle (of a neighbouring shell point) is tried before a search.
+        limit2 = best * best if found else 0.0
+        d2, t = bvh.triangle_distance2(floats, corners, hint, px, py, pz)[0], hint
+        tested += 1
+        if not d2 < limit2:
+            d2, t, _, _, _, _, _, count = bvh.nearest_triangle(
+                floats, corners, boxes, ints, nodes, n_tri, px, py, pz, -1, stack, stack_d2,
+                limit2)
+            tested += count
+        if t >= 0:
+            d, hint = -math.sqrt(d2), t
+        else:
+            d, qx, qy, qz, ux, uy, uz, t, original, count = bvh.mesh_distance(
+                floats, fo, ints, io, px, py, pz, hint, stack, stack_d2)
+            tested += count
+            hint = t
+            if d < best:
+                best, found = d, True
+                x, y, z, mx, my, mz, leaf_t, triangle = qx, qy, qz, ux, uy, uz, t, original
+        w = work + 4 * measured
+        tool_floats[w], tool_floats[w + 1], tool_floats[w + 2], tool_floats[w + 3] = (
+            px, py, pz, d)
+        measured += 1
+    return found, best, x, y, z, mx, my, mz, leaf_t, triangle, tested
+
+
+@jit
+def mesh_tool_distance(floats, fo, ints, io, tool_floats, tool_ints, tool_kind, rel, hint,
+                       size, rel_tol, abs_tol, max_iter, W, stack, stack_d2):
+    """Signed distance from a packed triangle mesh to the tool, in the mesh's frame.
+
+    ``rel`` (12,) is the tool's pose in the mesh's frame; ``hint`` a triangle (leaf order) to
+    try first; W GJK's scratch (24 used), ``stack`` and ``stack_d2`` the tree search's.
+    Returns (status, distance, lower bound, x, y, z, nx, ny, nz, iterations, triangle, leaf
+    triangle): x on the mesh, n outward from it; the tool's witness is x + distance n.
+    """
+    tool = (tool_kind, tool_floats, FLOAT_HEADER, tool_ints, INT_HEADER)
+    radius = tool_floats[0]
+    core = core_of(tool)
+    if core[0] == POINT:
+        d, x, y, z, nx, ny, nz, t, original, tested = bvh.mesh_distance(
+            floats, fo, ints, io, rel[9], rel[10], rel[11], hint, stack, stack_d2)
+        return STATUS_OK, d - radius, d - radius, x, y, z, nx, ny, nz, tested, original, t
+    lay = bvh.layout(floats, fo, ints, io)
+    n_tri, corners, face_normals, _, _, boxes, _, _, original, nodes = lay
+    box_at = int(tool_floats[7]) + 12
+    box = tool_floats[box_at:box_at + BOX_FLOATS]
+    _set_tool_box(core, rel, box)
+    contact, t, d, ax, ay, az, vx, vy, vz, status, lower, tested = _nearest_triangle(
+        floats, ints, corners, boxes, nodes, n_tri, core, rel, box, hint, size, rel_tol,
+        abs_tol, max_iter, W, stack, stack_d2)
+    if not contact and _outside(floats, ints, lay, t, ax, ay, az, vx, vy, vz):
+        nx, ny, nz = unit3(-vx, -vy, -vz)
+        return (status, d - radius, lower - radius, ax, ay, az, nx, ny, nz, tested,
+                ints[original + t], t)
+    f = face_normals + 3 * t
+    fx, fy, fz = floats[f], floats[f + 1], floats[f + 2]
+    found, depth, x, y, z, nx, ny, nz, leaf_t, triangle, more = _deepest_shell_point(
+        floats, fo, ints, io, lay, tool_floats, tool_ints, rel, fx, fy, fz, ax, ay, az, t,
+        stack, stack_d2)
+    if not found:
+        return (STATUS_OK, -radius, -radius, ax, ay, az, fx, fy, fz, tested + more,
+                ints[original + t], t)
+    return (STATUS_OK, depth - radius, depth - radius, x, y, z, nx, ny, nz, tested + more,
+            triangle, leaf_t)
