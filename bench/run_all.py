@@ -58,6 +58,7 @@ BENCHMARKS = (
               ('--rates', '1000', '4000', '--stiffness', '5000', '100000')),
     Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4')),
     Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60')),
+    Benchmark('tool', 'bench_tool.py', ('--near', '300', '--tapping', '1')),
 )
 
 

@@ -109,7 +109,7 @@ class BagRecorder(Node):
 
 
 def _matching_qos(publishers) -> QoSProfile:
-    """The recorder's QoS for a topic of these publishers: latched or reliable if they all are."""
+    """Return the QoS to record a topic with: latched, or reliable if all its publishers are."""
     qos = [p.qos_profile for p in publishers]
     if any(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in qos):
         return LATCHED_QOS
