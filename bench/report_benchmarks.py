@@ -156,9 +156,9 @@ def floor_rows(seconds: float, runs: int, domain_id: int) -> list[dict]:
 
 
 def stiff_wall_rows(duration: float, domain_id: int) -> list[dict]:
-    """One ``stiff_wall_loop.run`` per wall stiffness, rendered locally and remotely."""
-    return [stiff_wall_loop.run(k, rendering, duration=duration, domain_id=domain_id)
-            for k in STIFF_WALLS for rendering in ('local', 'remote')]
+    """``stiff_wall_loop.compare`` per wall stiffness: local and remote, and the ideal wall."""
+    return [row for k in STIFF_WALLS
+            for row in stiff_wall_loop.compare(k, duration=duration, domain_id=domain_id)]
 
 
 def colgate_bound() -> float:

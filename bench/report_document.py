@@ -142,7 +142,9 @@ def _stability_chapter(findings: Findings) -> list[str]:
               'model against its current position at its 4 kHz servo rate. Every figure is read '
               'from the bag: *contacts per tap* above 1 are rebounds (a lift over 0.1 mm); *net '
               'work* is that of `wand/applied_wrench` on the tip, above 0 energy the loop gave '
-              'the user\'s hand.', '']
+              'the user\'s hand; *deepest / continuous wall* compares the deepest penetration '
+              'with that of the same taps against the wall rendered continuously, without the '
+              'loop (the exact plane at the tip, the device\'s law at 50 kHz).', '']
     parts += ([stiff_wall_section(findings.stiff_wall), ''] if findings.stiff_wall
               else [skipped('stiff wall over the loop'), ''])
     parts += ['### The device\'s servo rate', '',
