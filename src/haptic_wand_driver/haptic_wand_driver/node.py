@@ -210,7 +210,7 @@ class WandDriverNode(Node):
         return estimate
 
     def _run(self) -> None:
-        """Start the session: once a wrench answered a probe, or at once when open loop."""
+        """Start the session: once an answer came back for a probe, or at once when open loop."""
         self._phase = Phase.RUNNING
         self._device_offset = time.monotonic() - self._probe_start
         self.get_logger().info('loop closed: experiment started')
