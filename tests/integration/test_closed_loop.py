@@ -21,6 +21,7 @@ POSES = 20  # per check of refused poses
 LOOP_RATE = 1000.0  # [Hz] the rate the loop is built for
 FLOOD_POSES = 20000
 FLOOD_FACTOR = 10.0  # a flood sends at least this many times the loop's rate
+FLOOD_DRAIN = 0.5  # [s] for the flood's samples to leave the queues and buffers
 
 
 def refused(client, position, **kwargs) -> list:
@@ -96,5 +97,11 @@ def test_a_flood_of_poses_crashes_nothing_and_the_loop_answers_after(
     assert rate >= FLOOD_FACTOR * LOOP_RATE, \
         f'not a flood: {FLOOD_POSES} poses sent at only {rate:.0f} Hz'
     assert all(child.returncode is None for child in collision_and_force.children)
-    client.wait_connected()  # the flood fills the nodes' queues: poses sent then are dropped
+    # The flood fills the nodes' queues and this client's shared-memory buffers. A press sent
+    # right after got, in about 1 run of 10, a timely answer with a damper's force (10 N once,
+    # 0 N once): the force node had no twist of that pose and estimated the velocity from the
+    # poses, across this client's jump from the flood to the press. So the press comes once the
+    # flood has drained (0 failures in 25 runs).
+    client.spin_until(lambda: False, FLOOD_DRAIN)
+    client.wait_connected()
     press(client, (0.0, 0.0, TOP - 0.003), (0.0, 0.0, K * 0.003), 'after the flood')
