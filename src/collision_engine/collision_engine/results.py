@@ -16,49 +16,37 @@ __all__ = ['QueryResult', 'BatchResult', 'ToolResult']
 _NAN = float('nan')
 
 
-class QueryResult:
-    """The nearest object to one tip position.
+class _PackedRow:
+    """The fields a point query and a tool query share, read from one packed output row.
 
-    Built from one packed output row (see ``_kernels``); the vectors are made on first access,
-    so that a haptic loop reading a few fields pays only for those.
-
-    Attributes
-    ----------
-    cross_validated : bool
-        True when this query was handed to the FCL cross-check. The check runs afterwards, on
-        its own thread: its verdict goes to ``Scene.cross_validation_stats``, not here.
-    fcl_distance, fcl_discrepancy : float, m
-        NaN: FCL's answer for this query comes after the query returns (the totals are in
-        ``CrossValidationStats``). Kept for ``CollisionState``'s fields of the same names.
+    Built from one row (see ``_kernels``); the vectors are made on first access, so that a
+    haptic loop reading a few fields pays only for those.
     """
 
-    __slots__ = ('_row', '_names', 'cross_validated', 'fcl_distance', 'fcl_discrepancy')
+    __slots__ = ('_row', '_names')
 
-    def __init__(self, row: list, names: tuple, cross_validated: bool = False,
-                 fcl_distance: float = _NAN, fcl_discrepancy: float = _NAN) -> None:
+    def __init__(self, row: list, names: tuple) -> None:
         self._row = row
         self._names = names
-        self.cross_validated = cross_validated
-        self.fcl_distance = fcl_distance
-        self.fcl_discrepancy = fcl_discrepancy
 
     @property
     def row(self) -> list:
         """Return the packed output (``_kernels.OUT_SIZE`` floats), to copy many fields at once.
 
-        distance, point (3), normal (3), object index, iterations, status, tip (3), triangle,
-        lower bound; a node writing a message takes its vectors from here without numpy.
+        distance, point (3), normal (3), object index, iterations, status, tip or tool witness
+        (3), triangle, lower bound; a node writing a message takes its vectors from here without
+        numpy.
         """
         return self._row
 
     @property
     def distance(self) -> float:
-        """Signed distance from the tip to the nearest object, m (``inf`` when none)."""
+        """Signed distance to the nearest object, m (``inf`` when none)."""
         return self._row[0]
 
     @property
     def point(self) -> np.ndarray:
-        """(3,) closest point on that object's surface, m."""
+        """(3,) closest (witness) point on that object's surface, m."""
         return np.array(self._row[1:4])
 
     @property
@@ -88,13 +76,8 @@ class QueryResult:
         return int(self._row[9])
 
     @property
-    def tip(self) -> np.ndarray:
-        """(3,) the tip position queried, m."""
-        return np.array(self._row[10:13])
-
-    @property
     def triangle(self) -> int:
-        """The nearest triangle of a mesh (-1 for other shapes)."""
+        """The mesh triangle ``point`` lies on (-1 for other shapes)."""
         return int(self._row[13])
 
     @property
@@ -106,6 +89,34 @@ class QueryResult:
     def in_collision(self) -> bool:
         """``distance <= 0``."""
         return self._row[0] <= 0.0
+
+
+class QueryResult(_PackedRow):
+    """The nearest object to one tip position (see ``_PackedRow`` for the shared fields).
+
+    Attributes
+    ----------
+    cross_validated : bool
+        True when this query was handed to the FCL cross-check. The check runs afterwards, on
+        its own thread: its verdict goes to ``Scene.cross_validation_stats``, not here.
+    fcl_distance, fcl_discrepancy : float, m
+        NaN: FCL's answer for this query comes after the query returns (the totals are in
+        ``CrossValidationStats``). Kept for ``CollisionState``'s fields of the same names.
+    """
+
+    __slots__ = ('cross_validated', 'fcl_distance', 'fcl_discrepancy')
+
+    def __init__(self, row: list, names: tuple, cross_validated: bool = False,
+                 fcl_distance: float = _NAN, fcl_discrepancy: float = _NAN) -> None:
+        super().__init__(row, names)
+        self.cross_validated = cross_validated
+        self.fcl_distance = fcl_distance
+        self.fcl_discrepancy = fcl_discrepancy
+
+    @property
+    def tip(self) -> np.ndarray:
+        """(3,) the tip position queried, m."""
+        return np.array(self._row[10:13])
 
     @property
     def penetration(self) -> np.ndarray:
@@ -170,34 +181,17 @@ class BatchResult:
         return self.distance <= 0.0
 
 
-class ToolResult:
+class ToolResult(_PackedRow):
     """The nearest object to a convex tool (``Scene.query_tool``), from one packed output row.
 
     The distance is positive apart and minus the penetration depth in overlap (against a
     non-convex mesh: the depth of the tool's deepest shell point, ``tool_mesh``); the normal is
     outward from the object, and ``tool_point - point = distance * normal``. Scene frame, m.
+    The row's tip slot holds the tool's witness; ``iterations`` counts GJK and EPA iterations
+    and the triangles the shell's point queries tested.
     """
 
-    __slots__ = ('_row', '_names')
-
-    def __init__(self, row: list, names: tuple) -> None:
-        self._row = row
-        self._names = names
-
-    @property
-    def row(self) -> list:
-        """Return the packed output: as ``QueryResult.row``, the tool's witness for the tip."""
-        return self._row
-
-    @property
-    def distance(self) -> float:
-        """Signed distance from the tool to the nearest object, m (``inf`` when none)."""
-        return self._row[0]
-
-    @property
-    def point(self) -> np.ndarray:
-        """(3,) the witness point on the object's surface, m."""
-        return np.array(self._row[1:4])
+    __slots__ = ()
 
     @property
     def tool_point(self) -> np.ndarray:
@@ -208,47 +202,6 @@ class ToolResult:
     def witness_points(self) -> np.ndarray:
         """(2, 3) ``point`` and ``tool_point``, m."""
         return np.array([self._row[1:4], self._row[10:13]])
-
-    @property
-    def normal(self) -> np.ndarray:
-        """(3,) unit normal, outward from the object at ``point``."""
-        return np.array(self._row[4:7])
-
-    @property
-    def object_index(self) -> int:
-        """Index of the nearest object in ``Scene.objects`` (-1 for none)."""
-        return int(self._row[7])
-
-    @property
-    def object(self) -> str | None:
-        """Name of the nearest object, as in the scene file (None for none)."""
-        index = int(self._row[7])
-        return self._names[index] if index >= 0 else None
-
-    @property
-    def iterations(self) -> int:
-        """GJK and EPA iterations, and triangles tested by the shell's point queries."""
-        return int(self._row[8])
-
-    @property
-    def status(self) -> int:
-        """0 OK, 1 NOT_CONVERGED (the distance is then the best bound found), 2 NO_OBJECT."""
-        return int(self._row[9])
-
-    @property
-    def triangle(self) -> int:
-        """The mesh triangle the object's witness lies on (-1 for other shapes)."""
-        return int(self._row[13])
-
-    @property
-    def lower_bound(self) -> float:
-        """Proven lower bound on the distance, m (equal to it when converged)."""
-        return self._row[14]
-
-    @property
-    def in_collision(self) -> bool:
-        """``distance <= 0``."""
-        return self._row[0] <= 0.0
 
     def __repr__(self) -> str:
         return (f'ToolResult(object={self.object!r}, distance={self.distance!r}, '
