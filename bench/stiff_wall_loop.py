@@ -34,7 +34,7 @@ from haptic_bringup.session import applied_work, read_session
 from haptic_util.paths import package_file
 from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
 from haptic_wand_driver.device import DeviceLimits
-from haptic_wand_driver.experiments import make_script
+from haptic_wand_driver.experiments import make_script, surface_projection
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
@@ -107,12 +107,8 @@ def ideal_depth(stiffness: float, *, duration: float = 6.0, rate: float = IDEAL_
     """
     wand, force = WandDriverParams(), ForceRendererParams()
     scene = load_scene(package_file(SCENE))
-
-    def project(point):
-        result = scene.query(point)
-        return result.point, result.normal
-    hand = OperatorHand(make_script('cuboid', project), stiffness=wand.hand_stiffness,
-                        damping=wand.hand_damping)
+    hand = OperatorHand(make_script('cuboid', surface_projection(scene)),
+                        stiffness=wand.hand_stiffness, damping=wand.hand_damping)
     limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
     device = SimulatedWand(SimulatedWandConfig(
         mass=[wand.device_mass] * 3, damping=[wand.device_damping] * 3, step=1.0 / rate,

@@ -10,7 +10,7 @@ from haptic_wand_driver.scripts import (cuboid_face_tapping, cylinder_side_tappi
                                         hand_dorsum_tapping, Projection, ScriptError,
                                         WaypointScript)
 
-__all__ = ['EXPERIMENTS', 'make_script', 'needs_scene']
+__all__ = ['EXPERIMENTS', 'make_script', 'needs_scene', 'surface_projection']
 
 EXPERIMENTS = {
     'cuboid': cuboid_face_tapping,
@@ -38,3 +38,12 @@ def make_script(name: str, project: Optional[Projection] = None, *, start=(0.0, 
         return WaypointScript.from_file(name)
     raise ScriptError(f'experiment {name!r} is not one of {[*EXPERIMENTS, HOLD]} '
                       'nor a waypoint file (.yaml, .yml, .csv)')
+
+
+def surface_projection(scene) -> Projection:
+    """``project(point) -> (closest surface point, outward normal)`` on a collision scene."""
+
+    def project(point):
+        result = scene.query(point)
+        return result.point, result.normal
+    return project

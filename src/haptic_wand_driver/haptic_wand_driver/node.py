@@ -25,7 +25,7 @@ from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
 from haptic_util.tally import Tally
 from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
 from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
-from haptic_wand_driver.experiments import make_script, needs_scene
+from haptic_wand_driver.experiments import make_script, needs_scene, surface_projection
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.loop_stats import LoopStats
 from haptic_wand_driver.operator import OperatorHand
@@ -129,9 +129,11 @@ class WandDriverNode(Node):
             return make_device(params.device)
         project = None
         if needs_scene(params.experiment):
-            project = _surface_projection(
+            from collision_engine import load_scene  # only the scripted experiments need it
+
+            project = surface_projection(load_scene(
                 resolve_path(params.scene_file, what='parameter scene_file'),
-                self.get_logger().info)
+                announce=self.get_logger().info))
         config = SimulatedWandConfig(
             mass=[params.device_mass] * 3, damping=[params.device_damping] * 3,
             step=1.0 / params.servo_rate,
@@ -343,18 +345,6 @@ class WandDriverNode(Node):
         off = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if not pushing]
         return {'force_on_ns': np.array(on, dtype=np.int64),
                 'force_off_ns': np.array(off, dtype=np.int64)}
-
-
-def _surface_projection(scene_path, announce):
-    """``project(point) -> (closest surface point, outward normal)`` on the scene, for scripts."""
-    from collision_engine import load_scene
-
-    scene = load_scene(scene_path, announce=announce)
-
-    def project(point):
-        result = scene.query(point)
-        return result.point, result.normal
-    return project
 
 
 def main(args=None) -> int:
