@@ -6,15 +6,23 @@ is silent), on this site's measurements alone. Per scheme:
 
 - ``direct`` and ``model``: the target is the operator's position;
 - ``tdpa``: the target moves at the operator's velocity through the robot's passivity
-  controller, which yields along the patient's force when the link would otherwise deliver more
+  controller, which yields along the port's force when the link would otherwise deliver more
   energy than the operator put in, and drifts back toward the operator's position with the
-  energy it can spare (``remote_probe.tdpa``).
+  energy it can spare (``remote_probe.tdpa``). The port's force is the one conjugate to the
+  commanded motion: the reaction of the robot's impedance spring, K·(x − x_target), which the
+  robot's controller knows exactly. It is what the patient pushes with once the probe is at
+  rest, but in motion the arm's mass and damping lie between the two, and energy booked with
+  the sensor's force instead let the link give energy (30 mJ over the scan at 50 ms, in
+  lockstep). So ``tdpa`` feeds that force back; ``direct`` and ``model`` the sensor's.
 
 For ``model``, the contact is learnt online from the sensor and the TCP's motion
 (``ContactModelEstimator``) and sent as a plane whose gains are those the command meets: the
 tissue in series with the robot's own impedance spring (a target δ deeper presses the patient
-by k·K/(k + K)·δ, not k·δ). The latest plane is kept while out of contact: the patient is still
-there.
+by k·K/(k + K)·δ, not k·δ). Out of contact, and before any, the plane is the patient's surface
+under the probe as the site sees it (``surface``: a depth camera's, here the phantom's mesh),
+with the gains last learnt (the estimator's prior before any contact): without it the first
+model would reach the operator a round trip after the touch, with the wand already that far
+in (18 mm at 100 ms in the scripted scan), and the hand would first feel the patient there.
 
 A sensor reading with NaN is not used: the feedback carries zero force and no plane until a good
 reading comes, and the safety goes on with the last good force. An older or repeated command is
@@ -22,6 +30,7 @@ ignored by its stamp.
 """
 from dataclasses import dataclass
 import math
+from typing import Callable
 
 import numpy as np
 
@@ -68,10 +77,14 @@ class Follower:
     safety : PatientSafety
     estimator : ContactModelEstimator or None
         Needed for ``model``; ignored otherwise.
+    surface : callable or None
+        ``surface(position) -> (point, outward normal)``: the patient's skin nearest a point,
+        for the model out of contact; None: only what contact has taught.
     """
 
     def __init__(self, config: FollowerConfig, safety: PatientSafety,
-                 estimator: ContactModelEstimator | None = None) -> None:
+                 estimator: ContactModelEstimator | None = None, *,
+                 surface: Callable | None = None) -> None:
         if config.scheme == 'model' and estimator is None:
             raise ValueError('the model scheme needs a contact estimator')
         self.config = config
@@ -85,6 +98,10 @@ class Follower:
         self._force_good = True
         self._tcp = np.zeros(3)
         self._plane: RemotePlane | None = None
+        self._surface = surface
+        if self.estimator is not None:
+            prior = self.estimator.config
+            self._gains = self._as_commanded(prior.initial_stiffness, prior.initial_damping)
 
     def receive(self, now: float, command: Command) -> bool:
         """Take ``command`` arrived at ``now`` (s); False if it is not newer than the held one."""
@@ -119,18 +136,28 @@ class Follower:
             return self._target
         if self.config.scheme != 'tdpa':
             return command.position
-        velocity = self.passivity.control(command.velocity, self._force, dt,
+        velocity = self.passivity.control(command.velocity, self._port_force(), dt,
                                           command.position - self._target)
         return self._target + velocity * dt
 
+    def _port_force(self) -> np.ndarray:
+        """The impedance spring's reaction to the commanded target, N (``tdpa``'s port)."""
+        return self.config.robot_stiffness * (self._tcp - self._target)
+
     def _learn(self, now: float, tcp_velocity) -> None:
         estimate = self.estimator.update(now, self._force, self._tcp, tcp_velocity)
-        if estimate is None or estimate.stiffness <= 0.0:
-            return
+        if estimate is not None and estimate.stiffness > 0.0:
+            self._gains = self._as_commanded(estimate.stiffness, estimate.damping)
+            self._plane = RemotePlane(estimate.point, estimate.normal, *self._gains)
+        elif self._surface is not None:
+            point, normal = self._surface(self._tcp)
+            self._plane = RemotePlane(np.asarray(point), np.asarray(normal), *self._gains)
+
+    def _as_commanded(self, stiffness: float, damping: float) -> tuple[float, float]:
+        """The tissue's gains as the command meets them, in series with the robot's spring."""
         robot = self.config.robot_stiffness
-        share = robot / (estimate.stiffness + robot)  # of a target step the tissue takes
-        self._plane = RemotePlane(estimate.point, estimate.normal, estimate.stiffness * share,
-                                  estimate.damping * share * share)
+        share = robot / (stiffness + robot)  # of a target step the tissue takes
+        return stiffness * share, damping * share * share
 
     def feedback(self, now: float) -> Feedback:
         """Return the feedback to send at ``now`` (s)."""
@@ -138,5 +165,6 @@ class Follower:
         echo, hold = (0.0, 0.0) if command is None else (command.stamp,
                                                          now - self._command_heard)
         good = self._force_good
-        return Feedback(now, echo, hold, self._force if good else np.zeros(3), self._tcp,
+        force = self._port_force() if self.config.scheme == 'tdpa' else self._force
+        return Feedback(now, echo, hold, force if good else np.zeros(3), self._tcp,
                         self.passivity.books.energy_in, self._plane if good else None)

@@ -4,7 +4,9 @@ Takes the operator's commands (through the link), the robot's TCP pose and its F
 at ``rate`` commands the robot a target that the patient's safety allows (``Follower``). Sends
 ``teleop/feedback`` back over the link at ``feedback_rate``: the measured force, the energy books
 and the estimated contact plane. A TCP pose or wrench older than ``sensor_timeout`` feeds back no
-force; a command older or repeated is ignored by its stamp.
+force; a command older or repeated is ignored by its stamp. ``scene_file`` is the patient's
+surface as this site sees it (a depth camera's, here the phantom's mesh), for the model out of
+contact.
 """
 import math
 
@@ -12,13 +14,16 @@ from geometry_msgs.msg import PoseStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
 
+from collision_engine import load_scene
 from haptic_msgs.msg import TeleopCommand, TeleopFeedback
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
+from haptic_util.paths import resolve_path
 from haptic_util.qos import HAPTIC_STREAM_QOS
 from haptic_util.tally import Tally
+from haptic_wand_driver.experiments import surface_projection
 from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import FollowerParams
@@ -47,9 +52,14 @@ class FollowerNode(Node):
                 max_patient_force=params.max_patient_force, force_margin=params.force_margin,
                 link_timeout=params.link_timeout, release_force=params.release_force,
                 retract_speed=params.retract_speed))
+            surface = None
+            if params.scene_file:
+                surface = surface_projection(load_scene(
+                    resolve_path(params.scene_file, what='parameter scene_file'),
+                    announce=self.get_logger().info))
             self.follower = Follower(
                 FollowerConfig(params.scheme, params.robot_stiffness, params.drift_rate),
-                safety, ContactModelEstimator())
+                safety, ContactModelEstimator(), surface=surface)
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self._period = 1.0 / params.rate

@@ -8,7 +8,18 @@ every wand pose at once from the newest feedback it holds, never waiting on the 
 - ``tdpa``: the same force through the operator's passivity controller, which books the energy
   at this port against what the robot's port has sent into the link (``remote_probe.tdpa``);
 - ``model``: the remote site's estimated plane, mapped into the wand's workspace with the
-  scaled gains, for the device to render at its own servo rate.
+  scaled gains, for the device to render at its own servo rate. Model updates are kept
+  passive: an update that would store more energy in the wand's spring (the wand deeper in a
+  stiffer one) is paid from a reserve, which holds what earlier updates took out (an estimate
+  that moved out, a softer one); what the reserve cannot pay, the plane is shown moved out
+  along its normal instead, and the robot's target with it. The first contact is where that
+  matters: the estimate arrives a round trip after the robot touched, with the wand already
+  that far in, and shown as it is it would throw the hand out (in lockstep at 250 ms: 45 mJ
+  given, 18 N on the patient). Moving the robot's target out by the same shift keeps the
+  patient pressed as the hand feels it; the shift is a position offset between the wand and
+  the probe, the price of passivity (as TDPA's drift is), paid back as soon as the reserve
+  allows. A reserve rather than a ratchet: refusing every rise while keeping every fall, the
+  estimate's noise alone drove the shift out to tens of millimetres.
 
 Feedback older than ``link_timeout`` (on this site's clock: the sites share none) gives zero
 force and no model; an older or repeated feedback is ignored by its stamp. The link's round trip
@@ -73,6 +84,9 @@ class Leader:
         self.round_trip = RoundTripEstimator()
         self._feedback: Feedback | None = None
         self._heard = -math.inf  # this site's clock when the newest feedback came
+        self._shown: RemotePlane | None = None  # the plane last shown, shift included
+        self._shift = np.zeros(3)  # [m] wand frame: how far it is shown out from the estimate
+        self._reserve = 0.0  # [J] energy model updates took out of the wand's spring, net
 
     def receive(self, now: float, feedback: Feedback) -> bool:
         """Take ``feedback`` arrived at ``now`` (s); False if it is not newer than the held one."""
@@ -91,7 +105,8 @@ class Leader:
 
     def command(self, stamp: float, wand, wand_velocity) -> Command:
         """Return the command for the wand's pose stamped ``stamp`` (s, this site's clock)."""
-        return Command(stamp, self.map.to_robot(wand), self.map.velocity_to_robot(wand_velocity),
+        target = self.map.to_robot(wand) + self.map.position_scale * self._shift
+        return Command(stamp, target, self.map.velocity_to_robot(wand_velocity),
                        self.passivity.books.energy_in)
 
     def force(self, now: float, wand_velocity, dt: float) -> np.ndarray:
@@ -107,14 +122,35 @@ class Leader:
                                              dt)
         return self.config.force_scale * patient
 
-    def plane(self, now: float) -> RemotePlane | None:
-        """Return the contact plane in the wand's frame, felt gains (``model``); None: free.
+    def plane(self, now: float, wand) -> RemotePlane | None:
+        """Return the contact plane to show the wand at ``wand`` (3,) m (``model``); None: free.
 
+        In the wand's frame, with the felt gains, moved out as far as a passive update needs.
         None too while the link is silent or the clutch is engaged.
         """
         if not self.live(now) or self.map.clutched or self._feedback.plane is None:
+            self._shown, self._shift, self._reserve = None, np.zeros(3), 0.0
             return None
         remote = self._feedback.plane
-        return RemotePlane(self.map.to_wand(remote.point), remote.normal,
-                           self.map.felt_gain(remote.stiffness),
-                           self.map.felt_gain(remote.damping))
+        stiffness = self.map.felt_gain(remote.stiffness)
+        point = self.map.to_wand(remote.point)
+        held = 0.0 if self._shown is None else _stored(self._shown, wand)
+        affordable = held + self._reserve  # [J] the most the new spring may hold
+        depth = _depth(point, remote.normal, wand)
+        allowed = (math.sqrt(2.0 * max(affordable, 0.0) / stiffness) if stiffness > 0.0
+                   else math.inf)
+        self._shift = max(depth - allowed, 0.0) * remote.normal
+        self._shown = RemotePlane(point - self._shift, remote.normal, stiffness,
+                                  self.map.felt_gain(remote.damping))
+        self._reserve = affordable - _stored(self._shown, wand)
+        return self._shown
+
+
+def _stored(plane: RemotePlane, wand) -> float:
+    """Energy (J) in ``plane``'s spring with the wand at ``wand``."""
+    return 0.5 * plane.stiffness * max(_depth(plane.point, plane.normal, wand), 0.0) ** 2
+
+
+def _depth(point, normal, wand) -> float:
+    """How far (m) ``wand`` lies behind the plane through ``point`` with outward ``normal``."""
+    return float(np.dot(np.asarray(point) - wand, normal))

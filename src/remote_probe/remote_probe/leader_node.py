@@ -127,7 +127,7 @@ class LeaderNode(Node):
             *command.position.tolist(), *command.velocity.tolist(), command.energy_in)))
         now = self._now()
         if self.params.scheme == 'model':
-            self._answer(stamp_ns, self.leader.plane(now), position)
+            self._answer(stamp_ns, self.leader.plane(now, position), position)
         else:
             self._answer(stamp_ns, self.leader.force(now, velocity, max(period, 1e-6)))
 

@@ -45,6 +45,9 @@ class FollowerParams:
                                      'tdpa (a force), 100 Hz for model (a plane)', unit='Hz',
                                      low=0.0, high=10000.0)
     frame_id: str = parameter('base_link', 'the robot\'s base frame')
+    scene_file: str = parameter('package://collision_engine/scenes/phantom.yaml',
+                                'the patient\'s surface as this site sees it, for the model out '
+                                'of contact; empty: only what contact teaches')
     robot_stiffness: float = parameter(1500.0, 'the robot\'s impedance stiffness', unit='N/m',
                                        low=1.0)
     max_patient_force: float = parameter(20.0, 'the force the patient may feel at most',
