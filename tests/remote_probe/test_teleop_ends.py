@@ -82,15 +82,48 @@ def test_tdpa_never_displays_more_energy_than_the_robot_put_in():
 def test_the_model_is_the_remote_plane_in_the_wands_frame_with_felt_gains():
     leader = Leader(LeaderConfig('model', force_scale=0.3, position_scale=0.5),
                     wand_start=[0.1, 0.0, 0.0], robot_start=[0.0, 0.0, 0.0])
-    assert leader.plane(0.0) is None
+    above = np.array([0.1, 0.0, 0.0])
+    assert leader.plane(0.0, above) is None
     plane = RemotePlane(np.array([0.0, 0.0, -0.02]), UP, 500.0, 4.0)
     leader.receive(0.0, feedback(1.0, plane=plane))
-    local = leader.plane(0.01)
+    local = leader.plane(0.01, above)
     np.testing.assert_allclose(local.point, [0.1, 0.0, -0.04])
     np.testing.assert_array_equal(local.normal, UP)
     assert (local.stiffness, local.damping) == pytest.approx((0.3 * 0.5 * 500.0,
                                                               0.3 * 0.5 * 4.0))
-    assert leader.plane(0.2) is None  # the link fell silent: nothing to render
+    assert leader.plane(0.2, above) is None  # the link fell silent: nothing to render
+
+
+def stored(plane, wand):
+    return 0.5 * plane.stiffness * max(float((plane.point - wand) @ plane.normal), 0.0) ** 2
+
+
+def test_a_model_that_arrives_with_the_wand_inside_is_shown_moved_out_and_so_is_the_robot():
+    leader = Leader(LeaderConfig('model', force_scale=1.0, position_scale=0.5), np.zeros(3),
+                    np.zeros(3))
+    wand = np.array([0.0, 0.0, -0.03])  # 30 mm below the start: 15 mm at the robot
+    surface = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)  # 10 mm at the robot
+    leader.receive(0.0, feedback(1.0, plane=surface))
+    shown = leader.plane(0.001, wand)
+    assert stored(shown, wand) == pytest.approx(0.0, abs=1e-15)  # no energy out of nowhere
+    assert shown.point[2] == pytest.approx(-0.03)
+    np.testing.assert_allclose(leader.command(2.0, wand, np.zeros(3)).position,
+                               [0.0, 0.0, -0.015 + 0.5 * 0.01])
+
+
+def test_energy_an_update_takes_out_pays_for_a_later_one_and_never_more():
+    leader = Leader(LeaderConfig('model', force_scale=1.0), np.zeros(3), np.zeros(3))
+    wand = np.array([0.0, 0.0, -0.02])
+    plane_at = lambda z: RemotePlane(np.array([0.0, 0.0, z]), UP, 400.0, 0.0)  # noqa: E731
+    leader.receive(0.0, feedback(1.0, plane=plane_at(0.0)))
+    leader.plane(0.001, np.zeros(3))  # shown before the wand went in
+    assert stored(leader.plane(0.002, wand), wand) == pytest.approx(0.5 * 400.0 * 0.02 ** 2)
+    leader.receive(0.003, feedback(1.1, plane=plane_at(-0.01)))  # the estimate moves in
+    assert stored(leader.plane(0.004, wand), wand) == pytest.approx(0.5 * 400.0 * 0.01 ** 2)
+    leader.receive(0.005, feedback(1.2, plane=plane_at(0.005)))  # and out past where it was
+    back = leader.plane(0.006, wand)
+    assert stored(back, wand) == pytest.approx(0.5 * 400.0 * 0.02 ** 2)  # what it took out
+    assert back.point[2] == pytest.approx(0.0)  # shown 5 mm in from the estimate
 
 
 def test_the_follower_holds_until_the_first_command_then_follows_within_the_force_bound():
