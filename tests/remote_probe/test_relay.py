@@ -73,3 +73,9 @@ def test_lateness_is_summarized_over_the_latest_releases_only():
         relay.send(2.0 + index, 0, b'on time')
         relay.release(2.0 + index)
     assert relay.lateness() == (0.0, 0.0)
+
+
+def test_blank_entries_say_nothing_crosses():
+    assert parse_routes([''], 'to_operator') == ()
+    assert parse_routes([' ', 'a:std_msgs/msg/Empty'], 'to_operator') == (
+        Route('a', 'std_msgs/msg/Empty'),)
