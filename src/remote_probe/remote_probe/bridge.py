@@ -4,11 +4,12 @@ Why: the two sites of telerobotic ultrasound run on this machine in two DDS doma
 nothing crosses between them except through this process, which holds each message for the
 emulated link's delay, jitter and loss (``remote_probe.link``; the kernel here has no netem).
 
-How, with the Jazzy wheels (measured, ``bench/bench_bridge.py``):
+How, with the Jazzy wheels (cost in ``bench/bench_bridge.py``):
 - one rclpy ``Context`` per domain, a node in each, and both nodes on one EventsExecutor in one
-  thread. An EventsExecutor serves nodes of several contexts; two executors in two threads held
-  1 kHz too, but their release lateness p99 was 2-5 ms against 0.5-1 ms in one thread (the GIL
-  passed back and forth), and one thread needs no locks;
+  thread. An EventsExecutor serves nodes of several contexts. Two executors spun in two threads
+  held 1 kHz each way too, at the same CPU, but in a trial beside this design their release
+  lateness p99 was 2-5 ms against 0.5-1 ms in one thread (the GIL passed back and forth); and
+  one thread needs no locks;
 - messages cross as serialized CDR bytes (``raw=True`` in, ``publish(bytes)`` out), never
   converted: the bridge knows the types only by name, and forwarding bytes costs about half as
   much CPU as message objects (``../shared/loop-latency.md``);
