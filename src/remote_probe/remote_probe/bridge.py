@@ -118,7 +118,6 @@ class _Plan:
                     first = str(error).splitlines()[0]
                     raise StartupError(f'{NODE_NAME}: {direction}: topic {route.topic!r}: '
                                        f'{first}') from None
-        self.params = params
         self.links = {'to_remote': EmulatedLink(config, trace=trace),
                       'to_operator': EmulatedLink(replace(config, seed=params.seed + 1),
                                                   trace=trace)}
