@@ -4,11 +4,12 @@ Why: the two sites of telerobotic ultrasound run on this machine in two DDS doma
 nothing crosses between them except through this process, which holds each message for the
 emulated link's delay, jitter and loss (``remote_probe.link``; the kernel here has no netem).
 
-How, with the Jazzy wheels (measured, ``bench/bench_bridge.py``):
+How, with the Jazzy wheels (cost in ``bench/bench_bridge.py``):
 - one rclpy ``Context`` per domain, a node in each, and both nodes on one EventsExecutor in one
-  thread. An EventsExecutor serves nodes of several contexts; two executors in two threads held
-  1 kHz too, but their release lateness p99 was 2-5 ms against 0.5-1 ms in one thread (the GIL
-  passed back and forth), and one thread needs no locks;
+  thread. An EventsExecutor serves nodes of several contexts. Two executors spun in two threads
+  held 1 kHz each way too, at the same CPU, but in a trial beside this design their release
+  lateness p99 was 2-5 ms against 0.5-1 ms in one thread (the GIL passed back and forth); and
+  one thread needs no locks;
 - messages cross as serialized CDR bytes (``raw=True`` in, ``publish(bytes)`` out), never
   converted: the bridge knows the types only by name, and forwarding bytes costs about half as
   much CPU as message objects (``../shared/loop-latency.md``);
@@ -68,11 +69,13 @@ class LinkBridgeParams:
                                    low=0, high=232)
     to_remote: tuple[str, ...] = parameter(
         ('robot/target_pose:geometry_msgs/msg/PoseStamped',),
-        "topics relayed from the operator's domain to the remote one, 'topic:pkg/msg/Type'")
+        "topics relayed from the operator's domain to the remote one, 'topic:pkg/msg/Type'; "
+        "[''] for none (rclpy cannot declare an empty list of strings)")
     to_operator: tuple[str, ...] = parameter(
         ('robot/tcp_pose:geometry_msgs/msg/PoseStamped',
          'robot/ft_sensor/wrench:geometry_msgs/msg/WrenchStamped'),
-        "topics relayed from the remote domain to the operator's, 'topic:pkg/msg/Type'")
+        "topics relayed from the remote domain to the operator's, 'topic:pkg/msg/Type'; "
+        "[''] for none")
     delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
                              high=10.0)
     jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
@@ -100,9 +103,12 @@ class _Plan:
             check_no_loop(self.to_remote, self.to_operator)
             config = LinkConfig(params.delay, params.jitter, params.loss, params.reorder,
                                 params.seed)
+        except ValueError as error:
+            raise StartupError(f'{NODE_NAME}: {error}') from None
+        try:
             trace = DelayTrace.from_csv(params.delay_trace) if params.delay_trace else None
         except (ValueError, OSError) as error:
-            raise StartupError(f'{NODE_NAME}: {error}') from None
+            raise StartupError(f'{NODE_NAME}: parameter delay_trace: {error}') from None
         for direction, routes in (('to_remote', self.to_remote),
                                   ('to_operator', self.to_operator)):
             for route in routes:
@@ -112,7 +118,6 @@ class _Plan:
                     first = str(error).splitlines()[0]
                     raise StartupError(f'{NODE_NAME}: {direction}: topic {route.topic!r}: '
                                        f'{first}') from None
-        self.params = params
         self.links = {'to_remote': EmulatedLink(config, trace=trace),
                       'to_operator': EmulatedLink(replace(config, seed=params.seed + 1),
                                                   trace=trace)}

@@ -56,11 +56,14 @@ def message_class(type_name: str) -> type:
 def parse_routes(entries: Iterable[str], direction: str) -> tuple:
     """Return the ``Route`` of each ``'topic:pkg/msg/Type'`` entry of one direction.
 
-    Raises ValueError naming the direction and the entry: a missing type, an unknown type, or
-    a topic listed twice.
+    Blank entries are skipped: ``['']`` says that nothing crosses this way, since a ROS
+    parameter cannot be declared as an empty list of strings. Raises ValueError naming the
+    direction and the entry: a missing type, an unknown type, or a topic listed twice.
     """
     routes, topics = [], set()
     for entry in entries:
+        if not entry.strip():
+            continue
         topic, separator, type_name = entry.rpartition(':')
         topic, type_name = topic.strip(), type_name.strip()
         if not separator or not topic or not type_name:
