@@ -43,7 +43,7 @@ ZERO = np.zeros(3)
 
 
 def _device(scheme: str, duration: float):
-    """The driver's simulated wand and hand, rendering as the launcher sets it for ``scheme``."""
+    """Build the driver's simulated wand and hand, rendering as the launcher sets ``scheme``."""
     wand = WandDriverParams()
     limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
     hand = OperatorHand(WaypointScript.from_file(package_file(SCAN)),

@@ -65,7 +65,7 @@ def _on_grid(times: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndar
 
 
 def _best_lag(a: np.ndarray, b: np.ndarray, longest: float, mask: np.ndarray):
-    """The RMS of |a(t) − b(t + lag)| over ``mask``, least over lags within ±``longest``."""
+    """Return the least RMS of |a(t) − b(t + lag)| over ``mask``, for lags within ±``longest``."""
     best = (np.inf, 0.0)
     for shift in range(-round(longest / GRID), round(longest / GRID) + 1):
         shifted = np.roll(b, -shift, axis=0)
@@ -80,7 +80,7 @@ def _best_lag(a: np.ndarray, b: np.ndarray, longest: float, mask: np.ndarray):
 
 
 def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
-    """The scan's figures (see the module's docstring) from ``read_scan``'s series."""
+    """Compute what the module's docstring lists from the series ``read_scan`` returns."""
     pose_t, pose = scan['/wand/pose']
     felt_t, felt = scan['/wand/applied_wrench']
     patient_t, patient = scan['/remote/robot/ft_sensor/wrench']

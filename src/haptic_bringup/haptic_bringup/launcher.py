@@ -168,7 +168,7 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
 
 
 def bridge_parameters(config: LoopConfig) -> dict:
-    """The link bridge's parameters: the two domains, what crosses, and the link."""
+    """Return the link bridge's parameters: the two domains, what crosses, and the link."""
     return {'/**': {'ros__parameters': {
         'operator_domain': config.domain_id, 'remote_domain': config.remote_domain_id,
         'to_remote': list(TO_REMOTE), 'to_operator': list(TO_OPERATOR), **config.link}}}
@@ -371,7 +371,7 @@ def parse_args(argv=None) -> argparse.Namespace:
 
 
 def link_parameters(args: argparse.Namespace) -> dict:
-    """The bridge's link parameters from the command line."""
+    """Return the bridge's link parameters from the command line."""
     link = {'delay': args.delay, 'jitter': args.jitter, 'loss': args.loss}
     if args.delay_trace:
         link['delay_trace'] = str(pathlib.Path(args.delay_trace).resolve())

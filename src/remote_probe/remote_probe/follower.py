@@ -113,7 +113,7 @@ class Follower:
         return True
 
     def target(self, now: float, tcp, tcp_velocity, force, dt: float) -> np.ndarray:
-        """Return the robot's target (3,) m for the next ``dt`` s, from its state now.
+        """Return the robot's target position (3,) m for the next ``dt`` s, from its state now.
 
         ``tcp``, ``tcp_velocity`` (3,) are the TCP's; ``force`` (3,) N the sensor's reading.
         """
@@ -141,7 +141,7 @@ class Follower:
         return self._target + velocity * dt
 
     def _port_force(self) -> np.ndarray:
-        """The impedance spring's reaction to the commanded target, N (``tdpa``'s port)."""
+        """Return the impedance spring's reaction to the commanded target, N (``tdpa``'s port)."""
         return self.config.robot_stiffness * (self._tcp - self._target)
 
     def _learn(self, now: float, tcp_velocity) -> None:
@@ -154,7 +154,7 @@ class Follower:
             self._plane = RemotePlane(np.asarray(point), np.asarray(normal), *self._gains)
 
     def _as_commanded(self, stiffness: float, damping: float) -> tuple[float, float]:
-        """The tissue's gains as the command meets them, in series with the robot's spring."""
+        """Return the tissue's gains as a command meets them: in series with the robot's."""
         robot = self.config.robot_stiffness
         share = robot / (stiffness + robot)  # of a target step the tissue takes
         return stiffness * share, damping * share * share

@@ -110,7 +110,7 @@ class Leader:
                        self.passivity.books.energy_in)
 
     def force(self, now: float, wand_velocity, dt: float) -> np.ndarray:
-        """Return the force (3,) N on the wand for the next ``dt`` s (``direct`` and ``tdpa``).
+        """Return what the wand should push with, (3,) N, over the next ``dt`` s (not ``model``).
 
         Zero while the link is silent or the clutch is engaged.
         """

@@ -67,7 +67,7 @@ class SimulatedRobotNode(Node):
         self.diagnostics = Diagnostics(self, self.report, 1.0)
 
     def _now(self) -> float:
-        """The robot's own clock (s): monotonic, so a step of the system clock moves nothing."""
+        """Return the robot's clock (s): monotonic, so a step of the system clock moves nothing."""
         return time.monotonic() - self._start
 
     def on_target(self, data: bytes) -> None:
