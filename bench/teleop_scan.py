@@ -27,11 +27,11 @@ import tempfile
 
 import machine
 import numpy as np
-from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
+from haptic_bringup.session import read_vectors
 
 __all__ = ['figures', 'read_scan', 'run', 'main']
 
@@ -47,17 +47,7 @@ TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
 
 def read_scan(path: pathlib.Path) -> dict:
     """Topic → (receive times s, (n, 3) vectors) for the four streams the figures need."""
-    series = {topic: ([], []) for topic in TOPICS}
-    with AnyReader([pathlib.Path(path)],
-                   default_typestore=typestore_with(custom_definitions())) as reader:
-        connections = [c for c in reader.connections if c.topic in TOPICS]
-        for connection, stamp, raw in reader.messages(connections=connections):
-            msg = reader.deserialize(raw, connection.msgtype)
-            vector = (msg.pose.position if TOPICS[connection.topic] == 'pose'
-                      else msg.wrench.force)
-            series[connection.topic][0].append(stamp * 1e-9)
-            series[connection.topic][1].append((vector.x, vector.y, vector.z))
-    return {topic: (np.array(t), np.array(v)) for topic, (t, v) in series.items()}
+    return read_vectors(path, typestore_with(custom_definitions()), TOPICS)
 
 
 def _on_grid(times: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:

@@ -81,11 +81,12 @@ class LoopConfig:
     python: str = sys.executable
     teleop: Optional[str] = None  # a bilateral scheme: a telerobotic session instead
     link: dict = dataclasses.field(default_factory=dict)  # delay, jitter, loss, ... (s)
+    remote_domain: Optional[int] = None  # the remote site's DDS domain; None: the next one
 
     @property
     def remote_domain_id(self) -> int:
-        """The remote site's DDS domain: the next one."""
-        return self.domain_id + 1
+        """Return the remote site's DDS domain."""
+        return self.domain_id + 1 if self.remote_domain is None else self.remote_domain
 
 
 def add_venv_prefix() -> None:
@@ -360,6 +361,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='teleop: standard deviation of the delay [s]')
     parser.add_argument('--loss', type=float, default=0.0,
                         help='teleop: probability that a message is lost')
+    parser.add_argument('--remote-domain-id', type=int,
+                        help='teleop: the remote site\'s DDS domain (default: the next one)')
     parser.add_argument('--delay-trace', metavar='CSV',
                         help='teleop: replay one-way delays from a CSV (time,delay in s)')
     parser.add_argument('--domain-id', type=int,
@@ -383,7 +386,8 @@ def main(argv=None) -> int:
     config = LoopConfig(composed=args.composed, scene=args.scene, experiment=args.experiment,
                         duration=args.duration, record=args.record, domain_id=args.domain_id,
                         params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
-                        teleop=args.teleop, link=link_parameters(args))
+                        teleop=args.teleop, link=link_parameters(args),
+                        remote_domain=args.remote_domain_id)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     loop = Loop(config)
     stop = []
