@@ -13,7 +13,9 @@ import argparse
 import math
 import sys
 
+import machine
 import numpy as np
+import teleop_scan
 
 from haptic_util.paths import package_file
 from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
@@ -33,7 +35,7 @@ from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
-__all__ = ['scan']
+__all__ = ['as_series', 'scan']
 
 SCAN = 'package://remote_probe/config/scan.yaml'
 SKIN = -0.025  # [m] the phantom's front, under the probe's start
@@ -111,26 +113,30 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
             'patient': table[:, 7:10], 'tcp': table[:, 10:13]}
 
 
-def net_work(run: dict) -> float:
-    """Work (J) of the force the device applied on the hand over the run (> 0: it gave)."""
-    return float(np.sum(np.einsum('ij,ij->i', run['felt'][1:], np.diff(run['wand'], axis=0))))
+def as_series(run: dict) -> dict:
+    """Return the run as ``teleop_scan.read_scan`` gives a bag: topic → (times, vectors)."""
+    return {'/wand/pose': (run['time'], run['wand']),
+            '/wand/applied_wrench': (run['time'], run['felt']),
+            '/remote/robot/ft_sensor/wrench': (run['time'], run['patient']),
+            '/remote/robot/tcp_pose': (run['time'], run['tcp'])}
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--schemes', nargs='+', default=['direct', 'tdpa', 'model'])
-    parser.add_argument('--delays', nargs='+', type=float, default=[0.0, 0.025, 0.05, 0.1, 0.25])
+    parser.add_argument('--schemes', nargs='+', default=['direct', 'tdpa', 'model'],
+                        choices=['direct', 'tdpa', 'model'])
+    parser.add_argument('--delays', nargs='+', type=float,
+                        default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
+    parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
+    parser.add_argument('--loss', type=float, default=0.01)
     args = parser.parse_args(argv)
+    print(f'machine: {machine.line("numpy")} (no ROS: one clock, lockstep)')
+    teleop_scan.print_header()
     for delay in args.delays:
         for scheme in args.schemes:
-            run = scan(scheme, delay)
-            contact = np.linalg.norm(run['patient'], axis=1) > 1.0
-            felt = np.linalg.norm(run['felt'], axis=1)[contact] / 0.3
-            patient = np.linalg.norm(run['patient'], axis=1)[contact]
-            print(f'{scheme:>6} {1e3 * delay:5.0f} ms  work {1e3 * net_work(run):9.2f} mJ  '
-                  f'peak {np.max(np.linalg.norm(run["patient"], axis=1)):6.2f} N  '
-                  f'mean felt/0.3 {np.mean(felt):5.2f} patient {np.mean(patient):5.2f} N',
-                  flush=True)
+            run = scan(scheme, delay, jitter=args.jitter * delay, loss=args.loss)
+            teleop_scan.print_row({'scheme': scheme,
+                                   **teleop_scan.figures(as_series(run), delay)})
     return 0
 
 

@@ -22,6 +22,7 @@ The jitter is given as a fraction of the delay (10 %, as the issue asks).
 import argparse
 import os
 import pathlib
+import shutil
 import sys
 import tempfile
 
@@ -87,12 +88,15 @@ def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
     oscillation = (100.0 * float(np.sqrt(np.mean(wobble[contact] ** 2))) / felt_mean
                    if felt_mean > 0.0 else 0.0)
     longest = 2.0 * delay + LAG_MARGIN
-    error, lag = _best_lag(felt_grid / force_scale, patient_grid, longest, contact)
     tracking, _ = _best_lag(wand, tcp_grid, longest, np.ones_like(contact))
-    mean_patient = float(np.mean(np.linalg.norm(patient_grid[contact], axis=1)))
+    error, lag, mean_patient = np.nan, np.nan, 0.0  # no contact, nothing to compare
+    if contact.any():
+        error, lag = _best_lag(felt_grid / force_scale, patient_grid, longest, contact)
+        mean_patient = float(np.mean(np.linalg.norm(patient_grid[contact], axis=1)))
     return {'delay': delay, 'net_work_j': work, 'oscillation_percent': oscillation,
             'stable': work <= 0.0 and oscillation <= STABLE_OSCILLATION,
-            'transparency_n': error, 'transparency_percent': 100.0 * error / mean_patient,
+            'transparency_n': error,
+            'transparency_percent': 100.0 * error / mean_patient if mean_patient else np.nan,
             'lag_s': lag, 'mean_patient_n': mean_patient,
             'peak_patient_n': float(np.max(np.linalg.norm(patient, axis=1))),
             'tracking_m': tracking, 'contact_s': float(contact.sum() * GRID)}
@@ -103,6 +107,7 @@ def run(scheme: str, delay: float, *, jitter: float = 0.1, loss: float = 0.01,
     """One scan with ``scheme`` over a link of one-way ``delay`` s; its figures."""
     with tempfile.TemporaryDirectory() as tmp:
         folder = keep or pathlib.Path(tmp)
+        shutil.rmtree(folder / 'bag', ignore_errors=True)  # an earlier run's
         config = LoopConfig(record=str(folder / 'bag'), domain_id=domain_id,
                             run_dir=folder / 'launch', teleop=scheme,
                             link={'delay': delay, 'jitter': jitter * delay, 'loss': loss})
@@ -110,6 +115,11 @@ def run(scheme: str, delay: float, *, jitter: float = 0.1, loss: float = 0.01,
             if loop.wait(60.0) is None:
                 raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
         return {'scheme': scheme, **figures(read_scan(folder / 'bag'), delay)}
+
+
+def print_header() -> None:
+    print(f'{"scheme":>6} {"ms":>6} {"stable":>6} {"work mJ":>9} {"osc %":>6} '
+          f'{"err N":>7} {"err %":>6} {"peak N":>7} {"track mm":>8}')
 
 
 def print_row(r: dict) -> None:
@@ -132,8 +142,7 @@ def main(argv=None) -> int:
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
-    print(f'{"scheme":>6} {"ms":>6} {"stable":>6} {"work mJ":>9} {"osc %":>6} '
-          f'{"err N":>7} {"err %":>6} {"peak N":>7} {"track mm":>8}')
+    print_header()
     for delay in args.delays:
         for scheme in args.schemes:
             print_row(run(scheme, delay, jitter=args.jitter, loss=args.loss,

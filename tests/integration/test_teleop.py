@@ -16,7 +16,7 @@ from rosbags.highlevel import AnyReader
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import read_vectors
+from haptic_bringup.session import read_vectors, reported
 
 DELAY = 0.05  # [s] one way
 FORCE_SCALE = 0.3  # the leader's default
@@ -50,15 +50,7 @@ def streams(folder: pathlib.Path) -> dict:
 
 def reports(folder: pathlib.Path, node: str, key: str) -> list:
     """The values ``node`` reported for ``key`` on /diagnostics, in order."""
-    values = []
-    with AnyReader([folder / 'bag'],
-                   default_typestore=typestore_with(custom_definitions())) as reader:
-        connections = [c for c in reader.connections if c.topic.endswith('/diagnostics')]
-        for connection, _, raw in reader.messages(connections=connections):
-            for status in reader.deserialize(raw, connection.msgtype).status:
-                if status.hardware_id == node:
-                    values += [v.value for v in status.values if v.key == key]
-    return values
+    return reported(folder / 'bag', typestore_with(custom_definitions()), key).get(node, [])
 
 
 def window(times: np.ndarray, start: float, end: float) -> np.ndarray:

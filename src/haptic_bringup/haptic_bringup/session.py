@@ -11,8 +11,8 @@ from rosbags.highlevel import AnyReader
 
 from haptic_util.stamps import to_nanoseconds
 
-__all__ = ['Session', 'read_session', 'read_vectors', 'topic_counts', 'published_counts',
-           'applied_work', 'PUBLISHERS']
+__all__ = ['Session', 'read_session', 'read_vectors', 'reported', 'topic_counts',
+           'published_counts', 'applied_work', 'PUBLISHERS']
 
 # Which node publishes each stream, by its name in /diagnostics reports (a node publishes each
 # of its streams once per count).
@@ -67,15 +67,21 @@ def published_counts(path: pathlib.Path, typestore) -> dict:
 
     Topics whose node left no report (it was killed, or not recorded) are missing.
     """
+    counts = reported(path, typestore, 'published')
+    said = {node: int(values[-1]) for node, values in counts.items()}
+    return {topic: said[node] for topic, node in PUBLISHERS.items() if node in said}
+
+
+def reported(path: pathlib.Path, typestore, key: str) -> dict:
+    """Node → every value it reported for ``key`` on /diagnostics (either site's), in order."""
     said = {}
     with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
-        connections = [c for c in reader.connections if c.topic == '/diagnostics']
+        connections = [c for c in reader.connections if c.topic.endswith('/diagnostics')]
         for connection, _, raw in reader.messages(connections=connections):
             for status in reader.deserialize(raw, connection.msgtype).status:
-                values = {v.key: v.value for v in status.values}
-                if 'published' in values:
-                    said[status.hardware_id] = int(values['published'])
-    return {topic: said[node] for topic, node in PUBLISHERS.items() if node in said}
+                said.setdefault(status.hardware_id, []).extend(
+                    v.value for v in status.values if v.key == key)
+    return {node: values for node, values in said.items() if values}
 
 
 def read_session(path: pathlib.Path, typestore) -> Session:
