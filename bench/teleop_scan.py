@@ -25,9 +25,11 @@ import pathlib
 import shutil
 import sys
 import tempfile
+import time
 
 import machine
 import numpy as np
+import psutil
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
@@ -42,6 +44,7 @@ GRID = 1e-3  # [s]
 MEAN_WINDOW = 0.25  # [s] the felt force's own slow part
 STABLE_OSCILLATION = 10.0  # [%] of the mean felt force
 LAG_MARGIN = 0.2  # [s] the robot's own lag behind its target (its impedance, its speed limit)
+CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the sweep
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
           '/remote/robot/ft_sensor/wrench': 'wrench', '/remote/robot/tcp_pose': 'pose'}
 
@@ -79,7 +82,9 @@ def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
     grid = np.arange(max(pose_t[0], patient_t[0]), min(pose_t[-1], patient_t[-1]), GRID)
     wand, felt_grid = _on_grid(pose_t, pose, grid), _on_grid(felt_t, felt, grid)
     patient_grid, tcp_grid = _on_grid(patient_t, patient, grid), _on_grid(tcp_t, tcp, grid)
-    work = float(np.sum(np.einsum('ij,ij->i', felt[1:], np.diff(pose, axis=0))))
+    # Each tick's applied force is published with its pose; the recorder may miss either.
+    felt_at_pose = _on_grid(felt_t, felt, pose_t)
+    work = float(np.sum(np.einsum('ij,ij->i', felt_at_pose[1:], np.diff(pose, axis=0))))
     contact = np.linalg.norm(patient_grid, axis=1) > CONTACT
     window = np.ones(round(MEAN_WINDOW / GRID)) / round(MEAN_WINDOW / GRID)
     felt_norm = np.linalg.norm(felt_grid, axis=1)
@@ -112,9 +117,26 @@ def run(scheme: str, delay: float, *, jitter: float = 0.1, loss: float = 0.01,
                             run_dir=folder / 'launch', teleop=scheme,
                             link={'delay': delay, 'jitter': jitter * delay, 'loss': loss})
         with Loop(config) as loop:
+            cpu = process_cpu(loop)
             if loop.wait(60.0) is None:
                 raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
-        return {'scheme': scheme, **figures(read_scan(folder / 'bag'), delay)}
+        return {'scheme': scheme, **figures(read_scan(folder / 'bag'), delay), 'cpu': cpu}
+
+
+def process_cpu(loop: Loop) -> dict:
+    """Process → CPU (% of one core) over the scan's steady middle: its press and sweep."""
+    processes = {child.name: psutil.Process(child.pid) for child in loop.children}
+    time.sleep(CPU_WINDOW[0])
+    before = {name: _cpu_seconds(p) for name, p in processes.items()}
+    time.sleep(CPU_WINDOW[1] - CPU_WINDOW[0])
+    return {name: 100.0 * (_cpu_seconds(p) - before[name]) / (CPU_WINDOW[1] - CPU_WINDOW[0])
+            for name, p in processes.items()}
+
+
+def _cpu_seconds(process: psutil.Process) -> float:
+    """Return the CPU time (s) of ``process`` and its threads so far."""
+    times = process.cpu_times()
+    return times.user + times.system
 
 
 def print_header() -> None:
@@ -143,10 +165,20 @@ def main(argv=None) -> int:
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     print_header()
+    rows = []
     for delay in args.delays:
         for scheme in args.schemes:
-            print_row(run(scheme, delay, jitter=args.jitter, loss=args.loss,
-                          domain_id=args.domain_id))
+            rows.append(run(scheme, delay, jitter=args.jitter, loss=args.loss,
+                            domain_id=args.domain_id))
+            print_row(rows[-1])
+    print('\nCPU, % of one core, over the press and the sweep (the machine has '
+          f'{psutil.cpu_count()} cores):')
+    names = list(rows[0]['cpu'])
+    print(f'{"scheme":>6} {"ms":>6} ' + ' '.join(f'{n:>9}' for n in names) + f' {"total":>7}')
+    for r in rows:
+        print(f'{r["scheme"]:>6} {1e3 * r["delay"]:6.0f} '
+              + ' '.join(f'{r["cpu"][n]:9.1f}' for n in names)
+              + f' {sum(r["cpu"].values()):7.1f}')
     return 0
 
 

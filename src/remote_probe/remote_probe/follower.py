@@ -142,6 +142,8 @@ class Follower:
 
     def _port_force(self) -> np.ndarray:
         """Return the impedance spring's reaction to the commanded target, N (``tdpa``'s port)."""
+        if self._target is None:
+            return np.zeros(3)  # nothing commanded yet
         return self.config.robot_stiffness * (self._tcp - self._target)
 
     def _learn(self, now: float, tcp_velocity) -> None:
