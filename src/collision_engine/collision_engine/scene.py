@@ -223,6 +223,17 @@ class Scene:
         _kernels.query_points(self._floats, self._ints, points, rows.reshape(-1))
         return BatchResult.from_rows(rows, self._names)
 
+    def query_rows(self, points: np.ndarray) -> np.ndarray:
+        """Return each point's packed row (n, ``_kernels.OUT_SIZE``), unchecked, for a hot loop.
+
+        ``query_many`` without its checks and copies: ``points`` must be a C-contiguous
+        (n, 3) float64 array of finite values (a validated pose's probe face is). Columns as
+        ``_PackedRow.row``: distance, point (3), normal (3), object index, ...
+        """
+        rows = np.empty((len(points), _kernels.OUT_SIZE))
+        _kernels.query_points(self._floats, self._ints, points, rows.reshape(-1))
+        return rows
+
     def query_within(self, point, radius: float) -> list[QueryResult]:
         """Every object whose signed distance from the tip is at most ``radius``, nearest first.
 

@@ -171,6 +171,8 @@ class MountedTool:
         In its own frame.
     offset : Pose
         The tool's frame in the tip frame.
+    offset_quaternion : tuple of 4 float
+        The offset's rotation, (x, y, z, w).
     face : (n, 3) float64, m, the tip frame
         The contact face's points (``face_shell``), n <= ``MAX_FACE_POINTS``.
     radius : float, m
@@ -179,6 +181,7 @@ class MountedTool:
 
     shape: object
     offset: Pose
+    offset_quaternion: tuple
     face: np.ndarray
     radius: float
 
@@ -199,9 +202,12 @@ def mount_tool(shape, offset: Pose, *, face_spacing: float,
         raise ValueError(f'the tool\'s face has {len(face)} points at a face_spacing of '
                          f'{face_spacing:g} m, more than the {MAX_FACE_POINTS} a collision '
                          'state carries: use a wider spacing')
+    from scipy.spatial.transform import Rotation
+
     face = offset.to_world(face)
     face.setflags(write=False)
-    return MountedTool(shape, offset, face, radius)
+    quaternion = tuple(Rotation.from_matrix(offset.rotation).as_quat().tolist())
+    return MountedTool(shape, offset, quaternion, face, radius)
 
 
 def _refuse(shape, workspace_size: float) -> None:
