@@ -190,3 +190,36 @@ def test_the_pipeline_scales_the_torque_with_the_saturated_force_and_zeroes_it_w
     np.testing.assert_allclose(pipeline.last_torque, raw_torque * 2.0 / raw_force[2], rtol=1e-12)
     pipeline.step(contact, (0.0, 0.0, 0.0), 1.0)  # a second old: stale
     assert pipeline.last_reason is not Reason.OK and pipeline.last_torque == (0.0, 0.0, 0.0)
+
+
+def device_wrench(planes, tip, roll: float):
+    """The wand's own rendering of the model's planes (``haptic_wand_driver.contact_model``)."""
+    from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
+
+    model = ContactModel(0.0, Kind.PLANES, tuple(Plane(*plane) for plane in planes), 10.0, 1.0,
+                         1.0, tuple(tip), (0.0,) * 6)
+    return model.wrench(tip, (0.0, 0.0, 0.0), roll, 0.0, (0.0, 0.0, 0.0))
+
+
+@pytest.mark.parametrize(('theta', 'turn'), [(0.1, 0.0), (0.1, 0.03), (-0.2, -0.05),
+                                             (0.0, 0.1)])
+def test_the_three_plane_model_renders_the_face_s_wrench_while_the_same_points_press(theta,
+                                                                                     turn):
+    """Exact at the model's pose and after a turn that keeps every point pressed."""
+    face, tip = grid(2, 8), (0.003, -0.001, -0.012)
+    law = ProbeSpringDamper(K, C)
+    planes = law.planes(on_plane(face, roll_yaw(theta), tip))
+    assert len(planes) == 3
+    force, torque = device_wrench(planes, tip, theta + turn)
+    expected_force, expected_torque = point_sum(face, roll_yaw(theta + turn), tip)
+    np.testing.assert_allclose(force, expected_force, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(torque, expected_torque, rtol=1e-9, atol=1e-12)
+
+
+def test_a_face_off_the_surface_models_the_whole_face():
+    face, tip = grid(2, 8), (0.0, 0.0, 0.0005)
+    planes = ProbeSpringDamper(K, C).planes(on_plane(face, roll_yaw(0.0), tip))
+    pressed = (0.0, 0.0, -0.001)  # the device moves 1.5 mm down before the next state
+    force, torque = device_wrench(planes, pressed, 0.0)
+    np.testing.assert_allclose(force, [0.0, 0.0, K * 0.001], rtol=1e-9)
+    np.testing.assert_allclose(torque, [0.0, 0.0, 0.0], atol=1e-12)
