@@ -42,7 +42,8 @@ def equivalent_points(arms: np.ndarray) -> np.ndarray:
     and the rotational stiffness of the k points, which is all a 3-plane model can carry.
     """
     mean = arms.mean(axis=0)
-    values, vectors = np.linalg.eigh(np.cov(arms.T, bias=True).reshape(3, 3))
+    centred = arms - mean
+    values, vectors = np.linalg.eigh(centred.T @ centred / len(arms))
     widths = np.sqrt(np.maximum(values[1:], 0.0)) * vectors[:, 1:]  # the two widest axes
     return mean + _SPREAD @ widths.T
 
@@ -64,33 +65,40 @@ class ProbeSpringDamper(SpringDamper):
         super().__init__(stiffness, damping)
         self._torque = _ZERO
 
-    def wrench(self, contact: Contact, velocity) -> tuple[np.ndarray, np.ndarray]:
-        """Force (N) and torque about the tip (N·m) of the face, (3,) each, scene frame."""
+    def wrench(self, contact: Contact, velocity) -> tuple[Vector3, Vector3]:
+        """Force (N) and torque about the tip (N·m) of the face, scene frame, as floats.
+
+        Plain floats point by point: numpy's per-call cost on 3-vectors is larger than the
+        arithmetic, and this runs once per state at 1 kHz.
+        """
         face = contact.face
         velocity = floats3(velocity)
-        force, torque = np.zeros(3), np.zeros(3)
         share = 1.0 / len(face.distance)
         stiffness = tuple((self.stiffness * share).tolist())
         damping = tuple((self.damping * share).tolist())
-        tip = contact.tip
-        for depth, point, normal in zip(face.depth.tolist(), face.points, face.normals):
-            if depth <= 0.0:
+        tx0, ty0, tz0 = contact.tip.tolist()
+        fx = fy = fz = mx = my = mz = 0.0
+        for distance, (px, py, pz), n in zip(face.distance.tolist(), face.points.tolist(),
+                                             face.normals.tolist()):
+            if distance >= 0.0:
                 continue
-            n = normal.tolist()
-            f = np.array(unilateral_spring_damper((depth * n[0], depth * n[1], depth * n[2]), n,
-                                                  velocity, stiffness, damping))
-            force += f
-            torque += np.cross(point - tip, f)
-        return force, torque
+            d = -distance
+            f = unilateral_spring_damper((d * n[0], d * n[1], d * n[2]), n, velocity,
+                                         stiffness, damping)
+            ax, ay, az = px - tx0, py - ty0, pz - tz0
+            fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
+            mx += ay * f[2] - az * f[1]
+            my += az * f[0] - ax * f[2]
+            mz += ax * f[1] - ay * f[0]
+        return (fx, fy, fz), (mx, my, mz)
 
     def force(self, contact: Contact, velocity) -> np.ndarray:
         """Force on the tip, (3,) float, N; keeps the torque for ``torque``."""
         if contact.face is None:
             self._torque = _ZERO
             return super().force(contact, velocity)
-        force, torque = self.wrench(contact, velocity)
-        self._torque = tuple(torque.tolist())
-        return force
+        force, self._torque = self.wrench(contact, velocity)
+        return np.array(force)
 
     def torque(self, contact: Contact) -> Vector3:
         """Return the torque about the tip (N·m) that came with the last ``force``."""
