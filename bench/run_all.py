@@ -59,6 +59,7 @@ BENCHMARKS = (
     Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4')),
     Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60')),
     Benchmark('tool', 'bench_tool.py', ('--near', '300', '--tapping', '1')),
+    Benchmark('probe', 'bench_probe.py', ('--poses', '300')),
 )
 
 
