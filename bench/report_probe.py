@@ -188,10 +188,10 @@ def probe_figure(findings: ProbeFindings, path: Path) -> None:
                     label='applied, about roll', alpha=0.7)
     axes[1, 0].set(title='(c) torque about the tip', xlabel='t (s)', ylabel='mN·m')
     order = np.argsort(findings.roll)
-    axes[1, 1].plot(np.degrees(findings.roll), 1e3 * findings.rendered, '.', markersize=2,
-                    label='rendered')
     axes[1, 1].plot(np.degrees(findings.roll[order]), 1e3 * findings.continuous[order], 'x',
-                    markersize=3, label='continuous face (analytic)')
+                    markersize=4, color='C1', label='continuous face (analytic)')
+    axes[1, 1].plot(np.degrees(findings.roll), 1e3 * findings.rendered, '.', markersize=1,
+                    color='C0', label='rendered')
     axes[1, 1].set(title=f'(d) {FLAT}: roll torque against roll', xlabel='roll (degrees)',
                    ylabel='mN·m')
     for panel in axes.ravel():
