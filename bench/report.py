@@ -2,7 +2,7 @@
 
     .venv/bin/python bench/report.py [--demo-dir build/demo] [--out report]
                                      [--skip probe timing tradeoff loop sweep stiffwall servo
-                                             extreme]
+                                             extreme teleop]
                                      [--quick]
 
 Reads the bags ``demo`` recorded (the simulated wand tapping the hand, the cylinder and the
@@ -13,8 +13,9 @@ paper's own collision code (``paper_method.py``, on the paper's STL objects) alo
 trajectories, and writes ``README.md`` with PNG figures into ``--out``: the paper's Figures
 1-3 and Tables 1, 2, 4 with its reported values beside ours, error against run time for every
 method, our GJK's tolerance trade-off, the loop against its floor, the stiffness sweep, the
-stiff wall over the loop (local against remote rendering), the servo rate, the extreme-geometry
-table, the probe's torque against the analytic face (``report_probe``), message counts, and the
+stiff wall over the loop (local against remote rendering), the servo rate, the
+extreme-geometry table, the probe's torque against the analytic face (``report_probe``), the
+telerobotic scan per scheme and delay, message counts, and the
 machine. Every number of ours is
 computed by the run; the paper's are typed in from it (``PAPER``) and labelled as such.
 
@@ -39,11 +40,11 @@ import time
 import bench_collision
 import extreme_cases
 from report_benchmarks import (colgate_bound, error_time_rows, floor_rows, stiff_wall_rows,
-                               tradeoff_rows)
+                               TELEOP_PLOTTED, teleop_rows, tradeoff_rows)
 from report_document import Findings, readme
 from report_experiments import EXPERIMENTS
 from report_figures import (error_time_figure, experiment_figure, headline_figure, sweep_figure,
-                            tradeoff_figure)
+                            teleop_figure, tradeoff_figure)
 from report_metrics import measure
 from report_paper_replay import replay_paper
 from report_probe import probe_figure, read_probe_runs
@@ -57,8 +58,10 @@ __all__ = ['SKIPPABLE', 'STAGES', 'build', 'main']
 
 ROOT = Path(__file__).resolve().parents[1]
 STAGES = ('bags', 'truth', 'paper', 'figures', 'probe', 'timing', 'tradeoff', 'loop', 'sweep',
-          'stiffwall', 'servo', 'extreme', 'write')
-SKIPPABLE = ('probe', 'timing', 'tradeoff', 'loop', 'sweep', 'stiffwall', 'servo', 'extreme')
+          'stiffwall', 'servo', 'extreme', 'teleop', 'write')
+SKIPPABLE = ('probe', 'timing', 'tradeoff', 'loop', 'sweep', 'stiffwall', 'servo', 'extreme',
+             'teleop')
+FORCE_SCALE = 0.3  # the teleop leader's default
 
 
 class _Stages:
@@ -134,12 +137,17 @@ def build(args) -> Path:
         (1e3, 4e3) if quick else (1e3, 2e3, 4e3, 1e4), (1e3, 1e4, 1e5, 2e5, 5e5, 1e6)))
     extreme = stages.run('extreme', 'extreme-geometry table',
                          lambda: extreme_cases.rows(60 if quick else 200))
+    teleop = stages.run('teleop', 'the telerobotic scan, every scheme and delay',
+                        lambda: teleop_rows(args.demo_dir, args.demo_dir / 'report_teleop',
+                                            args.domain_id, quick))
+    if teleop:
+        teleop_figure(teleop['traces'], FORCE_SCALE, TELEOP_PLOTTED, out / 'teleop_forces.png')
 
     def write():
         findings = Findings(
             recordings, truths, replays, measures, control_contacts(args.demo_dir, type_store),
             timing, bench_collision.timer_overhead() if timing else None, tradeoff, loop, sweep,
-            bound, stiff_wall, servo, extreme, probe)
+            bound, stiff_wall, servo, extreme, probe, teleop)
         return readme(findings, provenance=provenance(), argv=args.argv, demo_dir=args.demo_dir,
                       durations=stages.durations)
 

@@ -1,12 +1,14 @@
 """What the report measures live on this machine, beside the bags: times, trade-offs, loops.
 
 Error against run time for every method, our GJK's tolerance and iteration-cap trade-off, the
-loop latency over ROS 2 at 0.5, 1 and 2 kHz, and the stiff wall over the real loop; each
-builds on a bench script (``bench_collision``, ``bench_loop``, ``stiff_wall_loop``), so the
-report times things as those scripts do.
+loop latency over ROS 2 at 0.5, 1 and 2 kHz, the stiff wall over the real loop, and the
+telerobotic scan; each builds on a bench script (``bench_collision``, ``bench_loop``,
+``stiff_wall_loop``, ``teleop_lockstep``, ``teleop_scan``), so the report measures things as
+those scripts do.
 """
 
 import math
+from pathlib import Path
 
 import bench_collision
 import numpy as np
@@ -16,14 +18,22 @@ from report_metrics import error_summary, false_samples
 from report_paper_replay import paper_rows
 import stiff_wall_loop
 import stiffness_sweep
+import teleop_lockstep
+import teleop_scan
 
 from collision_engine import ConvexMesh, DistanceRequest, load_scene, Scene, STATUS_NOT_CONVERGED
 from collision_engine.scene import SceneObject
 
 __all__ = ['ITERATION_CAPS', 'LOOP_LAYOUTS', 'STIFF_WALLS', 'TOLERANCES',
-           'colgate_bound', 'error_time_rows', 'floor_rows', 'stiff_wall_rows', 'tradeoff_rows']
+           'colgate_bound', 'error_time_rows', 'floor_rows', 'stiff_wall_rows', 'teleop_rows',
+           'tradeoff_rows']
 
 STIFF_WALLS = (160.0, 1e3, 5e3, 2e4, 1e5)  # [N/m] over the real loop
+TELEOP_SCHEMES = ('direct', 'tdpa', 'model')
+TELEOP_DELAYS = (0.0, 0.01, 0.025, 0.05, 0.1, 0.25)  # [s] one way
+TELEOP_PLOTTED = 0.1  # [s] the delay whose runs over ROS 2 are plotted
+TELEOP_JITTER, TELEOP_LOSS = 0.1, 0.01  # of the delay; a probability
+TELEOP_DEMO_DELAY = 0.05  # [s] the demo's run (haptic_bringup.demo)
 LOOP_LAYOUTS = ('separate', 'composed')
 TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 ITERATION_CAPS = (1, 2, 3, 4, 6, 8, 12, 16, 100)
@@ -167,3 +177,28 @@ def colgate_bound() -> float:
 
     return passivity_bound(stiffness_sweep.DEVICE.damping, PipelineConfig().servo_period,
                            stiffness_sweep.WALL_DAMPING)
+
+
+def teleop_rows(demo_dir: Path, work_dir: Path, domain_id: int, quick: bool) -> dict:
+    """Run the telerobotic scan: each scheme and delay in lockstep, the plotted delay over ROS 2.
+
+    Returns ``lockstep`` and ``ros`` rows (``teleop_scan.figures`` plus ``scheme`` and
+    ``source``), the ROS runs' series by scheme (``traces``), and the demo's own run (``demo``:
+    model at 50 ms, from its bag), None if the demo did not record it.
+    """
+    delays = (0.05, 0.25) if quick else TELEOP_DELAYS
+    lockstep = [{'scheme': scheme, 'source': 'lockstep', **teleop_scan.figures(
+        teleop_lockstep.as_series(teleop_lockstep.scan(
+            scheme, delay, jitter=TELEOP_JITTER * delay, loss=TELEOP_LOSS)), delay)}
+        for delay in delays for scheme in TELEOP_SCHEMES]
+    ros, traces = [], {}
+    for scheme in TELEOP_SCHEMES:
+        folder = work_dir / f'teleop_{scheme}'
+        ros.append({'source': 'ROS 2', **teleop_scan.run(
+            scheme, TELEOP_PLOTTED, jitter=TELEOP_JITTER, loss=TELEOP_LOSS,
+            domain_id=domain_id, keep=folder)})
+        traces[scheme] = teleop_scan.read_scan(folder / 'bag')
+    bag = demo_dir / 'teleop' / 'bag'
+    demo = ({'scheme': 'model', 'source': 'ROS 2, demo', **teleop_scan.figures(
+        teleop_scan.read_scan(bag), TELEOP_DEMO_DELAY)} if bag.exists() else None)
+    return {'lockstep': lockstep, 'ros': ros, 'traces': traces, 'demo': demo}

@@ -13,8 +13,7 @@ from report_sections import (counts_section, DEFINITIONS, error_time_section,
                              experiment_section, extreme_section, force_effect_section,
                              headline_section, identical_modes, interval_table, loop_section,
                              provenance_section, servo_section, skipped, stiff_wall_section,
-                             sweep_section,
-                             table_2, table_3, tradeoff_section)
+                             sweep_section, table_2, table_3, teleop_section, tradeoff_section)
 
 __all__ = ['Findings', 'readme']
 
@@ -38,6 +37,7 @@ class Findings:
     servo: list | None
     extreme: list | None
     probe: object | None
+    teleop: dict | None
 
 
 def readme(findings: Findings, *, provenance: dict, argv: list, demo_dir: Path,
@@ -46,8 +46,8 @@ def readme(findings: Findings, *, provenance: dict, argv: list, demo_dir: Path,
     parts = (_opening(findings, provenance, [str(a) for a in argv])
              + _figures_chapter(findings, demo_dir) + _tables_chapter(findings)
              + _timing_chapter(findings) + _stability_chapter(findings)
-             + _probe_chapter(findings)
-             + ['## 6. Messages per topic', '',
+             + _probe_chapter(findings) + _teleop_chapter(findings)
+             + ['## 7. Messages per topic', '',
                 'Published (the node\'s own count, from its last diagnostics report) and '
                 'recorded (in the bag), per experiment.', '',
                 counts_section(findings.recordings), '',
@@ -189,3 +189,30 @@ def _stability_chapter(findings: Findings) -> list[str]:
               'unsigned (magnitudes compared).', '']
     return parts + ([extreme_section(findings.extreme), ''] if findings.extreme
                     else [skipped('extreme cases'), ''])
+
+
+def _teleop_chapter(findings: Findings) -> list[str]:
+    parts = [
+        '## 6. Telerobotic scan', '',
+        'The scripted sonographer approaches the patient phantom through the remote robot, '
+        'presses at about 8 N, sweeps 8 cm along it and lifts, over a link of the given one-way '
+        'delay with 10 % jitter and 1 % loss, per bilateral scheme: *direct* (the F/T force, '
+        'scaled by 0.3, the baseline), *tdpa* (time-domain passivity at both ports, energy sent '
+        'over the link), *model* (the remote site\'s contact estimate rendered by the wand at '
+        'its servo rate, updated passively). *Lockstep* runs the same pieces on one clock '
+        'without ROS (`bench/teleop_lockstep.py`); *ROS 2* runs both sites as processes in two '
+        'DDS domains with the link bridge between them (`bench/teleop_scan.py`, as '
+        '`haptic_loop --teleop`). Every figure comes from what the device applied to the hand '
+        'and what the remote sensor measured: *stable* is a net work of the applied force on '
+        'the hand ≤ 0 and an oscillation (RMS of the felt force about its 0.25 s mean, in '
+        'contact) ≤ 10 % of it; *transparency* the RMS of felt / 0.3 − patient force at the '
+        'lag that makes it least; *tracking* the RMS of the probe against the wand\'s path at '
+        'its best lag (it includes the robot\'s spring giving way to the patient\'s force).',
+        '']
+    teleop = findings.teleop
+    if teleop is None:
+        return parts + [skipped('telerobotic scan'), '']
+    demo = [teleop['demo']] if teleop['demo'] is not None else []
+    parts += [teleop_section(teleop['lockstep'] + teleop['ros'] + demo), '',
+              '![force against time per scheme](teleop_forces.png)', '']
+    return parts

@@ -24,7 +24,8 @@ from haptic_bringup.contacts import contact_intervals, MIN_FORCE
 __all__ = ['DEFINITIONS', 'counts_section', 'error_time_section', 'experiment_section',
            'extreme_section', 'force_effect_section', 'headline_section', 'identical_modes',
            'interval_table', 'loop_section', 'provenance_section', 'servo_section', 'skipped',
-           'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'tradeoff_section']
+           'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'teleop_section',
+           'tradeoff_section']
 
 
 def provenance_section(info: dict, recordings: dict, argv: list) -> str:
@@ -392,3 +393,17 @@ def force_effect_section(cuboid: Recording, without: list | None, demo_dir: Path
 def skipped(what: str) -> str:
     """Say that a stage was left out with ``--skip``."""
     return f'*Skipped in this run ({what}); run without `--skip` to include it.*'
+
+
+def teleop_section(rows: list) -> str:
+    """Tabulate each scheme's stability, transparency, patient force and tracking per delay."""
+    def number(value: float, fmt: str) -> str:
+        return '–' if not np.isfinite(value) else format(value, fmt)
+    return markdown_table(
+        ['scheme', 'one-way delay (ms)', 'run', 'stable', 'net work on the hand (mJ)',
+         'oscillation (%)', 'transparency error (N)', '(% of mean contact force)',
+         'peak patient force (N)', 'tracking RMS (mm)'],
+        [[r['scheme'], f'{1e3 * r["delay"]:g}', r['source'], 'yes' if r['stable'] else '**no**',
+          f'{1e3 * r["net_work_j"]:+.1f}', f'{r["oscillation_percent"]:.1f}',
+          number(r['transparency_n'], '.2f'), number(r['transparency_percent'], '.1f'),
+          f'{r["peak_patient_n"]:.2f}', f'{1e3 * r["tracking_m"]:.1f}'] for r in rows])

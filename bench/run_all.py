@@ -51,6 +51,7 @@ BENCHMARKS = (
     Benchmark('model_error', 'model_error.py', ('--contacts', '100')),
     Benchmark('wand_driver', 'bench_wand_driver.py', ('--repeats', '2', '--seconds', '2')),
     Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3')),
+    Benchmark('bridge', 'bench_bridge.py', ('--runs', '1', '--seconds', '3')),
     Benchmark('loop_stats', 'bench_loop_stats.py', ('--hours', '0.1', '1')),
     Benchmark('stream_cost', 'stream_cost.py', ('--seconds', '2', '--runs', '1')),
     Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5')),
@@ -60,6 +61,8 @@ BENCHMARKS = (
     Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60')),
     Benchmark('tool', 'bench_tool.py', ('--near', '300', '--tapping', '1')),
     Benchmark('probe', 'bench_probe.py', ('--poses', '300')),
+    Benchmark('teleop_lockstep', 'teleop_lockstep.py', ('--delays', '0.05')),
+    Benchmark('teleop_scan', 'teleop_scan.py', ('--delays', '0.05')),
 )
 
 

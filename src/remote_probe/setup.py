@@ -1,3 +1,5 @@
+from glob import glob
+
 from setuptools import find_packages, setup
 
 package_name = 'remote_probe'
@@ -9,17 +11,23 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/config', glob('config/*')),
     ],
     install_requires=['setuptools', 'numpy'],
     extras_require={'phantom': ['trimesh']},
     zip_safe=False,
     maintainer='Haptic toolkit maintainers',
     maintainer_email='maintainers@haptic-telesono.invalid',
-    description='Remote site of telerobotic ultrasound: robot probe, F/T sensor, patient, link.',
+    description='Telerobotic ultrasound: the remote robot probe, its patient, the link, and both '
+                'ends of the bilateral schemes.',
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
+            'link_bridge = remote_probe.bridge:main',
             'make_phantom = remote_probe.phantom:main',
+            'sim_robot = remote_probe.robot_node:main',
+            'teleop_follower = remote_probe.follower_node:main',
+            'teleop_leader = remote_probe.leader_node:main',
         ],
     },
 )

@@ -9,7 +9,8 @@ PROBE = '''
 import sys
 import remote_probe.ft_sensor, remote_probe.impedance_robot, remote_probe.link
 import remote_probe.model_estimation, remote_probe.phantom, remote_probe.safety
-import remote_probe.tissue
+import remote_probe.relay, remote_probe.tissue
+remote_probe.relay.message_class('geometry_msgs/msg/PoseStamped')
 print(sorted({'rclpy', 'trimesh', 'scipy', 'collision_engine'} & set(sys.modules)))
 '''
 

@@ -1,6 +1,6 @@
 """The main job: the simulated wand taps the paper's objects over ROS 2, recorded and summarised.
 
-    demo [--experiments cuboid cylinder hand cuboid-no-force probe-flat probe-phantom]
+    demo [--experiments cuboid cylinder hand cuboid-no-force probe-flat probe-phantom teleop]
          [--composed] [--out build/demo]
 
 For each experiment it launches the loop (driver, collision engine, force renderer and a
@@ -9,7 +9,10 @@ line per contact: depth, mean force per axis, and how far the force pointed from
 ``cuboid-no-force`` is the control: the same taps with the force held at zero, to show how deep
 the operator's hand would go if nothing pushed back. ``probe-flat`` and ``probe-phantom`` sweep
 a linear probe (a 10 x 40 mm face) rolled and yawed +-20 degrees on a flat slab and on the
-patient phantom: force and torque about the tip.
+patient phantom: force and torque about the tip. ``teleop`` is the telerobotic scan: the
+operator's site and the remote robot on the patient phantom, in two DDS domains, model-mediated
+over a 50 ms link (5 ms jitter, 1 % loss); it prints the force the patient felt and the hand
+felt, and the round trip the operator measured.
 """
 import argparse
 import os
@@ -22,10 +25,10 @@ import numpy as np
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.contacts import contact_intervals, format_contacts
-from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import (published_counts, PUBLISHERS, read_session,
-                                    topic_counts)
+                                    read_vectors, reported, topic_counts)
 
 __all__ = ['main', 'EXPERIMENTS', 'run_experiment']
 
@@ -40,6 +43,10 @@ EXPERIMENTS = {
     'probe-phantom': ('package://collision_engine/scenes/probe_phantom.yaml', 'probe', {}),
 }
 DURATION = 10.0  # [s] as the paper's experiments
+TELEOP = 'teleop'
+TELEOP_LINK = {'delay': 0.05, 'jitter': 0.005, 'loss': 0.01}  # [s, s, probability]
+TELEOP_SCHEME = 'model'
+FORCE_SCALE = 0.3  # the leader's default
 
 
 def run_experiment(name: str, out: pathlib.Path, *, composed: bool = False,
@@ -59,6 +66,37 @@ def run_experiment(name: str, out: pathlib.Path, *, composed: bool = False,
             raise RuntimeError(f'{name}: the driver did not end its experiment '
                                f'({ended.name if ended else "timeout"})')
     return {'bag': run / 'bag', 'stats': stats}
+
+
+def run_teleop(out: pathlib.Path, *, domain_id: int = 42) -> pathlib.Path:
+    """Run the telerobotic scan over ROS 2 (two domains and the bridge); return its bag."""
+    run = out / TELEOP
+    shutil.rmtree(run, ignore_errors=True)
+    run.mkdir(parents=True)
+    config = LoopConfig(teleop=TELEOP_SCHEME, link=dict(TELEOP_LINK), record=str(run / 'bag'),
+                        domain_id=domain_id, run_dir=run / 'launch')
+    with Loop(config) as loop:
+        ended = loop.wait(SCAN_DURATION + 30.0)
+        if ended is None or ended.name != 'operator':
+            raise RuntimeError(f'{TELEOP}: the operator did not end the scan '
+                               f'({ended.name if ended else "timeout"})')
+    return run / 'bag'
+
+
+def summarise_teleop(bag: pathlib.Path) -> str:
+    """Summarise the scan: the patient's force and the hand's while pressing, the round trip."""
+    typestore = typestore_with(custom_definitions())
+    series = read_vectors(bag, typestore, {'/wand/applied_wrench': 'wrench',
+                                           '/remote/robot/ft_sensor/wrench': 'wrench'})
+    patient = np.linalg.norm(series['/remote/robot/ft_sensor/wrench'][1], axis=1)
+    felt = np.linalg.norm(series['/wand/applied_wrench'][1], axis=1)
+    round_trip = reported(bag, typestore, 'round_trip_s').get('teleop_leader', ['nan'])[-1]
+    return (f'== {TELEOP}: {TELEOP_SCHEME} over a {1e3 * TELEOP_LINK["delay"]:g} ms link ==\n'
+            f'patient force: median {np.median(patient[patient > 1.0]):.2f} N in contact, peak '
+            f'{patient.max():.2f} N; felt / {FORCE_SCALE:g}: median '
+            f'{np.median(felt[felt > FORCE_SCALE]) / FORCE_SCALE:.2f} N; round trip measured by '
+            f'the operator from echoed stamps: {1e3 * float(round_trip):.1f}'
+            ' ms')
 
 
 def summarise(name: str, files: dict) -> str:
@@ -86,8 +124,8 @@ def summarise(name: str, files: dict) -> str:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog='demo', description=__doc__.split('\n\n')[0])
-    parser.add_argument('--experiments', nargs='+', choices=list(EXPERIMENTS),
-                        default=list(EXPERIMENTS))
+    parser.add_argument('--experiments', nargs='+', choices=[*EXPERIMENTS, TELEOP],
+                        default=[*EXPERIMENTS, TELEOP])
     parser.add_argument('--composed', action='store_true', help='one process for the loop')
     parser.add_argument('--out', default='build/demo', type=pathlib.Path)
     parser.add_argument('--domain-id', type=int,
@@ -96,8 +134,14 @@ def main(argv=None) -> int:
     add_venv_prefix()
     started = time.monotonic()
     for name in args.experiments:
-        print(f'[demo] {name}: tapping for {DURATION:g} s over ROS 2 ...', flush=True)
         try:
+            if name == TELEOP:
+                print(f'[demo] {name}: scanning the patient phantom through the remote robot '
+                      f'for {SCAN_DURATION:g} s ...', flush=True)
+                print(summarise_teleop(run_teleop(args.out, domain_id=args.domain_id)),
+                      flush=True)
+                continue
+            print(f'[demo] {name}: tapping for {DURATION:g} s over ROS 2 ...', flush=True)
             files = run_experiment(name, args.out, composed=args.composed,
                                    domain_id=args.domain_id)
         except RuntimeError as error:

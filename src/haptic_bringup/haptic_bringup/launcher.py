@@ -1,6 +1,7 @@
 """The local launcher: the haptic loop without ros2cli or launch (PyPI installs).
 
     haptic_loop [--composed] [--scene SCENE] [--experiment NAME] [--duration S] [--record DIR]
+    haptic_loop --teleop SCHEME [--delay S] [--jitter S] [--loss P] [--record DIR]
 
 starts the wand driver, the collision engine and the force renderer as three processes (or, with
 ``--composed``, as one process on one executor), with local-only DDS discovery, a domain id, and
@@ -8,6 +9,12 @@ ROS logs under ``build/``. It waits for the loop's topics to be discovered, runs
 driver's experiment ends, ``--duration`` passes or Ctrl-C, then stops every process (the
 recorder last) and removes stale shared memory. On a full ROS 2 install,
 ``ros2 launch haptic_bringup haptic_loop.launch.py`` does the same.
+
+With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
+(the wand driver and the leader, one process) in one DDS domain, the remote site (the robot with
+its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and the
+link bridge between them, which delays, jitters and drops what crosses. The recorder writes both
+sites into one bag, the remote one's topics under ``/remote/``.
 """
 import argparse
 import dataclasses
@@ -33,6 +40,22 @@ NODES = {
     'collision_engine': ('collision_engine', 'collision_engine.node', 'CollisionNode'),
     'force_renderer': ('force_renderer', 'force_renderer.node', 'ForceNode'),
 }
+TELEOP_NODES = {
+    'teleop_leader': ('remote_probe', 'remote_probe.leader_node', 'LeaderNode'),
+    'sim_robot': ('remote_probe', 'remote_probe.robot_node', 'SimulatedRobotNode'),
+    'teleop_follower': ('remote_probe', 'remote_probe.follower_node', 'FollowerNode'),
+}
+OPERATOR_SITE = ('wand_driver', 'teleop_leader')
+REMOTE_SITE = ('sim_robot', 'teleop_follower')
+SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
+SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
+BRIDGE_MODULE = 'remote_probe.bridge'
+TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
+TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
+OPERATOR_RECORDED = ('/wand/pose', '/wand/twist', '/wand/applied_wrench', '/teleop/command',
+                     '/teleop/feedback', '/diagnostics')
+REMOTE_RECORDED = ('/robot/target_pose', '/robot/tcp_pose', '/robot/ft_sensor/wrench',
+                   '/teleop/command', '/teleop/feedback', '/diagnostics')
 COMPOSED_MODULE = 'haptic_bringup.composed'
 RECORDER_MODULE = 'haptic_bringup.recorder'
 DEFAULT_DOMAIN_ID = 42
@@ -56,6 +79,14 @@ class LoopConfig:
     overrides: dict = dataclasses.field(default_factory=dict)
     run_dir: pathlib.Path = pathlib.Path('build/launch')
     python: str = sys.executable
+    teleop: Optional[str] = None  # a bilateral scheme: a telerobotic session instead
+    link: dict = dataclasses.field(default_factory=dict)  # delay, jitter, loss, ... (s)
+    remote_domain: Optional[int] = None  # the remote site's DDS domain; None: the next one
+
+    @property
+    def remote_domain_id(self) -> int:
+        """Return the remote site's DDS domain."""
+        return self.domain_id + 1 if self.remote_domain is None else self.remote_domain
 
 
 def add_venv_prefix() -> None:
@@ -86,7 +117,8 @@ def loop_environment(domain_id: int, log_dir: pathlib.Path) -> dict:
 def node_parameters(config: LoopConfig) -> dict:
     """Every node's parameters: package defaults, then the user's file, then the options."""
     merged = {}
-    for package, _, _ in NODES.values():
+    packages = {package for package, _, _ in (*NODES.values(), *TELEOP_NODES.values())}
+    for package in sorted(packages):
         share = pathlib.Path(get_package_share_directory(package))
         merged.update(yaml.safe_load((share / 'config' / f'{package}.yaml').read_text()) or {})
     if config.params_file:
@@ -105,10 +137,54 @@ def node_parameters(config: LoopConfig) -> dict:
     if config.record:
         options.setdefault('wand_driver', {})['wait_for_recorder'] = True
         options['recorder'] = {'output': str(pathlib.Path(config.record).resolve())}
+    if config.teleop:
+        _teleop_options(config, options)
     for node, values in [*options.items(), *config.overrides.items()]:
         merged.setdefault(node, {'ros__parameters': {}})
         merged[node]['ros__parameters'].update(values)
     return merged
+
+
+def _teleop_options(config: LoopConfig, options: dict) -> None:
+    """Set the scheme on both ends, and the driver for it: the model is rendered at the device.
+
+    The baseline, direct reflection, runs without the device's own passivity controller, and so
+    does tdpa, whose controllers sit at the link's ports.
+    """
+    scheme = config.teleop
+    driver = options.setdefault('wand_driver', {})
+    if not config.experiment:
+        package, relative = SCAN_SCRIPT
+        driver['experiment'] = str(pathlib.Path(get_package_share_directory(package)) / relative)
+        driver.setdefault('duration', SCAN_DURATION)
+    driver['rendering'] = 'local' if scheme == 'model' else 'remote'
+    driver['passivity'] = scheme == 'model'
+    for node in ('teleop_leader', 'teleop_follower'):
+        options.setdefault(node, {})['scheme'] = scheme
+    if config.record:
+        answer = '/wand/contact_model' if scheme == 'model' else '/wand/wrench'
+        options['recorder'].update(topics=[*OPERATOR_RECORDED, answer],
+                                   remote_domain=config.remote_domain_id,
+                                   remote_topics=list(REMOTE_RECORDED))
+
+
+def bridge_parameters(config: LoopConfig) -> dict:
+    """Return the link bridge's parameters: the two domains, what crosses, and the link."""
+    return {'/**': {'ros__parameters': {
+        'operator_domain': config.domain_id, 'remote_domain': config.remote_domain_id,
+        'to_remote': list(TO_REMOTE), 'to_operator': list(TO_OPERATOR), **config.link}}}
+
+
+def teleop_endpoints(config: LoopConfig) -> dict:
+    """Domain → topic → (publishers, subscribers) that make the telerobotic session closed."""
+    recording = 1 if config.record else 0
+    crossing = {'/teleop/command': (1, 1 + recording), '/teleop/feedback': (1, 1 + recording)}
+    return {
+        config.domain_id: {'/wand/pose': (1, 1 + recording), **crossing},
+        config.remote_domain_id: {**crossing, '/robot/target_pose': (1, 1 + recording),
+                                  '/robot/tcp_pose': (1, 1 + recording),
+                                  '/robot/ft_sensor/wrench': (1, 1 + recording)},
+    }
 
 
 def expected_endpoints(config: LoopConfig) -> dict:
@@ -135,7 +211,7 @@ def _finished(child) -> bool:
 
     A driver starts its experiment only once the loop is closed.
     """
-    return child.returncode == 0 and child.name in ('wand_driver', 'composed')
+    return child.returncode == 0 and child.name in ('wand_driver', 'composed', 'operator')
 
 
 class Loop:
@@ -167,7 +243,9 @@ class Loop:
         if config.record:
             self.children.append(start_child(
                 'recorder', [config.python, '-m', RECORDER_MODULE, *ros_args], env))
-        if config.composed:
+        if config.teleop:
+            self._start_teleop(env, ros_args)
+        elif config.composed:
             self.children.append(start_child(
                 'composed', [config.python, '-m', COMPOSED_MODULE, *config.nodes, *ros_args],
                 env))
@@ -178,13 +256,31 @@ class Loop:
         self._wait_for_discovery()
         self.startup_time = time.monotonic() - started
 
+    def _start_teleop(self, env: dict, ros_args: list) -> None:
+        """Start the two sites, each one process in its own domain, and the bridge."""
+        config = self.config
+        remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
+        bridge = self.run_dir / 'bridge.yaml'
+        bridge.write_text(yaml.safe_dump(bridge_parameters(config), sort_keys=False))
+        for name, nodes, site_env in (('operator', OPERATOR_SITE, env),
+                                      ('remote', REMOTE_SITE, remote_env)):
+            self.children.append(start_child(
+                name, [config.python, '-m', COMPOSED_MODULE, *nodes, *ros_args], site_env))
+        self.children.append(start_child(
+            'bridge', [config.python, '-m', BRIDGE_MODULE, '--ros-args', '--params-file',
+                       str(bridge)], env))
+
     def _wait_for_discovery(self) -> None:
-        watcher = GraphWatcher(self.config.domain_id)
-        try:
-            missing = watcher.wait(expected_endpoints(self.config), DISCOVERY_TIMEOUT,
-                                   abort=lambda: self.exited() is not None)
-        finally:
-            watcher.close()
+        endpoints = (teleop_endpoints(self.config) if self.config.teleop
+                     else {self.config.domain_id: expected_endpoints(self.config)})
+        missing = []
+        for domain_id, expected in endpoints.items():
+            watcher = GraphWatcher(domain_id)
+            try:
+                missing += watcher.wait(expected, DISCOVERY_TIMEOUT,
+                                        abort=lambda: self.exited() is not None)
+            finally:
+                watcher.close()
         dead = self.exited()
         if dead is not None and _finished(dead):
             return  # a short experiment ran to its end before this watcher saw every endpoint
@@ -212,7 +308,7 @@ class Loop:
         """
         old = self.child(name)
         old.process.wait()
-        clean_stale_shm(domains=[self.config.domain_id], existing=self._segments_before)
+        clean_stale_shm(domains=self._domains(), existing=self._segments_before)
         new = start_child(name, old.argv, old.env)
         self.children[self.children.index(old)] = new
         return new
@@ -236,8 +332,12 @@ class Loop:
             time.sleep(RECORDER_DRAIN)
             codes.update(stop_children(recorder, gently=gently))
         self.children = []
-        clean_stale_shm(domains=[self.config.domain_id], existing=self._segments_before)
+        clean_stale_shm(domains=self._domains(), existing=self._segments_before)
         return codes
+
+    def _domains(self) -> list:
+        config = self.config
+        return [config.domain_id, *([config.remote_domain_id] if config.teleop else [])]
 
 
 def parse_args(argv=None) -> argparse.Namespace:
@@ -253,6 +353,18 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='stop after this many seconds of closed loop (0: until Ctrl-C or '
                         'the end of the experiment)')
     parser.add_argument('--record', metavar='DIR', help='record a rosbag2 (mcap) to DIR')
+    parser.add_argument('--teleop', choices=('direct', 'tdpa', 'model'),
+                        help='a telerobotic session over an emulated link with this bilateral '
+                        'scheme (the experiment defaults to the scripted scan)')
+    parser.add_argument('--delay', type=float, default=0.0, help='teleop: one-way link delay [s]')
+    parser.add_argument('--jitter', type=float, default=0.0,
+                        help='teleop: standard deviation of the delay [s]')
+    parser.add_argument('--loss', type=float, default=0.0,
+                        help='teleop: probability that a message is lost')
+    parser.add_argument('--remote-domain-id', type=int,
+                        help='teleop: the remote site\'s DDS domain (default: the next one)')
+    parser.add_argument('--delay-trace', metavar='CSV',
+                        help='teleop: replay one-way delays from a CSV (time,delay in s)')
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', DEFAULT_DOMAIN_ID)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
@@ -261,11 +373,21 @@ def parse_args(argv=None) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
+def link_parameters(args: argparse.Namespace) -> dict:
+    """Return the bridge's link parameters from the command line."""
+    link = {'delay': args.delay, 'jitter': args.jitter, 'loss': args.loss}
+    if args.delay_trace:
+        link['delay_trace'] = str(pathlib.Path(args.delay_trace).resolve())
+    return link
+
+
 def main(argv=None) -> int:
     args = parse_args(argv)
     config = LoopConfig(composed=args.composed, scene=args.scene, experiment=args.experiment,
                         duration=args.duration, record=args.record, domain_id=args.domain_id,
-                        params_file=args.params_file, run_dir=pathlib.Path(args.run_dir))
+                        params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
+                        teleop=args.teleop, link=link_parameters(args),
+                        remote_domain=args.remote_domain_id)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     loop = Loop(config)
     stop = []
@@ -276,7 +398,10 @@ def main(argv=None) -> int:
     except RuntimeError as error:
         print(f'haptic_loop: {error}', file=sys.stderr)
         return 1
-    layout = 'one process' if config.composed else f'{len(config.nodes)} processes'
+    layout = ('one process' if config.composed else f'{len(config.nodes)} processes')
+    if config.teleop:
+        layout = (f'{config.teleop} over a {1e3 * args.delay:g} ms link, operator in domain '
+                  f'{config.domain_id}, remote site in {config.remote_domain_id}')
     print(f'haptic_loop: loop closed in {loop.startup_time:.2f} s ({layout}, '
           f'domain {config.domain_id}); Ctrl-C stops', flush=True)
     # The driver ends its experiment after ``duration`` and exits; this is only a backstop.

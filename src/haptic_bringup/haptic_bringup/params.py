@@ -27,3 +27,7 @@ class RecorderParams:
     output: str = parameter('bags/haptic_session', 'new bag directory to write')
     topics: tuple[str, ...] = parameter(tuple(LOOP_TOPICS), 'topics to record (others than '
                                         'the loop\'s are typed from the graph)')
+    remote_domain: int = parameter(-1, 'the remote site\'s DDS domain, recorded too (-1: none)',
+                                   low=-1, high=232)
+    remote_topics: tuple[str, ...] = parameter(('/diagnostics',), 'its topics to record, as '
+                                               '/remote/<topic> in the bag')

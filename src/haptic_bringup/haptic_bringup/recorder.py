@@ -9,11 +9,20 @@ Once every topic has a matched publisher it says so on ``recorder/ready`` (latch
 driver can hold its session until nothing it publishes can be missed. On SIGINT or SIGTERM the
 bag is closed and complete; after ``kill -9`` it is recoverable up to the last flush (see
 ``haptic_bringup.bag``).
+
+A telerobotic session spans two DDS domains, the operator's and the remote site's. With
+``remote_domain`` set, the recorder joins that domain too (a second context, spun in its own
+thread) and writes its ``remote_topics`` into the same bag under ``/remote/``, on the same
+clock, so one bag holds both sites.
 """
 import importlib
 import pathlib
+import threading
 
 from ament_index_python.packages import get_package_share_directory
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool
@@ -28,6 +37,7 @@ __all__ = ['BagRecorder', 'main', 'custom_definitions']
 
 CUSTOM_PACKAGES = ('haptic_msgs',)
 GRAPH_POLL_PERIOD = 0.02  # [s]
+REMOTE_PREFIX = '/remote'  # where the remote site's topics go in the bag
 WRITER_MATCH_SETTLE = 0.5  # [s] see subscribe_new_topics
 
 
@@ -58,30 +68,43 @@ class BagRecorder(Node):
             raise StartupError(f'{self.get_name()}: output {output} exists already; '
                                'give a new directory')
         self.bag = BagWriter(output, typestore_with(custom_definitions()))
-        topics = [self.resolve_topic_name(t) for t in self.params.topics]
+        self._lock = threading.Lock()  # the remote site's thread writes too
         self._subscribed = []
+        self._pending = []  # (node, topic, name in the bag) whose type the graph will tell
         self._ready_pub = self.create_publisher(Bool, 'recorder/ready', LATCHED_QOS)
         self._ready_pub.publish(Bool(data=False))
-        for topic in [t for t in topics if t in LOOP_TOPICS]:
-            self._subscribe(topic, LOOP_TOPICS[topic], (
-                LATCHED_QOS if topic in LATCHED_TOPICS else
-                RELIABLE_RECORDER_QOS if topic in RELIABLE_TOPICS else RECORDER_QOS))
-        self._pending = [t for t in topics if t not in LOOP_TOPICS]
+        self._remote = None
+        self._record(self, self.params.topics, '')
+        if self.params.remote_domain >= 0:
+            self._remote = _RemoteSite(self.params.remote_domain)
+            self._record(self._remote.node, self.params.remote_topics, REMOTE_PREFIX)
         self._poll = self.create_timer(GRAPH_POLL_PERIOD, self.subscribe_new_topics)
-        self.get_logger().info(f'recording {", ".join(topics)} to {output}')
+        self.get_logger().info(f'recording {", ".join(self.bag.counts)} to {output}')
 
-    def _subscribe(self, topic: str, type_name: str, qos) -> None:
-        self.bag.add_topic(topic, type_name)
-        self._subscribed.append(self.create_subscription(
-            message_class(type_name), topic, self._writer_for(topic), qos, raw=True))
+    def _record(self, node: Node, topics, prefix: str) -> None:
+        """Record ``topics`` of ``node``'s domain, each as ``prefix`` + its name."""
+        for topic in [node.resolve_topic_name(t) for t in topics]:
+            if topic in LOOP_TOPICS:
+                self._subscribe(node, topic, prefix + topic, LOOP_TOPICS[topic], (
+                    LATCHED_QOS if topic in LATCHED_TOPICS else
+                    RELIABLE_RECORDER_QOS if topic in RELIABLE_TOPICS else RECORDER_QOS))
+            else:
+                self._pending.append((node, topic, prefix + topic))
+
+    def _subscribe(self, node: Node, topic: str, name: str, type_name: str, qos) -> None:
+        self.bag.add_topic(name, type_name)
+        self._subscribed.append(node.create_subscription(
+            message_class(type_name), topic, self._writer_for(name), qos, raw=True))
 
     def subscribe_new_topics(self) -> None:
         """Subscribe the topics of unknown type once the graph shows them; say when ready."""
-        types = dict(self.get_topic_names_and_types())
-        for topic in [t for t in self._pending if t in types]:
-            self._subscribe(topic, types[topic][0],
-                            _matching_qos(self.get_publishers_info_by_topic(topic)))
-            self._pending.remove(topic)
+        for entry in list(self._pending):
+            node, topic, name = entry
+            types = dict(node.get_topic_names_and_types())
+            if topic in types:
+                self._subscribe(node, topic, name, types[topic][0],
+                                _matching_qos(node.get_publishers_info_by_topic(topic)))
+                self._pending.remove(entry)
         if not self._pending and all(s.get_publisher_count() for s in self._subscribed):
             self._poll.cancel()
             # DDS matches each reader-writer pair on both sides separately; the writers' side
@@ -98,14 +121,42 @@ class BagRecorder(Node):
         clock = self.get_clock()
 
         def write(data: bytes) -> None:
-            self.bag.write(topic, clock.now().nanoseconds, data)
+            with self._lock:
+                self.bag.write(topic, clock.now().nanoseconds, data)
         return write
 
     def destroy_node(self) -> bool:
+        if self._remote is not None:
+            self._remote.close()
         self.bag.close()
         counts = ', '.join(f'{t}: {n}' for t, n in self.bag.counts.items())
         self.get_logger().info(f'closed {self.bag.path} ({counts})')
         return super().destroy_node()
+
+
+class _RemoteSite:
+    """A node in another DDS domain, spun in a thread of its own."""
+
+    def __init__(self, domain_id: int) -> None:
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=domain_id)
+        self.node = Node('recorder_remote', context=self.context)
+        self.executor = EventsExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.thread = threading.Thread(target=self._spin, daemon=True)
+        self.thread.start()
+
+    def _spin(self) -> None:
+        try:
+            while self.context.ok():
+                self.executor.spin_once(timeout_sec=0.05)
+        except ExternalShutdownException:
+            pass  # closed: the recorder is stopping
+
+    def close(self) -> None:
+        self.context.try_shutdown()
+        self.thread.join(timeout=2.0)
+        self.node.destroy_node()
 
 
 def _matching_qos(publishers) -> QoSProfile:

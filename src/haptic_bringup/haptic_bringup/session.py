@@ -11,8 +11,8 @@ from rosbags.highlevel import AnyReader
 
 from haptic_util.stamps import to_nanoseconds
 
-__all__ = ['Session', 'read_session', 'topic_counts', 'published_counts', 'applied_work',
-           'PUBLISHERS']
+__all__ = ['Session', 'read_session', 'read_vectors', 'reported', 'topic_counts',
+           'published_counts', 'applied_work', 'PUBLISHERS']
 
 # Which node publishes each stream, by its name in /diagnostics reports (a node publishes each
 # of its streams once per count).
@@ -73,15 +73,21 @@ def published_counts(path: pathlib.Path, typestore) -> dict:
 
     Topics whose node left no report (it was killed, or not recorded) are missing.
     """
+    counts = reported(path, typestore, 'published')
+    said = {node: int(values[-1]) for node, values in counts.items()}
+    return {topic: said[node] for topic, node in PUBLISHERS.items() if node in said}
+
+
+def reported(path: pathlib.Path, typestore, key: str) -> dict:
+    """Node → every value it reported for ``key`` on /diagnostics (either site's), in order."""
     said = {}
     with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
-        connections = [c for c in reader.connections if c.topic == '/diagnostics']
+        connections = [c for c in reader.connections if c.topic.endswith('/diagnostics')]
         for connection, _, raw in reader.messages(connections=connections):
             for status in reader.deserialize(raw, connection.msgtype).status:
-                values = {v.key: v.value for v in status.values}
-                if 'published' in values:
-                    said[status.hardware_id] = int(values['published'])
-    return {topic: said[node] for topic, node in PUBLISHERS.items() if node in said}
+                said.setdefault(status.hardware_id, []).extend(
+                    v.value for v in status.values if v.key == key)
+    return {node: values for node, values in said.items() if values}
 
 
 def read_session(path: pathlib.Path, typestore) -> Session:
@@ -125,6 +131,25 @@ def read_session(path: pathlib.Path, typestore) -> Session:
         fcl_distance=np.array([m.fcl_distance for m in rows]),
         fcl_discrepancy=np.array([m.fcl_discrepancy for m in rows]),
         scene=scene)
+
+
+def read_vectors(path: pathlib.Path, typestore, topics: dict) -> dict:
+    """Topic → (receive times s, (n, 3) vectors) of stamped poses (position) or wrenches (force).
+
+    ``topics`` maps each topic to ``'pose'`` or ``'wrench'``; a topic absent from the bag gives
+    empty arrays.
+    """
+    series = {topic: ([], []) for topic in topics}
+    with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
+        connections = [c for c in reader.connections if c.topic in topics]
+        for connection, stamp, raw in reader.messages(connections=connections):
+            msg = reader.deserialize(raw, connection.msgtype)
+            vector = (msg.pose.position if topics[connection.topic] == 'pose'
+                      else msg.wrench.force)
+            series[connection.topic][0].append(stamp * 1e-9)
+            series[connection.topic][1].append(_xyz(vector))
+    return {topic: (np.array(times), np.array(vectors).reshape(-1, 3))
+            for topic, (times, vectors) in series.items()}
 
 
 def applied_work(session: Session) -> float:

@@ -1,0 +1,295 @@
+"""The link bridge: one process in the operator's and the remote site's DDS domains.
+
+Why: the two sites of telerobotic ultrasound run on this machine in two DDS domains, so that
+nothing crosses between them except through this process, which holds each message for the
+emulated link's delay, jitter and loss (``remote_probe.link``; the kernel here has no netem).
+
+How, with the Jazzy wheels (cost in ``bench/bench_bridge.py``):
+- one rclpy ``Context`` per domain, a node in each, and both nodes on one EventsExecutor in one
+  thread. An EventsExecutor serves nodes of several contexts. Two executors spun in two threads
+  held 1 kHz each way too, at the same CPU, but in a trial beside this design their release
+  lateness p99 was 2-5 ms against 0.5-1 ms in one thread (the GIL passed back and forth); and
+  one thread needs no locks;
+- messages cross as serialized CDR bytes (``raw=True`` in, ``publish(bytes)`` out), never
+  converted: the bridge knows the types only by name, and forwarding bytes costs about half as
+  much CPU as message objects (``../shared/loop-latency.md``);
+- each direction's release timer (steady clock) is re-armed for the link's next arrival, rather
+  than polling at 1 kHz: a release is then late by the executor's wake-up alone.
+
+The domains are parameters, but a context's domain is fixed when it starts and rclpy reads
+parameters only through a node. So the parameters are read first by a node of a short-lived
+context in the process's own ``ROS_DOMAIN_ID``, then the two sites' contexts are started.
+
+Each site's node reports both directions on its domain's ``/diagnostics`` at 1 Hz.
+"""
+from dataclasses import dataclass, replace
+import faulthandler
+import functools
+import math
+import signal
+import sys
+import time
+
+import rclpy
+from rclpy.clock import Clock, ClockType
+from rclpy.exceptions import NameValidationException, ParameterException
+from rclpy.executors import ExternalShutdownException
+from rclpy.expand_topic_name import expand_topic_name
+from rclpy.experimental import EventsExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+from rclpy.validate_full_topic_name import validate_full_topic_name
+
+from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
+from haptic_util.executor import (request_stop, SHUTDOWN_TIMEOUT, spin, StartupError,
+                                  stop_requested, TEARDOWN_LIMIT)
+from haptic_util.parameters import declare_parameters, parameter
+from haptic_util.qos import HAPTIC_STREAM_QOS
+from remote_probe.link import DelayTrace, EmulatedLink, LinkConfig
+from remote_probe.relay import check_no_loop, message_class, parse_routes, Relay
+
+__all__ = ['LinkBridge', 'LinkBridgeParams', 'main', 'read_parameters']
+
+NODE_NAME = 'link_bridge'
+DIAGNOSTICS_PERIOD = 1.0  # [s]
+LATE_WARNING = 1e-3  # [s] release lateness p99 above which the bridge itself distorts the link
+_STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() reads
+_CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException,
+                         NameValidationException, rclpy_implementation.RCLError)
+
+
+@dataclass(frozen=True)
+class LinkBridgeParams:
+    """The bridge's parameters (see config/link_bridge.yaml); the link is the same both ways."""
+
+    operator_domain: int = parameter(0, 'DDS domain of the operator site (wand, force '
+                                     'rendering)', low=0, high=232)
+    remote_domain: int = parameter(1, 'DDS domain of the remote site (robot, sensor, patient)',
+                                   low=0, high=232)
+    to_remote: tuple[str, ...] = parameter(
+        ('robot/target_pose:geometry_msgs/msg/PoseStamped',),
+        "topics relayed from the operator's domain to the remote one, 'topic:pkg/msg/Type'; "
+        "[''] for none (rclpy cannot declare an empty list of strings)")
+    to_operator: tuple[str, ...] = parameter(
+        ('robot/tcp_pose:geometry_msgs/msg/PoseStamped',
+         'robot/ft_sensor/wrench:geometry_msgs/msg/WrenchStamped'),
+        "topics relayed from the remote domain to the operator's, 'topic:pkg/msg/Type'; "
+        "[''] for none")
+    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
+                             high=10.0)
+    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
+                              "message's delay", unit='s', low=0.0, high=10.0)
+    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
+    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
+                              'holds back those behind it)')
+    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
+                          low=0)
+    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
+                                 'from each direction\'s first message, instead of delay; '
+                                 'empty: none')
+
+
+class _Plan:
+    """Everything the bridge needs, checked before any site's domain is joined."""
+
+    def __init__(self, params: LinkBridgeParams) -> None:
+        if params.operator_domain == params.remote_domain:
+            raise StartupError(f'{NODE_NAME}: operator_domain and remote_domain are both '
+                               f'{params.operator_domain}; the sites need two domains')
+        try:
+            self.to_remote = parse_routes(params.to_remote, 'to_remote')
+            self.to_operator = parse_routes(params.to_operator, 'to_operator')
+            check_no_loop(self.to_remote, self.to_operator)
+            config = LinkConfig(params.delay, params.jitter, params.loss, params.reorder,
+                                params.seed)
+        except ValueError as error:
+            raise StartupError(f'{NODE_NAME}: {error}') from None
+        try:
+            trace = DelayTrace.from_csv(params.delay_trace) if params.delay_trace else None
+        except (ValueError, OSError) as error:
+            raise StartupError(f'{NODE_NAME}: parameter delay_trace: {error}') from None
+        for direction, routes in (('to_remote', self.to_remote),
+                                  ('to_operator', self.to_operator)):
+            for route in routes:
+                try:
+                    validate_full_topic_name(expand_topic_name(route.topic, NODE_NAME, '/'))
+                except (ValueError, NameValidationException) as error:
+                    first = str(error).splitlines()[0]
+                    raise StartupError(f'{NODE_NAME}: {direction}: topic {route.topic!r}: '
+                                       f'{first}') from None
+        self.links = {'to_remote': EmulatedLink(config, trace=trace),
+                      'to_operator': EmulatedLink(replace(config, seed=params.seed + 1),
+                                                  trace=trace)}
+
+
+def read_parameters(args=None) -> LinkBridgeParams:
+    """Read and check the parameters with a node of a context of their own, then close it."""
+    context = rclpy.Context()
+    rclpy.init(args=args, context=context, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        node = Node(NODE_NAME, context=context, enable_rosout=False,
+                    start_parameter_services=False)
+        try:
+            return declare_parameters(node, LinkBridgeParams)
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+class _Direction:
+    """One direction's wiring: raw subscriptions at its source, publishers at its destination.
+
+    The release timer lives in the destination's node; it is armed for the link's next
+    arrival, and a message whose time has come on arrival (no delay) goes out at once.
+    """
+
+    def __init__(self, relay: Relay, routes: tuple, source: Node, destination: Node) -> None:
+        self.relay = relay
+        classes = [message_class(route.type_name) for route in routes]
+        self._publishers = [destination.create_publisher(cls, route.topic, HAPTIC_STREAM_QOS)
+                            for cls, route in zip(classes, routes)]
+        for index, (cls, route) in enumerate(zip(classes, routes)):
+            source.create_subscription(cls, route.topic, functools.partial(self.on_message, index),
+                                       HAPTIC_STREAM_QOS, raw=True)
+        self._timer = destination.create_timer(1.0, self.on_timer, clock=_STEADY,
+                                               autostart=False)
+        self._armed = None  # [s] the arrival the timer is armed for
+
+    def on_message(self, route: int, data: bytes) -> None:
+        self.relay.send(time.monotonic(), route, data)
+        self.release()
+
+    def on_timer(self) -> None:
+        self._armed = None  # it fired: arm it again, even for the same arrival
+        self.release()
+
+    def release(self) -> None:
+        now = time.monotonic()
+        for route, data in self.relay.release(now):
+            self._publishers[route].publish(data)
+        due = self.relay.next_arrival
+        if due == self._armed:
+            return
+        self._armed = due
+        if due is None:
+            self._timer.cancel()
+            return
+        self._timer.timer_period_ns = max(1, math.ceil((due - now) * 1e9))
+        self._timer.reset()
+
+
+class _SiteNode(Node):
+    """The bridge's node in one site's domain, reporting both directions there."""
+
+    def __init__(self, name: str, context: rclpy.Context, relays: dict) -> None:
+        super().__init__(name, context=context)
+        self._relays = relays
+        self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
+
+    def report(self) -> Report:
+        values, late = {}, []
+        for direction, relay in self._relays.items():
+            values.update({f'{direction} {key}': value
+                           for key, value in relay.counts().items()})
+            p99 = relay.lateness()[1]
+            if p99 is not None and p99 > LATE_WARNING:
+                late.append(f'{direction} released late (p99 {p99 * 1e3:.1f} ms)')
+        return Report(WARN if late else OK, '; '.join(late) or 'relaying', values)
+
+    def destroy_node(self) -> bool:
+        self.diagnostics.final()
+        return super().destroy_node()
+
+
+class LinkBridge:
+    """The two sites' contexts and nodes, the two directions, and the executor of both."""
+
+    def __init__(self, params: LinkBridgeParams, args=None) -> None:
+        plan = _Plan(params)
+        self.relays = {direction: Relay(link) for direction, link in plan.links.items()}
+        self.contexts, self.nodes, self.executor = [], [], None
+        try:
+            for site, domain in (('operator', params.operator_domain),
+                                 ('remote', params.remote_domain)):
+                context = rclpy.Context()
+                rclpy.init(args=args, context=context, domain_id=domain,
+                           signal_handler_options=SignalHandlerOptions.NO)
+                self.contexts.append(context)
+                self.nodes.append(_SiteNode(f'{NODE_NAME}_{site}', context, self.relays))
+            operator, remote = self.nodes
+            self.directions = [
+                _Direction(self.relays['to_remote'], plan.to_remote, operator, remote),
+                _Direction(self.relays['to_operator'], plan.to_operator, remote, operator)]
+            self.executor = EventsExecutor(context=self.contexts[0])
+            for node in self.nodes:
+                self.executor.add_node(node)
+        except BaseException:
+            self.close()
+            raise
+        trace = f'trace {params.delay_trace}' if params.delay_trace else f'{params.delay:g} s'
+        operator.get_logger().info(
+            f'domain {params.operator_domain} <-> {params.remote_domain}: '
+            f'{len(plan.to_remote)} topics to remote, {len(plan.to_operator)} to operator; '
+            f'delay {trace}, jitter {params.jitter:g} s, loss {params.loss:g}, '
+            f'reorder {params.reorder}')
+
+    def close(self) -> None:
+        """Say the last counts, destroy the nodes and shut the contexts down (idempotent)."""
+        faulthandler.dump_traceback_later(TEARDOWN_LIMIT, exit=True)  # never hang silently
+        if self.executor is not None:  # it lets go of the nodes' entities first
+            for node in self.nodes:
+                self.executor.remove_node(node)
+            self.executor.shutdown(timeout_sec=SHUTDOWN_TIMEOUT)
+            self.executor = None
+        if self.nodes:
+            self.nodes[0].get_logger().info(', '.join(
+                f'{direction}: {relay.relayed} relayed, {relay.link.lost} lost'
+                for direction, relay in self.relays.items()))
+        for node in self.nodes:
+            node.destroy_node()
+        for context in self.contexts:
+            rclpy.try_shutdown(context=context)
+        self.nodes, self.contexts = [], []
+        faulthandler.cancel_dump_traceback_later()
+
+
+_starting = [False]  # a signal while the sites start interrupts the start itself
+
+
+def _on_signal(signum, frame) -> None:
+    first = not stop_requested()
+    request_stop()
+    if first and _starting[0]:
+        _starting[0] = False
+        raise KeyboardInterrupt  # no rclpy callback runs yet
+
+
+def main(args=None) -> int:
+    """Run the bridge until SIGINT or SIGTERM (exit 0); a bad configuration exits 2."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _on_signal)
+    _starting[0] = True
+    bridge = None
+    try:
+        bridge = LinkBridge(read_parameters(args), args)
+        _starting[0] = False
+        spin(bridge.executor)
+    except _CONFIGURATION_ERRORS as error:
+        print(f'error: {" ".join(str(error).split())}', file=sys.stderr, flush=True)
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        _starting[0] = False
+        if bridge is not None:
+            bridge.close()
+        # A late repeat of the signal must not kill the process at exit (see run_nodes).
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(signum, signal.SIG_IGN)
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -1,0 +1,156 @@
+"""The operator's end of the bilateral schemes: wand → command, feedback → what the hand feels.
+
+Why: the operator's site must stay safe and stable whatever the link does. The leader answers
+every wand pose at once from the newest feedback it holds, never waiting on the link:
+
+- ``direct``: the patient's force, scaled, as the wand's force (the baseline; with delay, the
+  force acts on an old motion and gives energy back);
+- ``tdpa``: the same force through the operator's passivity controller, which books the energy
+  at this port against what the robot's port has sent into the link (``remote_probe.tdpa``);
+- ``model``: the remote site's estimated plane, mapped into the wand's workspace with the
+  scaled gains, for the device to render at its own servo rate. Model updates are kept
+  passive: an update that would store more energy in the wand's spring (the wand deeper in a
+  stiffer one) is paid from a reserve, which holds what earlier updates took out (an estimate
+  that moved out, a softer one); what the reserve cannot pay, the plane is shown moved out
+  along its normal instead, and the robot's target with it. The first contact is where that
+  matters: the estimate arrives a round trip after the robot touched, with the wand already
+  that far in, and shown as it is it would throw the hand out (in lockstep at 250 ms: 45 mJ
+  given, 18 N on the patient). Moving the robot's target out by the same shift keeps the
+  patient pressed as the hand feels it; the shift is a position offset between the wand and
+  the probe, the price of passivity (as TDPA's drift is), paid back as soon as the reserve
+  allows. A reserve rather than a ratchet: refusing every rise while keeping every fall, the
+  estimate's noise alone drove the shift out to tens of millimetres.
+
+Feedback older than ``link_timeout`` (on this site's clock: the sites share none) gives zero
+force and no model; an older or repeated feedback is ignored by its stamp. The link's round trip
+is measured from the echoed command stamps, as NTP does (``RoundTripEstimator``).
+"""
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+from remote_probe._checks import finite_number
+from remote_probe.link import RoundTripEstimator
+from remote_probe.tdpa import OperatorPassivity
+from remote_probe.teleop import Command, Feedback, RemotePlane, SCHEMES
+from remote_probe.workspace_map import WorkspaceMap
+
+__all__ = ['Leader', 'LeaderConfig']
+
+
+@dataclass(frozen=True)
+class LeaderConfig:
+    """Parameters of the operator's end.
+
+    Parameters
+    ----------
+    scheme : str
+        One of ``SCHEMES``.
+    force_scale : float
+        Felt force per patient force.
+    position_scale : float
+        Robot motion per wand motion.
+    link_timeout : float, s
+        Feedback older than this (since it arrived) is not rendered.
+    """
+
+    scheme: str = 'model'
+    force_scale: float = 0.3
+    position_scale: float = 1.0
+    link_timeout: float = 0.1
+
+    def __post_init__(self):
+        if self.scheme not in SCHEMES:
+            raise ValueError(f'scheme {self.scheme!r} is not one of {list(SCHEMES)}')
+        finite_number(self.link_timeout, 'link_timeout', minimum=0.0, strict=True)
+
+
+class Leader:
+    """The operator's end of the link.
+
+    Parameters
+    ----------
+    config : LeaderConfig
+    wand_start, robot_start : (3,) float, m
+        Where the wand and the probe are when the session starts (the first anchors).
+    """
+
+    def __init__(self, config: LeaderConfig, wand_start, robot_start) -> None:
+        self.config = config
+        self.map = WorkspaceMap(config.position_scale, config.force_scale, wand_start,
+                                robot_start)
+        self.passivity = OperatorPassivity()
+        self.round_trip = RoundTripEstimator()
+        self._feedback: Feedback | None = None
+        self._heard = -math.inf  # this site's clock when the newest feedback came
+        self._shown: RemotePlane | None = None  # the plane last shown, shift included
+        self._shift = np.zeros(3)  # [m] wand frame: how far it is shown out from the estimate
+        self._reserve = 0.0  # [J] energy model updates took out of the wand's spring, net
+
+    def receive(self, now: float, feedback: Feedback) -> bool:
+        """Take ``feedback`` arrived at ``now`` (s); False if it is not newer than the held one."""
+        if self._feedback is not None and feedback.stamp <= self._feedback.stamp:
+            return False
+        self._feedback, self._heard = feedback, now
+        self.passivity.books.receive(feedback.energy_in)
+        if feedback.echo > 0.0:
+            replied = feedback.stamp
+            self.round_trip.add(feedback.echo, replied - feedback.echo_hold, replied, now)
+        return True
+
+    def live(self, now: float) -> bool:
+        """Whether feedback came within ``link_timeout`` before ``now``."""
+        return now - self._heard <= self.config.link_timeout
+
+    def command(self, stamp: float, wand, wand_velocity) -> Command:
+        """Return the command for the wand's pose stamped ``stamp`` (s, this site's clock)."""
+        target = self.map.to_robot(wand) + self.map.position_scale * self._shift
+        return Command(stamp, target, self.map.velocity_to_robot(wand_velocity),
+                       self.passivity.books.energy_in)
+
+    def force(self, now: float, wand_velocity, dt: float) -> np.ndarray:
+        """Return what the wand should push with, (3,) N, over the next ``dt`` s (not ``model``).
+
+        Zero while the link is silent or the clutch is engaged.
+        """
+        patient = np.zeros(3)
+        if self.live(now) and not self.map.clutched:
+            patient = self._feedback.force
+        if self.config.scheme == 'tdpa':
+            patient = self.passivity.control(patient, self.map.velocity_to_robot(wand_velocity),
+                                             dt)
+        return self.config.force_scale * patient
+
+    def plane(self, now: float, wand) -> RemotePlane | None:
+        """Return the contact plane to show the wand at ``wand`` (3,) m (``model``); None: free.
+
+        In the wand's frame, with the felt gains, moved out as far as a passive update needs.
+        None too while the link is silent or the clutch is engaged.
+        """
+        if not self.live(now) or self.map.clutched or self._feedback.plane is None:
+            self._shown, self._shift, self._reserve = None, np.zeros(3), 0.0
+            return None
+        remote = self._feedback.plane
+        stiffness = self.map.felt_gain(remote.stiffness)
+        point = self.map.to_wand(remote.point)
+        held = 0.0 if self._shown is None else _stored(self._shown, wand)
+        affordable = held + self._reserve  # [J] the most the new spring may hold
+        depth = _depth(point, remote.normal, wand)
+        allowed = (math.sqrt(2.0 * max(affordable, 0.0) / stiffness) if stiffness > 0.0
+                   else math.inf)
+        self._shift = max(depth - allowed, 0.0) * remote.normal
+        self._shown = RemotePlane(point - self._shift, remote.normal, stiffness,
+                                  self.map.felt_gain(remote.damping))
+        self._reserve = affordable - _stored(self._shown, wand)
+        return self._shown
+
+
+def _stored(plane: RemotePlane, wand) -> float:
+    """Energy (J) in ``plane``'s spring with the wand at ``wand``."""
+    return 0.5 * plane.stiffness * max(_depth(plane.point, plane.normal, wand), 0.0) ** 2
+
+
+def _depth(point, normal, wand) -> float:
+    """How far (m) ``wand`` lies behind the plane through ``point`` with outward ``normal``."""
+    return float(np.dot(np.asarray(point) - wand, normal))

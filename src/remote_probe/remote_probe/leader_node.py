@@ -1,0 +1,187 @@
+"""The operator site's end of the link: the wand's pose out as a command, its feeling back.
+
+With every wand pose (and its twist, same stamp) it sends ``teleop/command`` over the link and
+answers the driver at once from the newest ``teleop/feedback`` (``Leader``): ``wand/wrench`` for
+``direct`` and ``tdpa`` (the driver applies it), ``wand/contact_model`` for ``model`` (the driver
+renders it at its servo rate). Each answer carries the pose's stamp and a short lifetime, so a
+leader that dies leaves no force behind. The session starts at the first feedback, whose TCP is
+the robot's anchor. ``teleop/clutch`` (Bool, true: engaged) re-centres the wand without moving
+the robot.
+"""
+import math
+
+from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
+import numpy as np
+from rclpy.node import Node
+from std_msgs.msg import Bool
+
+from haptic_msgs.msg import ContactModel, TeleopCommand, TeleopFeedback
+from haptic_util.cdr import MessageCodec
+from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
+from haptic_util.executor import run_nodes, StartupError
+from haptic_util.parameters import declare_parameters
+from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
+from haptic_util.tally import Tally
+from remote_probe.leader import Leader, LeaderConfig
+from remote_probe.params import LeaderParams
+from remote_probe.teleop import Feedback, RemotePlane
+
+__all__ = ['LeaderNode', 'main']
+
+COMMAND = MessageCodec(TeleopCommand)
+FEEDBACK = MessageCodec(TeleopFeedback)
+MODEL = MessageCodec(ContactModel)
+POSE = MessageCodec(PoseStamped)
+TWIST = MessageCodec(TwistStamped)
+WRENCH = MessageCodec(WrenchStamped)
+_UNUSED_PLANES = (0.0,) * 30  # two of ContactModel's three planes
+_ZERO_WRENCH = (0.0,) * 6
+
+
+class LeaderNode(Node):
+    """Sends the wand to the robot and renders the robot's answer on the wand."""
+
+    def __init__(self, **kwargs):
+        super().__init__('teleop_leader', **kwargs)
+        self.params = params = declare_parameters(self, LeaderParams)
+        try:
+            self.config = LeaderConfig(params.scheme, params.force_scale,
+                                       params.position_scale, params.link_timeout)
+        except ValueError as error:
+            raise StartupError(f'{self.get_name()}: {error}') from None
+        self.leader: Leader | None = None  # from the first feedback on
+        self._pending = None  # (stamp ns, position) of the pose waiting for its twist
+        self._last_stamp_ns = None
+        self._clutch = False
+        self._refused = Tally()
+        self._answers = 0
+        self._command_pub = self.create_publisher(TeleopCommand, 'teleop/command',
+                                                  HAPTIC_STREAM_QOS)
+        answer = ((ContactModel, 'wand/contact_model') if params.scheme == 'model'
+                  else (WrenchStamped, 'wand/wrench'))
+        self._answer_pub = self.create_publisher(*answer, HAPTIC_STREAM_QOS)
+        self.create_subscription(PoseStamped, 'wand/pose', self.on_pose, HAPTIC_STREAM_QOS,
+                                 raw=True)
+        self.create_subscription(TwistStamped, 'wand/twist', self.on_twist, HAPTIC_STREAM_QOS,
+                                 raw=True)
+        self.create_subscription(TeleopFeedback, 'teleop/feedback', self.on_feedback,
+                                 HAPTIC_STREAM_QOS, raw=True)
+        self.create_subscription(Bool, 'teleop/clutch', self.on_clutch, LATCHED_QOS)
+        self.diagnostics = Diagnostics(self, self.report, 1.0)
+        self.get_logger().info(f'{params.scheme} scheme: force x{params.force_scale:g}, '
+                               f'motion x{params.position_scale:g}; waiting for the robot')
+
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def on_feedback(self, data: bytes) -> None:
+        fields = FEEDBACK.decode(data)
+        if fields[2] != self.params.robot_frame:
+            self._refused.add(f'feedback in frame {fields[2]!r}')
+            return
+        values = np.array(fields[5:29], dtype=np.float64)
+        if not np.all(np.isfinite(values)):
+            self._refused.add('feedback not finite')
+            return
+        plane = None
+        if fields[13] == TeleopFeedback.KIND_PLANE:
+            plane = RemotePlane(values[9:12], values[12:15], values[15], values[18])
+        feedback = Feedback(fields[0] + fields[1] * 1e-9, fields[3] + fields[4] * 1e-9,
+                            values[0], values[1:4], values[4:7], values[7], plane)
+        if self.leader is None:
+            if self._pending is None:
+                return  # the wand's start is not known yet
+            self.leader = Leader(self.config, self._pending[1], feedback.tcp)
+            self.get_logger().info(f'robot found at {np.round(feedback.tcp, 4).tolist()} m: '
+                                   'following the wand')
+        if not self.leader.receive(self._now(), feedback):
+            self._refused.add('feedback older than the held one')
+
+    def on_pose(self, data: bytes) -> None:
+        fields = POSE.decode(data)
+        if fields[2] != self.params.frame_id:
+            self._refused.add(f'pose in frame {fields[2]!r}')
+            return
+        self._pending = (fields[0] * 1_000_000_000 + fields[1],
+                         np.array(fields[3:6], dtype=np.float64))
+
+    def on_twist(self, data: bytes) -> None:
+        """Answer the pose of the same stamp: the driver publishes its twist right after it."""
+        fields = TWIST.decode(data)
+        stamp_ns = fields[0] * 1_000_000_000 + fields[1]
+        if self._pending is None or self._pending[0] != stamp_ns:
+            return
+        position, velocity = self._pending[1], np.array(fields[3:6], dtype=np.float64)
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
+            self._refused.add('wand pose or twist not finite')
+            self._answer(stamp_ns, None)
+            return
+        if self.leader is None:
+            self._answer(stamp_ns, None)
+            return
+        period = (stamp_ns - self._last_stamp_ns) * 1e-9 if self._last_stamp_ns else 1e-3
+        self._last_stamp_ns = stamp_ns
+        command = self.leader.command(stamp_ns * 1e-9, position, velocity)
+        self._command_pub.publish(COMMAND.encode((
+            *divmod(stamp_ns, 1_000_000_000), self.params.robot_frame,
+            *command.position.tolist(), *command.velocity.tolist(), command.energy_in)))
+        now = self._now()
+        if self.params.scheme == 'model':
+            self._answer(stamp_ns, self.leader.plane(now, position), position)
+        else:
+            self._answer(stamp_ns, self.leader.force(now, velocity, max(period, 1e-6)))
+
+    def _answer(self, stamp_ns: int, answer, position=None) -> None:
+        """Publish the wrench or model for the pose ``stamp_ns``; None: zero force, no model."""
+        header = (*divmod(stamp_ns, 1_000_000_000), self.params.frame_id)
+        self._answers += 1
+        if self.params.scheme != 'model':
+            force = (0.0, 0.0, 0.0) if answer is None else tuple(answer.tolist())
+            self._answer_pub.publish(WRENCH.encode((*header, *force, 0.0, 0.0, 0.0)))
+            return
+        tip = (0.0, 0.0, 0.0) if position is None else tuple(position.tolist())
+        if answer is None:
+            kind, count, plane = ContactModel.KIND_FREE, 0, (0.0,) * 15
+        else:
+            kind, count = ContactModel.KIND_PLANES, 1
+            plane = (*answer.point.tolist(), *answer.normal.tolist(), *[answer.stiffness] * 3,
+                     *[answer.damping] * 3, 0.0, 0.0, 0.0)
+        self._answer_pub.publish(MODEL.encode((
+            *header, 'patient', kind, count, *plane, *_UNUSED_PLANES, self.params.force_limit,
+            self.params.model_lifetime, self.params.model_radius, *tip, *_ZERO_WRENCH)))
+
+    def on_clutch(self, msg: Bool) -> None:
+        if self.leader is None or self._pending is None:
+            return
+        if msg.data:
+            self.leader.map.engage(self._pending[1])
+        else:
+            self.leader.map.release(self._pending[1])
+
+    def report(self) -> Report:
+        self._refused.log_new(lambda line: self.get_logger().warn(f'refused: {line}'))
+        leader = self.leader
+        live = leader is not None and leader.live(self._now())
+        round_trip = leader.round_trip.round_trip if leader is not None else None
+        values = {'published': self._answers, 'link_live': live,
+                  'round_trip_s': math.nan if round_trip is None else round_trip,
+                  'clutched': leader is not None and leader.map.clutched,
+                  'refused': self._refused.total()}
+        if leader is not None:
+            values['operator_energy_out_j'] = leader.passivity.books.energy_out
+        message = ('waiting for the robot' if leader is None else
+                   f'link {"live" if live else "silent"}, round trip '
+                   f'{1e3 * values["round_trip_s"]:.1f} ms')
+        return Report(OK if live else WARN, message, values)
+
+    def destroy_node(self) -> bool:
+        self.diagnostics.final()
+        return super().destroy_node()
+
+
+def main(args=None) -> int:
+    return run_nodes([LeaderNode], args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -1,0 +1,81 @@
+"""The ROS parameters of the telerobotic nodes, in one place (see config/*.yaml)."""
+from dataclasses import dataclass
+
+from haptic_util.parameters import parameter
+from remote_probe.teleop import SCHEMES
+
+__all__ = ['FollowerParams', 'LeaderParams', 'SimulatedRobotParams']
+
+
+@dataclass(frozen=True)
+class SimulatedRobotParams:
+    rate: float = parameter(1000.0, 'TCP pose and F/T wrench publishing rate', unit='Hz',
+                            low=1.0, high=10000.0)
+    frame_id: str = parameter('base_link', 'the robot\'s base frame, also the scene\'s frame')
+    scene_file: str = parameter('package://collision_engine/scenes/phantom.yaml',
+                                'the patient: a collision scene whose skin the probe presses')
+    tissue_stiffness: float = parameter(2000.0, 'Hunt-Crossley k of F = k x^n + lambda x^n xdot',
+                                        unit='N/m^n', low=0.0)
+    tissue_exponent: float = parameter(1.3, 'Hunt-Crossley n', low=1.0, high=3.0)
+    tissue_damping: float = parameter(1500.0, 'Hunt-Crossley lambda', unit='N*s/m^(n+1)',
+                                      low=0.0)
+    mass: float = parameter(2.0, 'apparent Cartesian mass at the TCP', unit='kg', low=1e-3)
+    stiffness: float = parameter(1500.0, 'Cartesian impedance stiffness', unit='N/m', low=1.0)
+    max_speed: float = parameter(0.25, 'largest TCP speed', unit='m/s', low=1e-3)
+    workspace_lower: tuple[float, ...] = parameter((-0.4, -0.4, -0.4), 'workspace box corner',
+                                                   unit='m', length=3)
+    workspace_upper: tuple[float, ...] = parameter((0.4, 0.4, 0.4), 'workspace box corner',
+                                                   unit='m', length=3)
+    initial_position: tuple[float, ...] = parameter((0.0, 0.0, 0.0), 'TCP at start', unit='m',
+                                                    length=3)
+    force_noise: float = parameter(0.05, 'F/T sensor noise RMS per axis', unit='N', low=0.0)
+    force_bias: tuple[float, ...] = parameter((0.0, 0.0, 0.0), 'F/T sensor bias (after taring)',
+                                              unit='N', length=3)
+    sensor_bandwidth: float = parameter(200.0, 'F/T sensor first-order cut-off', unit='Hz',
+                                        low=1.0)
+    seed: int = parameter(0, 'seed of the sensor noise', low=0)
+
+
+@dataclass(frozen=True)
+class FollowerParams:
+    scheme: str = parameter('model', 'bilateral scheme', choices=SCHEMES)
+    rate: float = parameter(1000.0, 'control rate: a target per tick', unit='Hz', low=1.0,
+                            high=10000.0)
+    feedback_rate: float = parameter(0.0, 'feedback over the link; 0: 1 kHz for direct and '
+                                     'tdpa (a force), 100 Hz for model (a plane)', unit='Hz',
+                                     low=0.0, high=10000.0)
+    frame_id: str = parameter('base_link', 'the robot\'s base frame')
+    scene_file: str = parameter('package://collision_engine/scenes/phantom.yaml',
+                                'the patient\'s surface as this site sees it, for the model out '
+                                'of contact; empty: only what contact teaches')
+    robot_stiffness: float = parameter(1500.0, 'the robot\'s impedance stiffness', unit='N/m',
+                                       low=1.0)
+    max_patient_force: float = parameter(20.0, 'the force the patient may feel at most',
+                                         unit='N', low=0.1)
+    force_margin: float = parameter(1.0, 'the spring stays this far below the limit', unit='N',
+                                    low=0.0)
+    link_timeout: float = parameter(0.1, 'no command for this long: hold, then retract',
+                                    unit='s', low=0.001)
+    release_force: float = parameter(1.0, 'retraction stops below this force', unit='N',
+                                     low=0.0)
+    retract_speed: float = parameter(0.02, 'retraction speed', unit='m/s', low=1e-4)
+    drift_rate: float = parameter(2.0, 'tdpa: drift compensation rate', unit='1/s', low=0.0)
+    sensor_timeout: float = parameter(0.05, 'no F/T wrench or TCP pose for this long: no force '
+                                      'is fed back', unit='s', low=0.001)
+
+
+@dataclass(frozen=True)
+class LeaderParams:
+    scheme: str = parameter('model', 'bilateral scheme', choices=SCHEMES)
+    force_scale: float = parameter(0.3, 'felt force per patient force', low=1e-3, high=10.0)
+    position_scale: float = parameter(1.0, 'robot motion per wand motion', low=1e-3, high=10.0)
+    link_timeout: float = parameter(0.1, 'no feedback for this long: zero force', unit='s',
+                                    low=0.001)
+    frame_id: str = parameter('world', 'the wand\'s frame')
+    robot_frame: str = parameter('base_link', 'the robot\'s base frame, of the link\'s messages')
+    force_limit: float = parameter(10.0, 'force limit sent with the contact model', unit='N',
+                                   low=0.0)
+    model_lifetime: float = parameter(0.010, 'a rendered model holds this long after its '
+                                      'pose\'s stamp', unit='s', low=0.0005, high=1.0)
+    model_radius: float = parameter(0.01, 'a rendered model holds this far from the wand',
+                                    unit='m', low=1e-4, high=1.0)

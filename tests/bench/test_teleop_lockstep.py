@@ -1,0 +1,38 @@
+"""The bilateral schemes in lockstep (no ROS): what each does with a delay, reproducibly.
+
+The figures are ``teleop_scan.figures`` of the force the simulated device applied to the hand and
+the force the patient's tissue put on the probe; the schemes' own books are not read.
+"""
+import pytest
+import teleop_lockstep
+import teleop_scan
+
+MAX_PATIENT_FORCE = 20.0  # [N] the safety's default
+
+
+def figures(scheme: str, delay: float, **options) -> dict:
+    run = teleop_lockstep.scan(scheme, delay, jitter=0.1 * delay, loss=0.01, **options)
+    return teleop_scan.figures(teleop_lockstep.as_series(run), delay)
+
+
+def test_direct_reflection_gives_the_hand_energy_by_50_ms():
+    baseline = figures('direct', 0.05, duration=8.0)
+    assert not baseline['stable']
+    assert baseline['net_work_j'] > 1.0  # joules: it diverges
+
+
+@pytest.mark.parametrize('delay', [0.05, 0.25])
+def test_tdpa_never_gives_the_hand_energy_and_keeps_the_patient_safe(delay):
+    passive = figures('tdpa', delay)
+    assert passive['net_work_j'] <= 0.0
+    assert passive['peak_patient_n'] <= MAX_PATIENT_FORCE
+
+
+@pytest.mark.parametrize('delay, transparency', [(0.025, 10.0), (0.1, 25.0), (0.25, None)])
+def test_the_model_is_stable_and_transparent_at_every_delay(delay, transparency):
+    mediated = figures('model', delay)
+    assert mediated['stable']
+    assert mediated['peak_patient_n'] <= MAX_PATIENT_FORCE
+    assert mediated['mean_patient_n'] > 5.0  # the scan does press
+    if transparency is not None:
+        assert mediated['transparency_percent'] <= transparency

@@ -1,0 +1,144 @@
+"""Both sites as real processes, each in its own DDS domain, over the link bridge with a delay.
+
+Every figure comes from the bag (what the device applied to the hand, what the remote sensor
+read) or from the nodes' own reports, never from the schemes' internal books.
+"""
+import os
+import pathlib
+import signal
+import time
+
+from domains import session_domain_id
+import numpy as np
+import pytest
+from rosbags.highlevel import AnyReader
+
+from haptic_bringup.bag import typestore_with
+from haptic_bringup.launcher import Loop, LoopConfig
+from haptic_bringup.recorder import custom_definitions
+from haptic_bringup.session import read_vectors, reported
+
+DELAY = 0.05  # [s] one way
+FORCE_SCALE = 0.3  # the leader's default
+MAX_PATIENT_FORCE = 20.0  # [N] the follower's default
+LINK_TIMEOUT = 0.1  # [s] the leader's and the follower's default
+MODEL_LIFETIME = 0.010  # [s] the leader's default
+PRESSING = (6.0, 8.0)  # [s] after the first pose: the scan holds its press, then sweeps
+STREAMS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
+           '/teleop/feedback': 'pose', '/remote/robot/ft_sensor/wrench': 'wrench',
+           '/remote/robot/tcp_pose': 'pose'}
+
+
+def teleop(folder: pathlib.Path, scheme: str = 'model', duration: float = 9.0, **link):
+    config = LoopConfig(teleop=scheme, duration=duration, record=str(folder / 'bag'),
+                        domain_id=session_domain_id(),
+                        remote_domain=session_domain_id(second=True), run_dir=folder / 'launch',
+                        link={'delay': DELAY, 'jitter': 0.1 * DELAY, 'loss': 0.01, **link})
+    return Loop(config)
+
+
+def streams(folder: pathlib.Path) -> dict:
+    typestore = typestore_with(custom_definitions())
+    topics = {topic: kind for topic, kind in STREAMS.items() if topic != '/teleop/feedback'}
+    series = read_vectors(folder / 'bag', typestore, topics)
+    with AnyReader([folder / 'bag'], default_typestore=typestore) as reader:
+        connections = [c for c in reader.connections if c.topic == '/teleop/feedback']
+        series['/teleop/feedback'] = np.array(
+            [stamp * 1e-9 for _, stamp, _ in reader.messages(connections=connections)])
+    return series
+
+
+def reports(folder: pathlib.Path, node: str, key: str) -> list:
+    """The values ``node`` reported for ``key`` on /diagnostics, in order."""
+    return reported(folder / 'bag', typestore_with(custom_definitions()), key).get(node, [])
+
+
+def window(times: np.ndarray, start: float, end: float) -> np.ndarray:
+    return (times >= start) & (times < end)
+
+
+@pytest.fixture(scope='module')
+def scan(tmp_path_factory):
+    folder = tmp_path_factory.mktemp('teleop_scan')
+    with teleop(folder) as loop:
+        assert loop.wait(60.0) is not None, 'the scan did not end'
+    return folder, streams(folder)
+
+
+def test_the_patient_is_felt_scaled_across_the_delayed_link(scan):
+    folder, series = scan
+    pose_times = series['/wand/pose'][0]
+    start = pose_times[0]
+    felt_times, felt = series['/wand/applied_wrench']
+    patient_times, patient = series['/remote/robot/ft_sensor/wrench']
+    held = window(felt_times - start, *PRESSING)
+    pressed = window(patient_times - start, *PRESSING)
+    felt_force = np.median(felt[held, 2]) / FORCE_SCALE
+    patient_force = np.median(patient[pressed, 2])
+    assert patient_force > 5.0  # the scan presses
+    assert felt_force == pytest.approx(patient_force, rel=0.15)
+    assert np.max(np.linalg.norm(patient, axis=1)) <= MAX_PATIENT_FORCE
+
+
+def test_the_operator_measures_the_round_trip_from_echoed_stamps(scan):
+    folder, _ = scan
+    round_trips = [float(v) for v in reports(folder, 'teleop_leader', 'round_trip_s')
+                   if v != 'nan']
+    assert round_trips, 'the leader never reported a round trip'
+    assert np.median(round_trips) == pytest.approx(2 * DELAY, abs=0.02)
+
+
+def test_the_bag_holds_both_sites_the_remote_one_under_remote(scan):
+    folder, series = scan
+    assert len(series['/remote/robot/tcp_pose'][0]) > 1000
+    assert len(series['/wand/pose'][0]) > 1000
+    assert reports(folder, 'teleop_follower', 'published')  # its /diagnostics, from /remote
+
+
+def test_a_link_dropped_mid_contact_zeroes_the_force_and_the_robot_retracts(tmp_path):
+    with teleop(tmp_path) as loop:
+        time.sleep(PRESSING[0] + 0.5)
+        bridge = loop.child('bridge')
+        dropped = time.time()
+        bridge.signal(signal.SIGSTOP)
+        time.sleep(1.0)
+        bridge.signal(signal.SIGCONT)
+        assert loop.wait(60.0) is not None
+    series = streams(tmp_path)
+    last_feedback = series['/teleop/feedback'][series['/teleop/feedback'] < dropped + 0.5][-1]
+    felt_times, felt = series['/wand/applied_wrench']
+    after = felt_times > last_feedback
+    zero = felt_times[after & (np.linalg.norm(felt, axis=1) == 0.0)][0]
+    # The model is valid until the leader's link timeout, and each lasts its lifetime.
+    assert zero - last_feedback <= LINK_TIMEOUT + MODEL_LIFETIME + 0.010
+    tcp_times, tcp = series['/remote/robot/tcp_pose']
+    held = window(tcp_times, dropped, dropped + 1.0)
+    assert tcp[held, 2][-1] - tcp[held, 2][0] > 0.005  # it retracted, out of the patient
+    patient = series['/remote/robot/ft_sensor/wrench'][1]
+    assert np.max(np.linalg.norm(patient, axis=1)) <= MAX_PATIENT_FORCE
+
+
+def test_a_killed_remote_site_zeroes_the_force_and_a_restarted_one_follows_again(tmp_path):
+    """The restarted site's first model finds the wand deep (the hand pressed on through the
+    silence), so a passive update shows it where the wand is: no force until the hand presses
+    further or touches again. What resumes at once is the link and the robot's following."""
+    with teleop(tmp_path, duration=18.5) as loop:
+        time.sleep(PRESSING[0] + 0.5)
+        killed = time.time()
+        os.kill(loop.child('remote').pid, signal.SIGKILL)
+        time.sleep(1.0)
+        assert loop.exited().name == 'remote'  # nothing else went down
+        loop.restart('remote')
+        assert loop.wait(60.0).name == 'operator'
+    series = streams(tmp_path)
+    felt_times, felt = series['/wand/applied_wrench']
+    feedback = series['/teleop/feedback']
+    last = feedback[feedback < killed + 0.5][-1]
+    zero = felt_times[(felt_times > last) & (np.linalg.norm(felt, axis=1) == 0.0)][0]
+    assert zero - last <= LINK_TIMEOUT + MODEL_LIFETIME + 0.010
+    resumed = feedback[feedback > killed + 1.0]
+    assert len(resumed) > 100, 'the restarted site did not answer'
+    assert reports(tmp_path, 'teleop_leader', 'link_live')[-1] == 'True'
+    tcp_times, tcp = series['/remote/robot/tcp_pose']
+    after = tcp_times > resumed[0]
+    assert tcp[after, 2].max() - tcp[after, 2].min() > 0.01  # it followed the wand's lift
