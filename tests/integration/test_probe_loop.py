@@ -95,3 +95,19 @@ def test_the_contact_model_carries_three_tool_points_of_the_pressed_face(probe_l
         assert plane.stiffness.z == pytest.approx(K * len(pressed) / (3 * len(FACE)))
     _, expected_torque = expected_wrench(tip, roll)
     assert model.wrench.torque.x == pytest.approx(expected_torque[0], rel=1e-9)
+
+
+@pytest.mark.parametrize('orientation', [(0.0, 0.0, math.nan, 1.0), (0.0, 0.0, 0.0, 0.5)])
+def test_a_bad_orientation_gets_an_invalid_state_and_no_wrench(probe_loop, client, orientation):
+    from haptic_msgs.msg import CollisionState
+
+    client.wait_connected()
+    tip = (0.0, 0.0, SURFACE - 0.004)
+    for _ in range(5):
+        stamp, wrench, _ = client.exchange(tip, orientation=orientation)
+        assert wrench is not None, f'the pose stamped {stamp} got no answer'
+        w = wrench.wrench
+        assert (w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z) == (0.0,) * 6
+        assert client.spin_until(lambda: stamp in client.states)
+        state = client.states[stamp]
+        assert state.status == CollisionState.STATUS_INVALID_INPUT and state.contact_count == 0
