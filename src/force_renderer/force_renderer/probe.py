@@ -13,7 +13,9 @@ gets exactly K d, as a point tip would. The torque about the tip is the sum of (
 x_i the face point. On a plane of stiffness k, a face rolled by θ with all of it pressed in gets
 the restoring torque −k cos θ sin θ ⟨y²⟩ (⟨y²⟩ the mean square of the points' arms along the
 tilted side: L²/12 (1 − 1/m²) for m cells along a side L; the continuous face's L²/12 as m grows).
-The damper acts on the tip's linear velocity: rotation is damped by the device and the hand.
+The damper here acts on the tip's linear velocity (the state carries no angular one); the
+device's own rendering of the model's planes damps each tool point's velocity, rotation included
+(``haptic_wand_driver.contact_model``).
 
 Contact set: the points with d > 0. With none, the law pushes nothing; its local model then
 holds the whole face, for the contact the device may meet before the next state.
