@@ -1,8 +1,8 @@
 """The report: the paper's three experiments, reproduced over ROS 2, measured against exact truth.
 
     .venv/bin/python bench/report.py [--demo-dir build/demo] [--out report]
-                                     [--skip timing tradeoff loop sweep stiffwall servo extreme
-                                             teleop]
+                                     [--skip probe timing tradeoff loop sweep stiffwall servo
+                                             extreme teleop]
                                      [--quick]
 
 Reads the bags ``demo`` recorded (the simulated wand tapping the hand, the cylinder and the
@@ -14,7 +14,8 @@ trajectories, and writes ``README.md`` with PNG figures into ``--out``: the pape
 1-3 and Tables 1, 2, 4 with its reported values beside ours, error against run time for every
 method, our GJK's tolerance trade-off, the loop against its floor, the stiffness sweep, the
 stiff wall over the loop (local against remote rendering), the servo rate, the
-extreme-geometry table, the telerobotic scan per scheme and delay, message counts, and the
+extreme-geometry table, the probe's torque against the analytic face (``report_probe``), the
+telerobotic scan per scheme and delay, message counts, and the
 machine. Every number of ours is
 computed by the run; the paper's are typed in from it (``PAPER``) and labelled as such.
 
@@ -46,6 +47,7 @@ from report_figures import (error_time_figure, experiment_figure, headline_figur
                             teleop_figure, tradeoff_figure)
 from report_metrics import measure
 from report_paper_replay import replay_paper
+from report_probe import probe_figure, read_probe_runs
 from report_provenance import provenance
 from report_recordings import control_contacts, read_recording, typestore
 from report_truth import exact_truth
@@ -55,9 +57,10 @@ import stiffness_sweep
 __all__ = ['SKIPPABLE', 'STAGES', 'build', 'main']
 
 ROOT = Path(__file__).resolve().parents[1]
-STAGES = ('bags', 'truth', 'paper', 'figures', 'timing', 'tradeoff', 'loop', 'sweep',
+STAGES = ('bags', 'truth', 'paper', 'figures', 'probe', 'timing', 'tradeoff', 'loop', 'sweep',
           'stiffwall', 'servo', 'extreme', 'teleop', 'write')
-SKIPPABLE = ('timing', 'tradeoff', 'loop', 'sweep', 'stiffwall', 'servo', 'extreme', 'teleop')
+SKIPPABLE = ('probe', 'timing', 'tradeoff', 'loop', 'sweep', 'stiffwall', 'servo', 'extreme',
+             'teleop')
 FORCE_SCALE = 0.3  # the teleop leader's default
 
 
@@ -108,6 +111,10 @@ def build(args) -> Path:
         headline_figure(measures, out / 'headline.png')
 
     stages.run('figures', 'figures 1-3 and the headline figure', figures)
+    probe = stages.run('probe', 'the probe runs against the analytic face',
+                       lambda: read_probe_runs(args.demo_dir, type_store))
+    if probe is not None and (probe.flat is not None or probe.phantom is not None):
+        probe_figure(probe, out / 'probe.png')
     quick = args.quick
     timing = stages.run('timing', 'error against run time, every method', lambda: error_time_rows(
         random=100 if quick else 300, near=100 if quick else 300, tapping=0.4 if quick else 1.0,
@@ -140,7 +147,7 @@ def build(args) -> Path:
         findings = Findings(
             recordings, truths, replays, measures, control_contacts(args.demo_dir, type_store),
             timing, bench_collision.timer_overhead() if timing else None, tradeoff, loop, sweep,
-            bound, stiff_wall, servo, extreme, teleop)
+            bound, stiff_wall, servo, extreme, probe, teleop)
         return readme(findings, provenance=provenance(), argv=args.argv, demo_dir=args.demo_dir,
                       durations=stages.durations)
 

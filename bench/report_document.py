@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from report_experiments import PAPER
+from report_probe import probe_section
 from report_sections import (counts_section, DEFINITIONS, error_time_section,
                              experiment_section, extreme_section, force_effect_section,
                              headline_section, identical_modes, interval_table, loop_section,
@@ -35,6 +36,7 @@ class Findings:
     stiff_wall: list | None
     servo: list | None
     extreme: list | None
+    probe: object | None
     teleop: dict | None
 
 
@@ -44,8 +46,8 @@ def readme(findings: Findings, *, provenance: dict, argv: list, demo_dir: Path,
     parts = (_opening(findings, provenance, [str(a) for a in argv])
              + _figures_chapter(findings, demo_dir) + _tables_chapter(findings)
              + _timing_chapter(findings) + _stability_chapter(findings)
-             + _teleop_chapter(findings)
-             + ['## 6. Messages per topic', '',
+             + _probe_chapter(findings) + _teleop_chapter(findings)
+             + ['## 7. Messages per topic', '',
                 'Published (the node\'s own count, from its last diagnostics report) and '
                 'recorded (in the bag), per experiment.', '',
                 counts_section(findings.recordings), '',
@@ -127,6 +129,28 @@ def _timing_chapter(findings: Findings) -> list[str]:
                     else [skipped('loop against its floor'), ''])
 
 
+def _probe_chapter(findings: Findings) -> list[str]:
+    parts = ['## 5. The probe is a shape: force and torque', '',
+             'A linear probe (a box with a 10 x 40 mm face, its face at the wand\'s tip: the '
+             'scenes\' `tool:` section) pressed by the scripted hand 40 mm under the surface on '
+             'its 50 N/m spring, rolled +-20 degrees in place, slid +-20 mm and yawed +-20 '
+             'degrees (`probe_sweep`), on a flat slab of 1000 N/m (`probe-flat`) and on the '
+             'patient phantom (`probe-phantom`). The face is 2 x 8 points, each at 1/16 of the '
+             'material\'s gains (`force_renderer.probe`); the hand holds roll and yaw on its '
+             '0.3 N·m/rad springs, and the face\'s torque about the roll axis turns the wand '
+             'back toward flat. Figure: (a-c) the sweep over time, the torque as rendered for '
+             'each pose and as applied in the wand\'s servo loop from the contact model\'s '
+             'three planes; (d) on the flat slab, the rendered torque against roll beside the '
+             'continuous face\'s analytic torque at each sample\'s roll and depth '
+             '(`bench/report_probe.py`). Yaw on a flat face gives no torque: there is no '
+             'friction.', '']
+    if findings.probe is None:
+        return parts + [skipped('probe runs'), '']
+    figure = (['![probe](probe.png)', ''] if findings.probe.flat is not None
+              or findings.probe.phantom is not None else [])
+    return parts + [probe_section(findings.probe), ''] + figure
+
+
 def _stability_chapter(findings: Findings) -> list[str]:
     parts = ['## 4. Numerical stability', '', '### Stiffness sweep', '',
              f'A simulated device pressed into a virtual wall, held and released '
@@ -169,7 +193,7 @@ def _stability_chapter(findings: Findings) -> list[str]:
 
 def _teleop_chapter(findings: Findings) -> list[str]:
     parts = [
-        '## 5. Telerobotic scan', '',
+        '## 6. Telerobotic scan', '',
         'The scripted sonographer approaches the patient phantom through the remote robot, '
         'presses at about 8 N, sweeps 8 cm along it and lifts, over a link of the given one-way '
         'delay with 10 % jitter and 1 % loss, per bilateral scheme: *direct* (the F/T force, '

@@ -60,6 +60,7 @@ BENCHMARKS = (
     Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4')),
     Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60')),
     Benchmark('tool', 'bench_tool.py', ('--near', '300', '--tapping', '1')),
+    Benchmark('probe', 'bench_probe.py', ('--poses', '300')),
     Benchmark('teleop_lockstep', 'teleop_lockstep.py', ('--delays', '0.05')),
     Benchmark('teleop_scan', 'teleop_scan.py', ('--delays', '0.05')),
 )

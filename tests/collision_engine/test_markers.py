@@ -89,3 +89,16 @@ def test_package_uri_of_files_in_and_out_of_shares(tmp_path):
         'package://collision_engine/scenes/meshes/hand.stl'
     assert package_uri(INSTALLED_SCENES / 'meshes' / '..' / 'hand.yaml') == \
         'package://collision_engine/scenes/hand.yaml'
+
+
+def test_a_tool_s_contact_segment_runs_from_the_tool_s_witness():
+    from collision_engine import load_scene
+    from collision_engine.markers import contact_markers
+
+    scene = load_scene(scene_path('probe_flat'))
+    result = scene.query_tool(scene.tool.shape, ((0.0, 0.0, 0.01), (0.0, 0.0, 0.0, 1.0)))
+    point, segment = contact_markers(result, 'world')
+    start, end = segment.points
+    # The probe's centre at z = 0.01: its face 30 mm below it, 5 mm above the slab's top.
+    assert (start.z, end.z) == pytest.approx((0.01 - 0.03, -0.025), abs=1e-12)
+    assert point.pose.position.z == pytest.approx(-0.025, abs=1e-12)

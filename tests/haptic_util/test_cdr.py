@@ -36,7 +36,11 @@ def message_from(cls, codec: MessageCodec, values):
             target = getattr(target, name)
             if index:
                 target = target[int(index[:-1])]
-        setattr(target, leaf, value)
+        name, _, index = leaf.partition('[')
+        if index:  # an element of an array of numbers
+            getattr(target, name)[int(index[:-1])] = value
+        else:
+            setattr(target, leaf, value)
     return message
 
 

@@ -12,8 +12,8 @@ from wand_ground_truth import Box, Cylinder, HalfSpace, wall_force
 from haptic_wand_driver.device import Workspace
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.scripts import (
-    cuboid_face_tapping, cylinder_side_tapping, hand_dorsum_tapping, ScriptError, TappingScript,
-    TappingSite, WaypointScript)
+    cuboid_face_tapping, cylinder_side_tapping, hand_dorsum_tapping, probe_sweep, ScriptError,
+    TappingScript, TappingSite, WaypointScript)
 from haptic_wand_driver.simulated import SimulatedWand
 
 TICK = 1e-3
@@ -240,3 +240,45 @@ def test_bad_aim_points_and_sites_are_refused():
         TappingScript([])
     with pytest.raises(ScriptError, match='depth'):
         TappingScript([TappingSite([0.0, 0.0, -0.05], [0.0, 0.0, 1.0])], depth=-0.01)
+
+
+# The probe sweep.
+
+def flat_floor(point):
+    """The plane z = -0.025 m, seen from above."""
+    return np.array([point[0], point[1], -0.025]), np.array([0.0, 0.0, 1.0])
+
+
+def test_the_probe_sweep_presses_rolls_slides_and_yaws_within_ten_seconds():
+    script = probe_sweep(flat_floor)
+    rows = np.column_stack((script.times, script.coordinates))
+    assert script.duration <= 10.0
+    pressed = rows[(rows[:, 0] >= 1.8) & (rows[:, 0] <= 9.0)]
+    np.testing.assert_allclose(pressed[:, 3], -0.025 - 0.04)
+    twenty = np.radians(20.0)
+    assert pressed[:, 4].max() == pytest.approx(twenty) and pressed[:, 4].min() == -twenty
+    assert pressed[:, 5].max() == pytest.approx(twenty) and pressed[:, 5].min() == -twenty
+    assert pressed[:, 1].max() == pytest.approx(0.02) and pressed[:, 1].min() == -0.02
+    np.testing.assert_allclose(rows[[1, -1], 3], -0.02)  # 5 mm above, before and after
+    # While rolled it holds still; while yawed it slides.
+    rolled = pressed[pressed[:, 4] != 0.0]
+    assert np.all(rolled[:, 1] == 0.0) and np.all(rolled[:, 5] == 0.0)
+
+
+def test_the_probe_sweep_follows_a_curved_surface_below_each_position():
+    def dome(point):  # a sphere of radius 0.2 m whose top is at z = -0.025
+        centre = np.array([0.0, 0.0, -0.225])
+        normal = (point - centre) / np.linalg.norm(point - centre)
+        return centre + 0.2 * normal, normal
+    rows = probe_sweep(dome, depth=0.01).coordinates
+    for x, z in rows[2:-1, [0, 2]]:
+        surface = -0.225 + 0.2 * 0.225 / np.hypot(x, 0.225)  # along the ray from the centre
+        assert z == pytest.approx(surface - 0.01, abs=1e-12)
+    assert rows[:, 2].min() < rows[2, 2]  # lower at the sides than at the top
+
+
+def test_the_probe_sweep_refuses_a_surface_that_does_not_face_up():
+    def wall(point):
+        return np.array([0.1, point[1], point[2]]), np.array([-1.0, 0.0, 0.0])
+    with pytest.raises(ScriptError, match='probe sweep: no upward surface below'):
+        probe_sweep(wall)

@@ -80,6 +80,15 @@ def test_force_node_refuses_bad_parameters(tmp_path, parameter, expected):
     assert expected in line and 'force_renderer' in line
 
 
+@pytest.mark.parametrize('law', ['proxy', 'centroid'])
+def test_force_node_refuses_a_point_law_for_a_scene_with_a_tool(tmp_path, law):
+    scene = tmp_path / 'scene.yaml'
+    scene.write_text('tool: {shape: {box: {size: [0.01, 0.04, 0.06]}}}\n' + CUBOID)
+    line = error_line(run_node('force_renderer.node', tmp_path, f'law:={law}',
+                               f'scene_file:={scene}'))
+    assert f"law '{law}' renders a point tip" in line and 'mounts a tool' in line, line
+
+
 @pytest.mark.parametrize('parameter, expected', [
     ('passivity:=1', "'passivity' must be true or false, got 1"),
     ('frame_id:=1.5', "'frame_id' must be a string, got 1.5"),

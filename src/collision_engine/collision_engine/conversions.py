@@ -8,15 +8,18 @@ import math
 
 from geometry_msgs.msg import PoseStamped
 
+from collision_engine.tool import MAX_FACE_POINTS
 from haptic_msgs.msg import CollisionState
 from haptic_util.cdr import MessageCodec
 
-__all__ = ['InvalidPose', 'POSE', 'STATE', 'tip_position', 'state', 'invalid_state']
+__all__ = ['InvalidPose', 'POSE', 'STATE', 'invalid_state', 'state', 'tip_pose',
+           'tool_state']
 
 UNIT_QUATERNION_TOLERANCE = 1e-3  # |q| may differ from 1 by this much (float32 round trips)
 POSE = MessageCodec(PoseStamped)
 STATE = MessageCodec(CollisionState)
 _NAN3 = (math.nan, math.nan, math.nan)
+_NO_CONTACTS = (0,) + (0.0,) * (7 * MAX_FACE_POINTS)  # contact_count and its three arrays
 
 
 class InvalidPose(ValueError):
@@ -30,10 +33,12 @@ class InvalidPose(ValueError):
         self.kind = kind
 
 
-def tip_position(pose: list, frame_id: str) -> tuple:
-    """Return the tip position (x, y, z) [m] of a pose in the scene frame, or raise InvalidPose.
+def tip_pose(pose: list, frame_id: str) -> tuple:
+    """Return the tip position (x, y, z) [m] and unit quaternion (x, y, z, w) of a pose.
 
-    ``pose`` holds the leaf fields of a PoseStamped (``POSE.fields``).
+    ``pose`` holds the leaf fields of a PoseStamped (``POSE.fields``), in the scene frame; the
+    quaternion is normalised (its norm may be off by ``UNIT_QUATERNION_TOLERANCE``, not more).
+    Raises InvalidPose for any other frame, a NaN or infinite value or a non-unit quaternion.
     """
     _, _, frame, px, py, pz, qx, qy, qz, qw = pose
     if frame != frame_id:
@@ -50,22 +55,45 @@ def tip_position(pose: list, frame_id: str) -> tuple:
     if abs(norm - 1.0) > UNIT_QUATERNION_TOLERANCE:
         raise InvalidPose('non-unit quaternion',
                           f'pose.orientation is not a unit quaternion (|q| = {norm:.6g})')
-    return (px, py, pz)
+    return (px, py, pz), (qx / norm, qy / norm, qz / norm, qw / norm)
 
 
-def state(header: tuple, result, compute_time: float, disagreements: int) -> tuple:
-    """Return CollisionState's leaf fields for one query result.
+def state(header: tuple, result, compute_time: float, disagreements: int,
+          orientation: tuple = (0.0, 0.0, 0.0, 1.0)) -> tuple:
+    """Return CollisionState's leaf fields for one query result of the tip.
 
-    ``header`` is (sec, nanosec, frame_id) of the pose answered.
+    ``header`` is (sec, nanosec, frame_id) of the pose answered, ``orientation`` its quaternion.
     """
     row = result.row
     return (*header, result.object or '', result.status, row[0], row[0] <= 0.0, *row[1:4],
             *row[4:7], *result.penetration.tolist(), *row[10:13], result.iterations,
             result.cross_validated, result.fcl_distance, result.fcl_discrepancy,
-            disagreements, compute_time)
+            disagreements, compute_time, *orientation, *row[10:13], *_NO_CONTACTS)
+
+
+def tool_state(header: tuple, probe, tip: tuple, orientation: tuple, compute_time: float,
+               disagreements: int) -> tuple:
+    """Return CollisionState's leaf fields for a mounted tool (``probe.ProbeResult``).
+
+    The distance, witnesses and normal are the whole tool's; ``tip`` (3,) is the pose's position.
+    The face's points fill the contact arrays, the rest of each array zero.
+    """
+    row = probe.tool.row
+    distance = row[0]
+    penetration = ((-distance * row[4], -distance * row[5], -distance * row[6])
+                   if distance <= 0.0 else (0.0, 0.0, 0.0))
+    count = len(probe.distance)
+    padding = (0.0,) * (MAX_FACE_POINTS - count)
+    padding3 = padding * 3
+    return (*header, probe.tool.object or '', probe.tool.status, distance, distance <= 0.0,
+            *row[1:4], *row[4:7], *penetration, *tip, probe.tool.iterations, False, math.nan,
+            math.nan, disagreements, compute_time, *orientation, *row[10:13], count,
+            *probe.distance.tolist(), *padding, *probe.points.ravel().tolist(), *padding3,
+            *probe.normals.ravel().tolist(), *padding3)
 
 
 def invalid_state(header: tuple, disagreements: int) -> tuple:
     """Return the leaf fields of a state marked invalid: the renderer then sends zero force."""
     return (*header, '', CollisionState.STATUS_INVALID_INPUT, math.nan, False, *_NAN3, *_NAN3,
-            *_NAN3, *_NAN3, 0, False, math.nan, math.nan, disagreements, 0.0)
+            *_NAN3, *_NAN3, 0, False, math.nan, math.nan, disagreements, 0.0, *_NAN3, math.nan,
+            *_NAN3, *_NO_CONTACTS)

@@ -46,7 +46,11 @@ def scene_markers(spec: SceneSpec) -> list:
 
 
 def contact_markers(result, frame_id: str) -> list:
-    """Mark the closest point (red in contact, green outside) and the tip-to-surface segment."""
+    """Mark the closest point (red in contact, green outside) and the tip-to-surface segment.
+
+    ``result`` is a tip's ``QueryResult`` or a tool's ``ToolResult``: the segment starts at its
+    row's tip slot, the tip or the tool's witness.
+    """
     if result is None or not math.isfinite(result.distance):
         return []
     color = CONTACT_COLOR if result.in_collision else FREE_COLOR
@@ -57,7 +61,7 @@ def contact_markers(result, frame_id: str) -> list:
     point.scale.x = point.scale.y = point.scale.z = size
     segment = Marker(ns='contact/segment', id=1, type=Marker.LINE_LIST, action=Marker.ADD)
     segment.pose.orientation.w = 1.0
-    segment.points = [_point(result.tip), _point(result.point)]
+    segment.points = [_point(result.row[10:13]), _point(result.point)]
     segment.scale.x = size / 4
     for marker in (point, segment):
         marker.header.frame_id = frame_id

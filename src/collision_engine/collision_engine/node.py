@@ -1,9 +1,10 @@
 """The collision node: tip pose in, signed distance to the nearest scene object out.
 
 Subscribes ``wand/pose`` (PoseStamped) and publishes, per pose, ``collision/state``
-(CollisionState) with the pose's header, so that latency can be measured end to end. Optionally
-``collision/nearby`` (every object within ``report_radius``), ``collision/markers`` for RViz,
-``scene/description`` (the scene YAML, latched, for recorders) and ``/diagnostics``.
+(CollisionState) with the pose's header, so that latency can be measured end to end. When
+the scene mounts a tool, the whole pose places it and the state carries its face (``probe``).
+Optionally ``collision/nearby`` (every object within ``report_radius``), ``collision/markers``
+for RViz, ``scene/description`` (the scene YAML, latched, for recorders) and ``/diagnostics``.
 
 The 1 kHz streams are read and written as CDR bytes (``haptic_util.cdr``): converting message
 objects cost about half of the node's CPU.
@@ -17,9 +18,10 @@ from visualization_msgs.msg import MarkerArray
 
 from collision_engine import load_scene, read_scene
 from collision_engine.conversions import (invalid_state, InvalidPose, POSE, STATE, state,
-                                          tip_position)
+                                          tip_pose, tool_state)
 from collision_engine.markers import contact_markers, scene_markers
 from collision_engine.params import CollisionNodeParams
+from collision_engine.probe import query_probe
 from haptic_msgs.msg import CollisionState, CollisionStateArray
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
@@ -69,17 +71,23 @@ class CollisionNode(Node):
         pose = POSE.decode(data)
         header = (pose[0], pose[1], pose[2])
         try:
-            tip = tip_position(pose, self.scene.frame_id)
+            tip, orientation = tip_pose(pose, self.scene.frame_id)
         except InvalidPose as error:
             self._refused.add(error.kind, str(error))
             self._state_pub.publish(STATE.encode(invalid_state(header, self._disagreements())))
             return
         start = time.perf_counter()
-        result = self.scene.query(tip)
-        elapsed = time.perf_counter() - start
+        if self.scene.tool is None:
+            result = self.scene.query(tip)
+            elapsed = time.perf_counter() - start
+            fields = state(header, result, elapsed, self._disagreements(), orientation)
+        else:
+            probe = query_probe(self.scene, tip, orientation)
+            elapsed = time.perf_counter() - start
+            result = probe.tool
+            fields = tool_state(header, probe, tip, orientation, elapsed, self._disagreements())
         self._last_result = result
-        self._state_pub.publish(STATE.encode(state(header, result, elapsed,
-                                                   self._disagreements())))
+        self._state_pub.publish(STATE.encode(fields))
         self._answered += 1
         if self._nearby_pub is not None:
             self.publish_nearby(header, tip)

@@ -19,13 +19,14 @@ from scipy.spatial.transform import Rotation
 from collision_engine import _kernels
 from collision_engine._jit import compiling
 from collision_engine.distance import DistanceRequest
-from collision_engine.errors import MeshError
+from collision_engine.errors import MeshError, SceneError
 from collision_engine.gjk import STATUS_INVALID_INPUT
 from collision_engine.results import BatchResult, QueryResult, ToolResult
 from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CrossValidationSpec,
-                                         CylinderSpec, MaterialSpec, read_scene, SphereSpec)
+                                         CylinderSpec, MaterialSpec, MeshSpec, read_scene,
+                                         SphereSpec)
 from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, TriangleMesh
-from collision_engine.tool import DEFAULT_SHELL_SPACING, pack_tool
+from collision_engine.tool import DEFAULT_SHELL_SPACING, load_tool, mount_tool, pack_tool
 from collision_engine.transforms import Pose
 
 __all__ = ['Scene', 'SceneObject', 'load_scene']
@@ -96,14 +97,18 @@ class Scene:
         The largest tool ``query_tool`` accepts (its bounding diameter): the workspace's size.
     shell_spacing : float, m
         The point shell's spacing of a tool against a non-convex mesh (``tool``).
+    tool : MountedTool, optional
+        The probe the scene file mounts on the wand (``tool.mount_tool``); None for a point or
+        sphere tip. Kept for its user (``probe.query_probe``): no query reads it.
     """
 
     def __init__(self, objects, *, frame_id: str = 'world', tip_radius: float = 0.0,
                  request: DistanceRequest | None = None,
                  cross_validation: CrossValidationSpec | None = None,
                  workspace_size: float = DEFAULT_WORKSPACE_SIZE,
-                 shell_spacing: float = DEFAULT_SHELL_SPACING) -> None:
+                 shell_spacing: float = DEFAULT_SHELL_SPACING, tool=None) -> None:
         self.objects = tuple(objects)
+        self.tool = tool
         self.frame_id = frame_id
         if not (tip_radius >= 0.0 and math.isfinite(tip_radius)):
             raise ValueError(f'tip_radius must be a finite number >= 0 (m), got {tip_radius!r}')
@@ -218,6 +223,17 @@ class Scene:
         _kernels.query_points(self._floats, self._ints, points, rows.reshape(-1))
         return BatchResult.from_rows(rows, self._names)
 
+    def query_rows(self, points: np.ndarray) -> np.ndarray:
+        """Return each point's packed row (n, ``_kernels.OUT_SIZE``), unchecked, for a hot loop.
+
+        ``query_many`` without its checks and copies: ``points`` must be a C-contiguous
+        (n, 3) float64 array of finite values (a validated pose's probe face is). Columns as
+        ``_PackedRow.row``: distance, point (3), normal (3), object index, ...
+        """
+        rows = np.empty((len(points), _kernels.OUT_SIZE))
+        _kernels.query_points(self._floats, self._ints, points, rows.reshape(-1))
+        return rows
+
     def query_within(self, point, radius: float) -> list[QueryResult]:
         """Every object whose signed distance from the tip is at most ``radius``, nearest first.
 
@@ -323,10 +339,29 @@ def load_scene(path, *, request: DistanceRequest | None = None,
         except MeshError as error:
             raise MeshError(f'{spec.path}: objects[{index}].shape.mesh.file: {error}') from None
         objects.append(SceneObject(declared.name, shape, declared.pose, declared.material))
+    tool = None if spec.tool is None else _mount(spec)
     scene = Scene(objects, frame_id=spec.frame_id, tip_radius=spec.tip_radius,
-                  request=request, cross_validation=spec.cross_validation)
-    scene.warm_up(announce)
+                  request=request, cross_validation=spec.cross_validation, tool=tool)
+    scene.warm_up(announce, tool=None if tool is None else tool.shape)
     return scene
+
+
+def _mount(spec):
+    """Build and mount the scene file's tool; errors name the file and the key."""
+    declared = spec.tool
+    if isinstance(declared.shape, MeshSpec):
+        try:
+            _import_trimesh_without_fcl()
+            shape = load_tool(declared.shape.file, scale=declared.shape.scale)
+        except MeshError as error:
+            raise MeshError(f'{spec.path}: tool.shape.mesh.file: {error}') from None
+    else:
+        shape = _build_shape(declared.shape, False)
+    try:
+        return mount_tool(shape, declared.offset, face_spacing=declared.face_spacing,
+                          workspace_size=DEFAULT_WORKSPACE_SIZE)
+    except ValueError as error:
+        raise SceneError(f'{spec.path}: tool: {error}') from None
 
 
 def _build_shape(spec, check_self_intersection: bool):

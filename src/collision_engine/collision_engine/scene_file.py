@@ -10,6 +10,10 @@ Format (SI units, REP-103 frames; paths relative to the scene file)::
 
     frame_id: world                 # optional, default world
     tip_radius: 0.0                 # optional, m: the wand tip is a sphere of this radius
+    tool:                           # optional: the probe, a convex shape (not with tip_radius)
+      shape: {box: {size: [0.01, 0.04, 0.06]}}
+      offset: {position: [0.0, 0.0, 0.03], rpy: [0.0, 0.0, 0.0]}   # tool frame in the tip frame
+      face_spacing: 0.005           # optional, m: the contact face's point grid (``tool``)
     cross_validation: {fcl: true, every: 10, tolerance: 1.0e-6}   # optional, default off
     objects:
       - name: cuboid                # unique
@@ -23,6 +27,11 @@ convex}`` (``file`` relative to the scene file's folder, absolute, ``~/...`` or
 ``package://<pkg>/<path>``; ``scale`` from file units to m, default 1; ``convex`` true queries
 the mesh's convex hull by GJK, false the exact non-convex surface; omitted, it is detected on
 load).
+
+The tool takes the same shapes but a mesh must be convex (``convex: false`` is refused here, a
+non-convex file when the scene is loaded, naming the file). Without a ``tool`` the tip is a point
+(or a sphere of ``tip_radius``). Its size against the workspace is checked on load, where the
+workspace is known.
 """
 
 from dataclasses import dataclass
@@ -37,7 +46,7 @@ from collision_engine.errors import SceneError
 from collision_engine.transforms import Pose
 
 __all__ = ['BoxSpec', 'CapsuleSpec', 'CrossValidationSpec', 'CylinderSpec', 'MaterialSpec',
-           'MeshSpec', 'ObjectSpec', 'SceneSpec', 'SphereSpec', 'read_scene']
+           'MeshSpec', 'ObjectSpec', 'SceneSpec', 'SphereSpec', 'ToolSpec', 'read_scene']
 
 
 @dataclass(frozen=True)
@@ -107,15 +116,27 @@ class ObjectSpec:
 
 
 @dataclass(frozen=True, eq=False)
+class ToolSpec:
+    """The probe: ``shape`` (a *Spec), ``offset`` (its frame in the tip's), ``face_spacing`` m."""
+
+    shape: BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec
+    offset: Pose
+    face_spacing: float
+
+
+@dataclass(frozen=True, eq=False)
 class SceneSpec:
-    """A validated scene file: ``path``, ``frame_id``, ``tip_radius`` m, objects."""
+    """A validated scene file: ``path``, ``frame_id``, ``tip_radius`` m, objects, ``tool``."""
 
     path: Path
     frame_id: str
     tip_radius: float
     cross_validation: CrossValidationSpec
     objects: tuple[ObjectSpec, ...]
+    tool: ToolSpec | None = None
 
+
+DEFAULT_FACE_SPACING = 0.005  # m: a 10 x 40 mm probe face gets 2 x 8 points
 
 _SHAPE_KEYS = {
     'box': (('size',), ()),
@@ -220,7 +241,7 @@ def read_scene(path) -> SceneSpec:
         raise SceneError(f'{path}: {at}: not valid YAML: '
                          f'{getattr(error, "problem", error)}') from None
     top = reader.mapping(document, '', ('objects',),
-                         ('frame_id', 'tip_radius', 'cross_validation'))
+                         ('frame_id', 'tip_radius', 'cross_validation', 'tool'))
     frame_id = reader.text(top.get('frame_id', 'world'), 'frame_id')
     tip_radius = reader.number(top.get('tip_radius', 0.0), 'tip_radius', minimum=0.0)
     cross_validation = _cross_validation(reader, top.get('cross_validation', {}))
@@ -232,7 +253,23 @@ def read_scene(path) -> SceneSpec:
     for i, name in enumerate(names):
         if name in names[:i]:
             reader.fail(f'objects[{i}].name', f'duplicate name {name!r}')
-    return SceneSpec(path, frame_id, tip_radius, cross_validation, objects)
+    tool = None
+    if top.get('tool') is not None:
+        if tip_radius > 0.0:
+            reader.fail('tool', 'give tool or tip_radius, not both (the tool is the tip)')
+        tool = _tool(reader, top['tool'])
+    return SceneSpec(path, frame_id, tip_radius, cross_validation, objects, tool)
+
+
+def _tool(reader: _Reader, value) -> ToolSpec:
+    fields = reader.mapping(value, 'tool', ('shape',), ('offset', 'face_spacing'))
+    shape = _shape(reader, fields['shape'], 'tool.shape')
+    if isinstance(shape, MeshSpec) and shape.convex is False:
+        reader.fail('tool.shape.mesh.convex', 'must be true or omitted: a tool is convex')
+    offset = _pose(reader, fields.get('offset', {}), 'tool.offset')
+    spacing = reader.number(fields.get('face_spacing', DEFAULT_FACE_SPACING),
+                            'tool.face_spacing', minimum=0.0, strict=True)
+    return ToolSpec(shape, offset, spacing)
 
 
 def _cross_validation(reader: _Reader, value) -> CrossValidationSpec:

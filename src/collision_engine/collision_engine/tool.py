@@ -13,6 +13,7 @@ surface is measured exactly; a bump of the surface narrower than the spacing can
 shell points, undercounting the depth by at most the bump's height over one spacing.
 """
 
+from dataclasses import dataclass
 import math
 from pathlib import Path
 import weakref
@@ -22,14 +23,18 @@ import numpy as np
 from collision_engine.errors import MeshError
 from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere
 from collision_engine.support import pack_convex
+from collision_engine.transforms import Pose
 
-__all__ = ['BOX_FLOATS', 'DEFAULT_SHELL_SPACING', 'FLOAT_HEADER', 'INT_HEADER', 'load_tool',
-           'pack_tool', 'point_shell']
+__all__ = ['BOX_FLOATS', 'DEFAULT_SHELL_SPACING', 'FLOAT_HEADER', 'INT_HEADER',
+           'MAX_FACE_POINTS', 'MountedTool', 'face_shell', 'load_tool', 'mount_tool', 'pack_tool',
+           'point_shell']
 
 DEFAULT_SHELL_SPACING = 0.005  # m
 FLOAT_HEADER = 8  # radius, bounding radius, bounding centre (3), spacing, shell at, work at
 INT_HEADER = 2  # kind, shell points
 BOX_FLOATS = 25  # the tool's extents in an object's frame (``tool_mesh._set_tool_box``)
+MAX_FACE_POINTS = 32  # as haptic_msgs/CollisionState's contact arrays
+_FACE_TOLERANCE = 1e-9  # m: a hull vertex this near the lowest z lies on the face
 _CONVEX = (Box, Sphere, Cylinder, Capsule, ConvexMesh)
 _PACKED = weakref.WeakKeyDictionary()
 
@@ -96,6 +101,113 @@ def point_shell(shape, spacing: float = DEFAULT_SHELL_SPACING) -> np.ndarray:
     if isinstance(shape, Cylinder):
         return _cylinder_shell(shape.radius, shape.height, spacing)
     return _hull_shell(shape, spacing)
+
+
+def _cell_centres(lower, upper, spacing: float) -> np.ndarray:
+    """Centres (m, 2) of a grid of cells no wider than ``spacing`` over a rectangle."""
+    axes = []
+    for low, high in zip(lower, upper):
+        count = max(1, int(math.ceil((high - low) / spacing - 1e-9)))
+        axes.append(low + (np.arange(count) + 0.5) * (high - low) / count)
+    return np.stack(np.meshgrid(*axes, indexing='ij'), axis=-1).reshape(-1, 2)
+
+
+def _on_z(points: np.ndarray, z: float) -> np.ndarray:
+    return np.column_stack((points, np.full(len(points), z)))
+
+
+def _hull_face(shape: ConvexMesh, spacing: float) -> np.ndarray:
+    """Cell centres inside the hull's lowest face, or its lowest vertices if it has no face."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    z = shape.vertices[:, 2].min()
+    corners = shape.vertices[shape.vertices[:, 2] <= z + _FACE_TOLERANCE][:, :2]
+    try:
+        outline = ConvexHull(corners)
+    except (QhullError, ValueError):  # a vertex or an edge at the bottom: no area to share
+        return _on_z(corners, z)
+    cells = _cell_centres(corners.min(axis=0), corners.max(axis=0), spacing)
+    inside = np.all(cells @ outline.equations[:, :2].T + outline.equations[:, 2] <= 0.0, axis=1)
+    return _on_z(cells[inside], z)
+
+
+def face_shell(shape, spacing: float) -> tuple[np.ndarray, float]:
+    """Return the tool's contact face as points, and the radius to add to them (module doc).
+
+    Parameters
+    ----------
+    shape : Box, Sphere, Cylinder, Capsule or ConvexMesh
+    spacing : float, m
+        The widest cell of the grid on the face.
+
+    Returns
+    -------
+    points : (n, 3) float64, m, the tool's frame
+    radius : float, m
+        The tool's surface lies this far out of the points (0 but for a sphere or capsule).
+    """
+    if isinstance(shape, Sphere):
+        return np.zeros((1, 3)), shape.radius
+    if isinstance(shape, Capsule):
+        return np.array([[0.0, 0.0, -0.5 * shape.length]]), shape.radius
+    if isinstance(shape, Box):
+        half = 0.5 * np.asarray(shape.size)
+        return _on_z(_cell_centres(-half[:2], half[:2], spacing), -half[2]), 0.0
+    if isinstance(shape, Cylinder):
+        r = shape.radius
+        cells = _cell_centres((-r, -r), (r, r), spacing)
+        inside = cells[np.einsum('ij,ij->i', cells, cells) <= r * r]
+        return _on_z(inside if len(inside) else np.zeros((1, 2)), -0.5 * shape.height), 0.0
+    return _hull_face(shape, spacing), 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class MountedTool:
+    """A tool on the wand: its shape, its frame in the tip's, and its contact face.
+
+    Attributes
+    ----------
+    shape : Box, Sphere, Cylinder, Capsule or ConvexMesh
+        In its own frame.
+    offset : Pose
+        The tool's frame in the tip frame.
+    offset_quaternion : tuple of 4 float
+        The offset's rotation, (x, y, z, w).
+    face : (n, 3) float64, m, the tip frame
+        The contact face's points (``face_shell``), n <= ``MAX_FACE_POINTS``.
+    radius : float, m
+        The surface lies this far out of the face points.
+    """
+
+    shape: object
+    offset: Pose
+    offset_quaternion: tuple
+    face: np.ndarray
+    radius: float
+
+
+def mount_tool(shape, offset: Pose, *, face_spacing: float,
+               workspace_size: float) -> MountedTool:
+    """Check a tool and mount it at ``offset`` from the tip.
+
+    Raises
+    ------
+    ValueError
+        If the shape is not convex, is larger than the workspace, or its face has more than
+        ``MAX_FACE_POINTS`` points at this spacing.
+    """
+    _refuse(shape, workspace_size)
+    face, radius = face_shell(shape, face_spacing)
+    if len(face) > MAX_FACE_POINTS:
+        raise ValueError(f'the tool\'s face has {len(face)} points at a face_spacing of '
+                         f'{face_spacing:g} m, more than the {MAX_FACE_POINTS} a collision '
+                         'state carries: use a wider spacing')
+    from scipy.spatial.transform import Rotation
+
+    face = offset.to_world(face)
+    face.setflags(write=False)
+    quaternion = tuple(Rotation.from_matrix(offset.rotation).as_quat().tolist())
+    return MountedTool(shape, offset, quaternion, face, radius)
 
 
 def _refuse(shape, workspace_size: float) -> None:

@@ -13,7 +13,7 @@ import numpy as np
 
 from force_renderer._checks import vector3
 
-__all__ = ['Contact', 'STATUS_OK', 'STATUS_NOT_CONVERGED', 'STATUS_NO_OBJECT',
+__all__ = ['Contact', 'FaceContact', 'STATUS_OK', 'STATUS_NOT_CONVERGED', 'STATUS_NO_OBJECT',
            'STATUS_INVALID_INPUT']
 
 # The collision engine's status codes, as haptic_msgs/CollisionState defines them.
@@ -21,6 +21,33 @@ STATUS_OK = 0
 STATUS_NOT_CONVERGED = 1  # the distance is an upper bound: the force from it is never stronger
 STATUS_NO_OBJECT = 2
 STATUS_INVALID_INPUT = 3
+
+
+@dataclass(frozen=True, eq=False)
+class FaceContact:
+    """The tool's face against the scene, from one collision state (scene frame, SI).
+
+    Attributes
+    ----------
+    distance : (n,) float, m
+        Signed distance of each face point to the nearest surface, negative inside.
+    points : (n, 3) float, m
+        The face points, on the tool's surface.
+    normals : (n, 3) float
+        Unit outward normal of the surface nearest each point.
+    rotation : (3, 3) float
+        The tip's orientation (its frame's axes as columns), for the tool points of the model.
+    """
+
+    distance: np.ndarray
+    points: np.ndarray
+    normals: np.ndarray
+    rotation: np.ndarray
+
+    @property
+    def depth(self) -> np.ndarray:
+        """(n,) float, m: each point's depth in the surface, zero outside."""
+        return np.maximum(-self.distance, 0.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,6 +73,8 @@ class Contact:
         Stamp of the pose the state answers; carried through to the wrench.
     status : int
         The engine's status (``STATUS_*``).
+    face : FaceContact or None
+        The tool's face against the scene when the scene has a tool (``probe``), else None.
     """
 
     distance: float
@@ -55,6 +84,7 @@ class Contact:
     object: str = ''
     stamp: float = 0.0
     status: int = STATUS_OK
+    face: FaceContact | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, 'distance', float(self.distance))

@@ -31,6 +31,10 @@ class PerObjectLaw:
         """Force on the tip, (3,) float, N, by the law of the contact's object."""
         return self._law(contact).force(contact, velocity)
 
+    def torque(self, contact: Contact):
+        """Return the torque of the contact's object's law; see `ForceLaw.torque`."""
+        return self._law(contact).torque(contact)
+
     def axis(self, contact: Contact):
         """Return the axis of the contact's object's law; see `ForceLaw.axis`."""
         return self._law(contact).axis(contact)

@@ -2,22 +2,25 @@
 
 Subscribes ``collision/state`` (CollisionState) and, when the materials have damping and
 ``velocity_source`` is ``twist``, ``wand/twist`` (TwistStamped). Publishes one ``wand/wrench``
-(WrenchStamped) per state, with the state's header (the pose's stamp and frame), force at the tip,
-zero torque: the reference force, which a device without local rendering applies. With it, one
+(WrenchStamped) per state, with the state's header (the pose's stamp and frame), force and torque
+about the tip (zero but for a scene's tool, whose face gives one: ``probe``): the reference
+wrench, which a device without local rendering applies. With it, one
 ``wand/contact_model`` (ContactModel): the local model the device renders at its servo rate.
 When no fresh state arrives for ``watchdog_timeout``, it publishes zero wrenches (and models that
 render nothing). The 1 kHz streams are read and written as CDR bytes (``haptic_util.cdr``).
 """
 from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
+import numpy as np
 from rclpy.node import Node
 from visualization_msgs.msg import Marker
 
-from force_renderer.contact import Contact
+from force_renderer.contact import Contact, FaceContact
 from force_renderer.local_model import local_model, MAX_PLANES
 from force_renderer.materials import PerObjectLaw
 from force_renderer.params import ForceRendererParams
 from force_renderer.passivity import passivity_warning
 from force_renderer.pipeline import ForcePipeline, PipelineConfig
+from force_renderer.probe import ProbeSpringDamper
 from force_renderer.proxy import GodObjectProxy
 from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
@@ -37,7 +40,10 @@ PLANE_FIELDS = 15  # leaves of a ContactPlane
 STATE = MessageCodec(CollisionState)
 TWIST = MessageCodec(TwistStamped)
 WRENCH = MessageCodec(WrenchStamped)
-_NO_TORQUE = (0.0, 0.0, 0.0)  # the laws render a force at the tip
+_ZERO = (0.0, 0.0, 0.0)
+_ORIENTATION = STATE.fields.index('orientation.x')
+_FACE = STATE.fields.index('contact_count')  # then the distances, points and normals
+_FACE_SIZE = len(CollisionState().contact_distance)
 
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -68,7 +74,7 @@ class ForceNode(Node):
         self._published = 0
         self._zeroed = Tally()  # zero forces sent, by reason
         self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
-        self._force = (0.0, 0.0, 0.0)
+        self._force = self._torque = _ZERO
         self._wrench_pub = self.create_publisher(WrenchStamped, 'wand/wrench', HAPTIC_STREAM_QOS)
         self._model_pub = self.create_publisher(ContactModel, 'wand/contact_model',
                                                 HAPTIC_STREAM_QOS)
@@ -100,6 +106,12 @@ class ForceNode(Node):
         materials = {o.name: (tuple(o.material.stiffness), tuple(o.material.damping))
                      for o in spec.objects if o.material is not None}
         gains = [default, *materials.values()]
+        if spec.tool is not None:
+            if params.law != 'normal':
+                raise ValueError(f'law {params.law!r} renders a point tip, and the scene '
+                                 f'{scene_path} mounts a tool: use the normal law')
+            laws = {name: ProbeSpringDamper(*gain) for name, gain in materials.items()}
+            return PerObjectLaw(laws, ProbeSpringDamper(*default)), gains
         if params.law == 'proxy':
             from collision_engine import load_scene
             scene = load_scene(scene_path, announce=self.get_logger().info)  # warmed up
@@ -122,12 +134,13 @@ class ForceNode(Node):
         self._twist = (sec * 1_000_000_000 + nanosec, (vx, vy, vz))
 
     def on_state(self, data: bytes) -> None:
+        fields = STATE.decode(data)
         (sec, nanosec, frame, name, status, distance, _, px, py, pz, nx, ny, nz, _, _, _,
-         tx, ty, tz, *_) = STATE.decode(data)
+         tx, ty, tz) = fields[:19]
         stamp_ns = sec * 1_000_000_000 + nanosec
         self._approximate += status == CollisionState.STATUS_NOT_CONVERGED
         self._contact = Contact(distance, (px, py, pz), (nx, ny, nz), (tx, ty, tz), name,
-                                stamp_ns * 1e-9, status)
+                                stamp_ns * 1e-9, status, _face(fields))
         self._header = (sec, nanosec, frame)
         self.render(self._velocity(stamp_ns))
 
@@ -147,7 +160,8 @@ class ForceNode(Node):
         # Even the watchdog's zero carries the stamp of the state it judged, so it never
         # supersedes an answer to a newer pose still on its way to the driver.
         self._force = (float(force[0]), float(force[1]), float(force[2]))
-        self._wrench_pub.publish(WRENCH.encode((*self._header, *self._force, *_NO_TORQUE)))
+        self._torque = self.pipeline.last_torque
+        self._wrench_pub.publish(WRENCH.encode((*self._header, *self._force, *self._torque)))
         model = local_model(self.pipeline.law, self._contact, reason is Reason.OK,
                             self.params.model_radius)
         self._model_pub.publish(MODEL.encode(self._model_fields(model)))
@@ -155,13 +169,14 @@ class ForceNode(Node):
 
     def _model_fields(self, model) -> tuple:
         """Return the leaf fields of the ContactModel of ``model`` and the current contact."""
-        planes = [value for point, normal, stiffness, damping in model.planes
-                  for value in (*point, *normal, *stiffness, *damping, 0.0, 0.0, 0.0)]
+        planes = [value for plane in model.planes
+                  for value in (*plane[0], *plane[1], *plane[2], *plane[3],
+                                *(plane[4] if len(plane) > 4 else _ZERO))]
         planes += [0.0] * (PLANE_FIELDS * MAX_PLANES - len(planes))
         tip = self._contact.tip.tolist()
         return (*self._header, self._contact.object, model.kind, len(model.planes), *planes,
                 self.params.force_limit, self.params.model_lifetime, model.valid_radius, *tip,
-                *self._force, *_NO_TORQUE)
+                *self._force, *self._torque)
 
     def check_stale(self) -> None:
         """Publish zero force while the collision state is stale (after the first one)."""
@@ -204,6 +219,21 @@ class ForceNode(Node):
         self.diagnostics.final()
         self.get_logger().info(f'published {self._published} wrenches')
         return super().destroy_node()
+
+
+def _face(fields: list) -> FaceContact | None:
+    """Return the tool's face from a CollisionState's leaves, or None when it has no tool."""
+    count = fields[_FACE]
+    if count == 0:
+        return None
+    from collision_engine.probe import rotation_matrix
+
+    at, size = _FACE + 1, _FACE_SIZE
+    distance = np.array(fields[at:at + count])
+    points = np.array(fields[at + size:at + size + 3 * count]).reshape(count, 3)
+    normals = np.array(fields[at + 4 * size:at + 4 * size + 3 * count]).reshape(count, 3)
+    return FaceContact(distance, points, normals,
+                       rotation_matrix(fields[_ORIENTATION:_ORIENTATION + 4]))
 
 
 def main(args=None) -> int:

@@ -76,6 +76,10 @@ class ForcePipeline:
         Why the last force is what it is (anything but OK means it was zeroed).
     last_stamp : float, s
         Stamp of the state the last force answers (NaN when there was none), for the wrench.
+    last_torque : (3,) float, N·m
+        Torque about the tip that goes with the last force (a tool's face, ``probe``): the
+        law's, scaled as the saturation scaled its force, zero whenever the force was zeroed.
+        The passivity controller watches the force's port only.
     """
 
     def __init__(self, law: ForceLaw, config: PipelineConfig = PipelineConfig()) -> None:
@@ -88,6 +92,7 @@ class ForcePipeline:
             if config.passivity else None
         self.last_reason = Reason.NO_STATE
         self.last_stamp = math.nan
+        self.last_torque = _ZERO
 
     def step(self, contact: Contact | None, velocity, now: float) -> np.ndarray:
         """Render one servo step.
@@ -113,6 +118,7 @@ class ForcePipeline:
         self.last_reason = reason
         self.last_stamp = math.nan if contact is None else contact.stamp
         position, force, axis = None, _ZERO, None
+        self.last_torque = _ZERO
         if reason is Reason.OK or reason is Reason.STALE:
             position = floats3(contact.tip)
         else:
@@ -120,8 +126,12 @@ class ForcePipeline:
         if reason is Reason.OK:
             estimate = self.velocity_estimator.update_components(contact.stamp, position)
             twist = estimate if twist is None else twist
-            force = saturate_components(*floats3(self.law.force(contact, twist)), limit)
+            raw = floats3(self.law.force(contact, twist))
+            force = saturate_components(*raw, limit)
             axis = self.law.axis(contact)
+            torque = self.law.torque(contact)
+            if torque != _ZERO:
+                self.last_torque = _scaled(torque, force, raw)
         if self.passivity is not None:
             force = saturate_components(
                 *self.passivity.control(force, twist, position, now, axis), limit)
@@ -143,10 +153,23 @@ class ForcePipeline:
         return unanswered if reason is Reason.OK and unanswered is not None else reason
 
 
+def _scaled(torque, force, raw) -> tuple[float, float, float]:
+    """Return ``torque`` scaled by |force| / |raw|: the share of the law's force kept."""
+    kept = math.hypot(*force)
+    whole = math.hypot(*raw)
+    scale = kept / whole if whole > 0.0 else 1.0
+    return (torque[0] * scale, torque[1] * scale, torque[2] * scale)
+
+
 def _finite(contact: Contact, velocity: tuple[float, float, float] | None) -> bool:
     """Tell whether every number of the contact (and of the velocity, if given) is finite."""
     isfinite = math.isfinite
+    face = contact.face
     return (isfinite(contact.distance) and all(map(isfinite, contact.point.tolist()))
             and all(map(isfinite, contact.normal.tolist()))
             and all(map(isfinite, contact.tip.tolist()))
-            and (velocity is None or all(map(isfinite, velocity))))
+            and (velocity is None or all(map(isfinite, velocity)))
+            and (face is None or bool(np.isfinite(face.distance).all()
+                                      and np.isfinite(face.points).all()
+                                      and np.isfinite(face.normals).all()
+                                      and np.isfinite(face.rotation).all())))

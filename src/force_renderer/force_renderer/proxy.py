@@ -103,6 +103,10 @@ class GodObjectProxy:
             stretch.tolist(), (stretch / length).tolist(), floats3(velocity),
             self.stiffness.tolist(), self.damping.tolist()))
 
+    def torque(self, contact: Contact) -> tuple[float, float, float]:
+        """Return zero: the proxy pulls the tip itself; see `ForceLaw.torque`."""
+        return (0.0, 0.0, 0.0)
+
     def axis(self, contact: Contact) -> tuple[float, float, float] | None:
         """Return the direction from the tip to the proxy while touching; see `ForceLaw.axis`."""
         if not self._touching:

@@ -19,6 +19,7 @@ __all__ = ['CentroidSpringDamper', 'ForceLaw', 'SpringDamper', 'nearest_plane',
            'unilateral_spring_damper']
 
 Vector3 = tuple[float, float, float]
+_ZERO = (0.0, 0.0, 0.0)
 
 
 class ForceLaw(Protocol):
@@ -28,6 +29,12 @@ class ForceLaw(Protocol):
         """Force on the tip, (3,) float, N, in the contact's frame; zero out of contact.
 
         `velocity` is the tip velocity, (3,) float, m/s, same frame.
+        """
+
+    def torque(self, contact: Contact) -> Vector3:
+        """Return the torque about the tip (N·m) that came with the last `force`.
+
+        Zero for a law that pushes the tip itself; a tool's face gives one (``probe``).
         """
 
     def axis(self, contact: Contact) -> Vector3 | None:
@@ -40,7 +47,8 @@ class ForceLaw(Protocol):
         """Return the planes a device may render for this contact, or None if it has no model.
 
         Each plane is (point (3,) m, unit outward normal (3,), stiffness (3,) N/m, damping (3,)
-        N·s/m), the point on the plane the tip's centre may not cross (``local_model``).
+        N·s/m), the point on the plane the tip's centre may not cross (``local_model``), and
+        optionally the tool point it pushes (3,) m in the tip frame (omitted: the tip).
         """
 
 
@@ -110,6 +118,10 @@ class SpringDamper:
             contact.penetration.tolist(), contact.normal.tolist(), floats3(velocity),
             self._stiffness, self._damping))
 
+    def torque(self, contact: Contact) -> Vector3:
+        """Return zero: the force acts at the tip; see `ForceLaw.torque`."""
+        return _ZERO
+
     def axis(self, contact: Contact) -> Vector3 | None:
         """Return the outward surface normal in contact; see `ForceLaw.axis`."""
         return tuple(contact.normal.tolist()) if contact.in_contact else None
@@ -154,6 +166,10 @@ class CentroidSpringDamper:
     def planes(self, contact: Contact) -> None:
         """Return None: a push away from a centroid is no surface (see `ForceLaw.planes`)."""
         return None
+
+    def torque(self, contact: Contact) -> Vector3:
+        """Return zero: the force acts at the tip; see `ForceLaw.torque`."""
+        return _ZERO
 
     def axis(self, contact: Contact) -> Vector3 | None:
         """Return the direction away from the centroid in contact; see `ForceLaw.axis`."""

@@ -1,13 +1,15 @@
 """The main job: the simulated wand taps the paper's objects over ROS 2, recorded and summarised.
 
-    demo [--experiments cuboid cylinder hand cuboid-no-force teleop] [--composed]
-         [--out build/demo]
+    demo [--experiments cuboid cylinder hand cuboid-no-force probe-flat probe-phantom teleop]
+         [--composed] [--out build/demo]
 
 For each experiment it launches the loop (driver, collision engine, force renderer and a
 recorder), lets the scripted operator tap for 10 s, stops, reads the bag back and prints one
 line per contact: depth, mean force per axis, and how far the force pointed from the normal.
 ``cuboid-no-force`` is the control: the same taps with the force held at zero, to show how deep
-the operator's hand would go if nothing pushed back. ``teleop`` is the telerobotic scan: the
+the operator's hand would go if nothing pushed back. ``probe-flat`` and ``probe-phantom`` sweep
+a linear probe (a 10 x 40 mm face) rolled and yawed +-20 degrees on a flat slab and on the
+patient phantom: force and torque about the tip. ``teleop`` is the telerobotic scan: the
 operator's site and the remote robot on the patient phantom, in two DDS domains, model-mediated
 over a 50 ms link (5 ms jitter, 1 % loss); it prints the force the patient felt and the hand
 felt, and the round trip the operator measured.
@@ -37,6 +39,8 @@ EXPERIMENTS = {
     'hand': ('package://collision_engine/scenes/hand.yaml', 'hand', {}),
     'cuboid-no-force': ('package://collision_engine/scenes/cuboid.yaml', 'cuboid',
                         {'force_renderer': {'force_limit': 0.0}}),
+    'probe-flat': ('package://collision_engine/scenes/probe_flat.yaml', 'probe', {}),
+    'probe-phantom': ('package://collision_engine/scenes/probe_phantom.yaml', 'probe', {}),
 }
 DURATION = 10.0  # [s] as the paper's experiments
 TELEOP = 'teleop'

@@ -32,8 +32,11 @@ class Session:
     distance : (n,) float, m, signed, negative inside
     point, normal : (n, 3) float: closest surface point (m) and unit outward normal
     force : (n, 3) float, N, the wrench answering the pose (NaN when none came)
+    torque : (n, 3) float, N·m, about the tip, of the same wrench (zero for a point tip)
     applied : (n, 3) float, N, the force the device applied over the tick that ended with the
         pose (``wand/applied_wrench``; NaN when not recorded)
+    applied_torque : (n, 3) float, N·m, the torque it applied over that tick
+    orientation : (n, 4) float, the pose's quaternion (x, y, z, w)
     objects : (n,) str
     status : (n,) int, CollisionState status
     compute_time : (n,) float, s
@@ -47,7 +50,10 @@ class Session:
     point: np.ndarray
     normal: np.ndarray
     force: np.ndarray
+    torque: np.ndarray
     applied: np.ndarray
+    applied_torque: np.ndarray
+    orientation: np.ndarray
     objects: np.ndarray
     status: np.ndarray
     compute_time: np.ndarray
@@ -104,6 +110,7 @@ def read_session(path: pathlib.Path, typestore) -> Session:
     rows = [states[s] for s in stamps]
     nan3 = (np.nan, np.nan, np.nan)
     forces = [_xyz(wrenches[s].wrench.force) if s in wrenches else nan3 for s in stamps]
+    torques = [_xyz(wrenches[s].wrench.torque) if s in wrenches else nan3 for s in stamps]
     return Session(
         time=(np.array(stamps) - stamps[0]) * 1e-9,
         tip=np.array([_xyz(m.tip) for m in rows]),
@@ -111,8 +118,13 @@ def read_session(path: pathlib.Path, typestore) -> Session:
         point=np.array([_xyz(m.closest_point) for m in rows]),
         normal=np.array([_xyz(m.normal) for m in rows]),
         force=np.array(forces),
+        torque=np.array(torques),
         applied=np.array([_xyz(applied[s].wrench.force) if s in applied else nan3
                           for s in stamps]),
+        applied_torque=np.array([_xyz(applied[s].wrench.torque) if s in applied else nan3
+                                 for s in stamps]),
+        orientation=np.array([(m.orientation.x, m.orientation.y, m.orientation.z,
+                               m.orientation.w) for m in rows]),
         objects=np.array([m.object for m in rows]),
         status=np.array([m.status for m in rows]),
         compute_time=np.array([m.compute_time for m in rows]),

@@ -1,4 +1,6 @@
-"""The simulated operator's script, by name: the paper's experiments, holding still, or waypoints.
+"""The simulated operator's script, by name: an experiment, holding still, or waypoints.
+
+The experiments are the paper's three tapping ones and the probe sweep.
 
 A name picks a script; the scene only tells the scripted hand where the object's surface is
 (``project``), as the 3D view told the paper's operator.
@@ -7,8 +9,8 @@ from pathlib import Path
 from typing import Optional
 
 from haptic_wand_driver.scripts import (cuboid_face_tapping, cylinder_side_tapping,
-                                        hand_dorsum_tapping, Projection, ScriptError,
-                                        WaypointScript)
+                                        hand_dorsum_tapping, probe_sweep, Projection,
+                                        ScriptError, WaypointScript)
 
 __all__ = ['EXPERIMENTS', 'make_script', 'needs_scene', 'surface_projection']
 
@@ -16,6 +18,7 @@ EXPERIMENTS = {
     'cuboid': cuboid_face_tapping,
     'cylinder': cylinder_side_tapping,
     'hand': hand_dorsum_tapping,
+    'probe': probe_sweep,
 }
 HOLD = 'hold'
 HOLD_DURATION = 1.0  # [s] any positive length: a held target never moves

@@ -3,7 +3,8 @@
 Two kinds of script: :class:`WaypointScript` (user waypoints, each leg a minimum-jerk move) and
 :class:`TappingScript` (approach a surface site along its normal, press to a depth inside,
 retract, move on). The factories :func:`hand_dorsum_tapping`, :func:`cylinder_side_tapping` and
-:func:`cuboid_face_tapping` rebuild the paper's three ~10 s tapping experiments.
+:func:`cuboid_face_tapping` rebuild the paper's three ~10 s tapping experiments;
+:func:`probe_sweep` presses a probe's face on a surface and rolls, slides and yaws it.
 
 Scripts know no geometry engine: the caller passes ``project(point) -> (surface_point,
 outward_normal)``, built from its scene, and the factories' nominal aim points are only where to
@@ -38,6 +39,7 @@ __all__ = [
     'cuboid_face_tapping',
     'cylinder_side_tapping',
     'hand_dorsum_tapping',
+    'probe_sweep',
 ]
 
 Projection = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -487,3 +489,44 @@ def cuboid_face_tapping(project: Projection, *, aim_points=CUBOID_FACE_AIMS, tap
     ``options`` go to :class:`TappingScript`.
     """
     return _tapping_from_aims(project, aim_points, taps, 0.0, workspace, options)
+
+
+PROBE_SWEEP = (
+    # (t s, x m, roll, yaw) in units of the sweep's slide and tilt; z from the surface.
+    (1.8, 0.0, 0.0, 0.0), (2.2, 0.0, 0.0, 0.0),    # press, settle
+    (3.2, 0.0, 1.0, 0.0), (3.5, 0.0, 1.0, 0.0),    # roll +tilt, hold
+    (5.0, 0.0, -1.0, 0.0), (5.3, 0.0, -1.0, 0.0),  # roll -tilt, hold
+    (6.3, 1.0, 0.0, 0.0),                          # flat again, sliding
+    (7.3, 1.0, 0.0, 1.0), (8.3, -1.0, 0.0, -1.0),  # yaw +tilt, then slide back yawing -tilt
+    (9.0, 0.0, 0.0, 0.0),                          # back to the middle, flat
+)
+"""The pressed legs of :func:`probe_sweep`, after the approach (1 s) and before the lift."""
+
+
+def probe_sweep(project: Projection, *, start=(0.0, 0.0, 0.0), tilt: float = np.radians(20.0),
+                depth: float = 0.04, slide: float = 0.02, clearance: float = 0.005,
+                workspace: Workspace = Workspace()) -> WaypointScript:
+    """Script a probe pressed on the surface below ``start``: rolled, slid and yawed, ~10 s.
+
+    The hand aims ``depth`` below the surface (m, along -z: its spring, not the depth reached,
+    sets the press), rolls the face by +-``tilt`` (rad) in place, slides ``slide`` (m) along x
+    each way and yaws +-``tilt`` while sliding; every position is projected on the surface
+    straight below it, so the sweep follows a curved one. Lifts to ``clearance`` above at 9.8 s.
+    """
+    start = np.asarray(start, dtype=np.float64)
+
+    def below(x: float) -> float:
+        point, normal = project(start + (x, 0.0, 0.0))
+        point, normal = np.asarray(point, dtype=float), np.asarray(normal, dtype=float)
+        if not (np.all(np.isfinite(point)) and normal[2] > 0.5):
+            raise ScriptError(f'probe sweep: no upward surface below {start + (x, 0, 0)}: '
+                              f'project gave {point.tolist()}, normal {normal.tolist()}')
+        return float(point[2])
+
+    above = below(0.0) + clearance
+    rows = [(0.0, *start, 0.0, 0.0), (1.0, start[0], start[1], above, 0.0, 0.0)]
+    for t, x, roll, yaw in PROBE_SWEEP:
+        rows.append((t, start[0] + x * slide, start[1], below(x * slide) - depth, roll * tilt,
+                     yaw * tilt))
+    rows.append((9.8, start[0], start[1], above, 0.0, 0.0))
+    return WaypointScript.from_rows(rows, workspace=workspace)
