@@ -71,10 +71,9 @@ def test_the_state_carries_the_face_and_the_whole_pose(flat):
     result = query_probe(flat, tip, roll(0.2))
     fields = tool_state((5, 6, 'world'), result, tip, roll(0.2), 1e-5, 0)
     message = STATE.to_message(STATE.decode(STATE.encode(fields)))
-    assert message.contact_count == 16 and message.object == 'slab'
-    np.testing.assert_allclose(message.contact_distance[:16], result.distance, rtol=0, atol=0)
-    assert list(message.contact_distance[16:]) == [0.0] * (MAX_FACE_POINTS - 16)
-    assert (message.contact_points[3].y, message.contact_normals[3].z) == (
+    assert len(message.contact_distance) == 16 and message.object == 'slab'
+    np.testing.assert_allclose(message.contact_distance, result.distance, rtol=0, atol=0)
+    assert (message.contact_points[3 * 3 + 1], message.contact_normals[3 * 3 + 2]) == (
         result.points[3, 1], result.normals[3, 2])
     assert (message.tip.x, message.tip.y, message.tip.z) == tip
     orientation = message.orientation
@@ -86,9 +85,9 @@ def test_the_state_carries_the_face_and_the_whole_pose(flat):
 
 def test_the_face_limit_is_the_messages():
     fields = CollisionState.get_fields_and_field_types()
-    assert fields['contact_distance'] == f'double[{MAX_FACE_POINTS}]'
-    assert fields['contact_points'] == f'geometry_msgs/Point[{MAX_FACE_POINTS}]'
-    assert fields['contact_normals'] == f'geometry_msgs/Vector3[{MAX_FACE_POINTS}]'
+    assert fields['contact_distance'] == f'sequence<double, {MAX_FACE_POINTS}>'
+    assert fields['contact_points'] == f'sequence<double, {3 * MAX_FACE_POINTS}>'
+    assert fields['contact_normals'] == f'sequence<double, {3 * MAX_FACE_POINTS}>'
 
 
 def test_the_pose_s_quaternion_is_normalised_and_a_bad_one_refused():

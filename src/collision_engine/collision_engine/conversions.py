@@ -8,7 +8,6 @@ import math
 
 from geometry_msgs.msg import PoseStamped
 
-from collision_engine.tool import MAX_FACE_POINTS
 from haptic_msgs.msg import CollisionState
 from haptic_util.cdr import MessageCodec
 
@@ -19,7 +18,7 @@ UNIT_QUATERNION_TOLERANCE = 1e-3  # |q| may differ from 1 by this much (float32 
 POSE = MessageCodec(PoseStamped)
 STATE = MessageCodec(CollisionState)
 _NAN3 = (math.nan, math.nan, math.nan)
-_NO_CONTACTS = (0,) + (0.0,) * (7 * MAX_FACE_POINTS)  # contact_count and its three arrays
+_NO_CONTACTS = ((), (), ())  # the face's three sequences, empty without a tool
 
 
 class InvalidPose(ValueError):
@@ -76,20 +75,17 @@ def tool_state(header: tuple, probe, tip: tuple, orientation: tuple, compute_tim
     """Return CollisionState's leaf fields for a mounted tool (``probe.ProbeResult``).
 
     The distance, witnesses and normal are the whole tool's; ``tip`` (3,) is the pose's position.
-    The face's points fill the contact arrays, the rest of each array zero.
+    The face's points fill the contact sequences.
     """
     row = probe.tool.row
     distance = row[0]
     penetration = ((-distance * row[4], -distance * row[5], -distance * row[6])
                    if distance <= 0.0 else (0.0, 0.0, 0.0))
-    count = len(probe.distance)
-    padding = (0.0,) * (MAX_FACE_POINTS - count)
-    padding3 = padding * 3
     return (*header, probe.tool.object or '', probe.tool.status, distance, distance <= 0.0,
             *row[1:4], *row[4:7], *penetration, *tip, probe.tool.iterations, False, math.nan,
-            math.nan, disagreements, compute_time, *orientation, *row[10:13], count,
-            *probe.distance.tolist(), *padding, *probe.points.ravel().tolist(), *padding3,
-            *probe.normals.ravel().tolist(), *padding3)
+            math.nan, disagreements, compute_time, *orientation, *row[10:13],
+            tuple(probe.distance.tolist()), tuple(probe.points.ravel().tolist()),
+            tuple(probe.normals.ravel().tolist()))
 
 
 def invalid_state(header: tuple, disagreements: int) -> tuple:

@@ -42,8 +42,7 @@ TWIST = MessageCodec(TwistStamped)
 WRENCH = MessageCodec(WrenchStamped)
 _ZERO = (0.0, 0.0, 0.0)
 _ORIENTATION = STATE.fields.index('orientation.x')
-_FACE = STATE.fields.index('contact_count')  # then the distances, points and normals
-_FACE_SIZE = len(CollisionState().contact_distance)
+_FACE = STATE.fields.index('contact_distance')  # then the points and the normals
 
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -223,16 +222,13 @@ class ForceNode(Node):
 
 def _face(fields: list) -> FaceContact | None:
     """Return the tool's face from a CollisionState's leaves, or None when it has no tool."""
-    count = fields[_FACE]
-    if count == 0:
+    distance, points, normals = fields[_FACE:_FACE + 3]
+    if not distance:
         return None
     from collision_engine.probe import rotation_matrix
 
-    at, size = _FACE + 1, _FACE_SIZE
-    distance = np.array(fields[at:at + count])
-    points = np.array(fields[at + size:at + size + 3 * count]).reshape(count, 3)
-    normals = np.array(fields[at + 4 * size:at + 4 * size + 3 * count]).reshape(count, 3)
-    return FaceContact(distance, points, normals,
+    return FaceContact(np.array(distance), np.array(points).reshape(-1, 3),
+                       np.array(normals).reshape(-1, 3),
                        rotation_matrix(fields[_ORIENTATION:_ORIENTATION + 4]))
 
 
