@@ -52,10 +52,12 @@ SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 BRIDGE_MODULE = 'remote_probe.bridge'
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
-OPERATOR_RECORDED = ('/wand/pose', '/wand/twist', '/wand/applied_wrench', '/teleop/command',
-                     '/teleop/feedback', '/diagnostics')
+# What crosses the link is recorded where it arrives (its sent copy is the same message, earlier;
+# recording both cost the recorder two more 1 kHz streams).
+OPERATOR_RECORDED = ('/wand/pose', '/wand/twist', '/wand/applied_wrench', '/teleop/feedback',
+                     '/diagnostics')
 REMOTE_RECORDED = ('/robot/target_pose', '/robot/tcp_pose', '/robot/ft_sensor/wrench',
-                   '/teleop/command', '/teleop/feedback', '/diagnostics')
+                   '/teleop/command', '/diagnostics')
 COMPOSED_MODULE = 'haptic_bringup.composed'
 RECORDER_MODULE = 'haptic_bringup.recorder'
 DEFAULT_DOMAIN_ID = 42
@@ -178,10 +180,12 @@ def bridge_parameters(config: LoopConfig) -> dict:
 def teleop_endpoints(config: LoopConfig) -> dict:
     """Domain → topic → (publishers, subscribers) that make the telerobotic session closed."""
     recording = 1 if config.record else 0
-    crossing = {'/teleop/command': (1, 1 + recording), '/teleop/feedback': (1, 1 + recording)}
     return {
-        config.domain_id: {'/wand/pose': (1, 1 + recording), **crossing},
-        config.remote_domain_id: {**crossing, '/robot/target_pose': (1, 1 + recording),
+        config.domain_id: {'/wand/pose': (1, 1 + recording), '/teleop/command': (1, 1),
+                           '/teleop/feedback': (1, 1 + recording)},
+        config.remote_domain_id: {'/teleop/command': (1, 1 + recording),
+                                  '/teleop/feedback': (1, 1),
+                                  '/robot/target_pose': (1, 1 + recording),
                                   '/robot/tcp_pose': (1, 1 + recording),
                                   '/robot/ft_sensor/wrench': (1, 1 + recording)},
     }

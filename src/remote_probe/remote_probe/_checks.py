@@ -36,8 +36,10 @@ def finite_vector(value, size: int, name: str, *, minimum: float | None = None) 
         vector = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
         vector = np.full(0, math.nan)
-    if vector.shape != (size,) or not np.all(np.isfinite(vector)) or (
-            minimum is not None and np.any(vector < minimum)):
+    # The array's own all() and any(): np.all's dispatch took 7 % of the remote site's process,
+    # which checks its vectors at every tick.
+    if vector.shape != (size,) or not np.isfinite(vector).all() or (
+            minimum is not None and (vector < minimum).any()):
         bound = '' if minimum is None else f' >= {minimum:g}'
         raise ValueError(f'{name} must be {size} finite numbers{bound}, got {value!r}')
     vector.flags.writeable = False
