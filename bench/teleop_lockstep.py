@@ -17,6 +17,7 @@ import machine
 import numpy as np
 import teleop_scan
 
+from haptic_bringup.launcher import SCAN_DURATION
 from haptic_util.paths import package_file
 from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
 from haptic_wand_driver.device import DeviceLimits
@@ -32,6 +33,7 @@ from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
 from remote_probe.leader import Leader, LeaderConfig
 from remote_probe.link import EmulatedLink, LinkConfig
 from remote_probe.model_estimation import ContactModelEstimator
+from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
@@ -40,11 +42,11 @@ __all__ = ['as_series', 'scan']
 SCAN = 'package://remote_probe/config/scan.yaml'
 SKIN = -0.025  # [m] the phantom's front, under the probe's start
 TICK = 1e-3  # [s]
-MODEL_LIFETIME = 0.010  # [s] as the leader node's default
+MODEL_LIFETIME = LeaderParams().model_lifetime  # [s]
 ZERO = np.zeros(3)
 
 
-def _device(scheme: str, duration: float):
+def _device(scheme: str):
     """Build the driver's simulated wand and hand, rendering as the launcher sets ``scheme``."""
     wand = WandDriverParams()
     limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
@@ -72,9 +74,9 @@ def _model(time: float, plane, tip) -> ContactModel:
 
 
 def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
-         duration: float = 18.5, seed: int = 0) -> dict:
+         duration: float = SCAN_DURATION, seed: int = 0) -> dict:
     """Run the scan; return per-tick arrays: time, wand, felt (applied), patient, tcp."""
-    device, renderer = _device(scheme, duration)
+    device, renderer = _device(scheme)
     robot_config = ImpedanceRobotConfig()
     robot = ImpedanceRobot(robot_config, environment=Tissue(
         ABDOMEN, PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])))
