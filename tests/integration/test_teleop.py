@@ -14,7 +14,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import typestore_with
-from haptic_bringup.launcher import Loop, LoopConfig
+from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_vectors, reported
 
@@ -96,7 +96,8 @@ def test_the_bag_holds_both_sites_the_remote_one_under_remote(scan):
 
 
 def test_a_link_dropped_mid_contact_zeroes_the_force_and_the_robot_retracts(tmp_path):
-    with teleop(tmp_path) as loop:
+    # The whole scan: its press lasts from 4 to 16 s, whenever discovery let the session start.
+    with teleop(tmp_path, duration=SCAN_DURATION) as loop:
         time.sleep(PRESSING[0] + 0.5)
         bridge = loop.child('bridge')
         dropped = time.time()
@@ -122,7 +123,7 @@ def test_a_killed_remote_site_zeroes_the_force_and_a_restarted_one_follows_again
     """The restarted site's first model finds the wand deep (the hand pressed on through the
     silence), so a passive update shows it where the wand is: no force until the hand presses
     further or touches again. What resumes at once is the link and the robot's following."""
-    with teleop(tmp_path, duration=18.5) as loop:
+    with teleop(tmp_path, duration=SCAN_DURATION) as loop:
         time.sleep(PRESSING[0] + 0.5)
         killed = time.time()
         os.kill(loop.child('remote').pid, signal.SIGKILL)
