@@ -143,3 +143,20 @@ def test_a_killed_remote_site_zeroes_the_force_and_a_restarted_one_follows_again
     tcp_times, tcp = series['/remote/robot/tcp_pose']
     after = tcp_times > resumed[0]
     assert tcp[after, 2].max() - tcp[after, 2].min() > 0.01  # it followed the wand's lift
+
+
+def test_reordered_messages_from_the_link_are_ignored_by_stamp(tmp_path):
+    """A jitter of 40 % of the delay with reordering: many messages overtake one another."""
+    with teleop(tmp_path, duration=9.0, jitter=0.4 * DELAY, reorder=True) as loop:
+        assert loop.wait(60.0) is not None
+    older = reports(tmp_path, 'teleop_follower', 'refused: command older than the held one')
+    assert older and int(older[-1]) > 100
+    assert int(reports(tmp_path, 'teleop_leader', 'refused')[-1]) > 10  # older feedback
+    series = streams(tmp_path)
+    start = series['/wand/pose'][0][0]
+    felt_times, felt = series['/wand/applied_wrench']
+    patient_times, patient = series['/remote/robot/ft_sensor/wrench']
+    felt_force = np.median(felt[window(felt_times - start, *PRESSING), 2]) / FORCE_SCALE
+    patient_force = np.median(patient[window(patient_times - start, *PRESSING), 2])
+    assert patient_force > 5.0
+    assert felt_force == pytest.approx(patient_force, rel=0.15)
