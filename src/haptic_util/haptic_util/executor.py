@@ -33,8 +33,8 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
-__all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'request_stop', 'stop_requested',
-           'callback_errors', 'StartupError']
+__all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'request_stop',
+           'stop_requested', 'callback_errors', 'StartupError']
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
 SHUTDOWN_TIMEOUT = 1.0  # [s] for the executor to finish a callback in progress
@@ -80,10 +80,14 @@ def _on_signal(signum, frame) -> None:
         raise KeyboardInterrupt  # nodes are still being built: no rclpy callback is running
 
 
-def make_executor(kind: str = 'events') -> Executor:
-    """Return a new executor of the given kind ('events' or 'single_threaded')."""
+def make_executor(kind: str = 'events', context: Optional[rclpy.Context] = None) -> Executor:
+    """Return a new executor of the given kind ('events' or 'single_threaded').
+
+    One executor serves nodes of several contexts (a process in two DDS domains); ``context``
+    is the one whose shutdown ends its spin (None: the default context).
+    """
     try:
-        return EXECUTORS[kind]()
+        return EXECUTORS[kind](context=context)
     except KeyError:
         raise ValueError(
             f'executor {kind!r} is not one of {sorted(EXECUTORS)}') from None
@@ -123,16 +127,27 @@ def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
     parameter error from its constructor: this prints that one line and returns exit code 2,
     with nothing left running. A stop requested at any time returns 0.
     """
+    def start(nodes: list, contexts: list) -> None:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+        nodes.extend(factory() for factory in factories)
+    return run_process(start, executor=executor)
+
+
+def run_process(start: Callable[[list, list], None], *, executor: str = 'events') -> int:
+    """Run ``start``'s nodes on one executor until a stop, as ``run_nodes`` does, in any contexts.
+
+    ``start(nodes, contexts)`` inits the contexts it needs and builds the nodes, appending each
+    as it is made, so that whatever it made is torn down even when it fails half-way; the
+    contexts it leaves empty stand for the default one. Exit codes as ``run_nodes``.
+    """
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _on_signal)
     _flags['starting'] = True
-    nodes, spinner = [], None
+    nodes, contexts, spinner = [], [], None
     try:
-        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-        for factory in factories:
-            nodes.append(factory())
+        start(nodes, contexts)
         _flags['starting'] = False
-        spinner = make_executor(executor)
+        spinner = make_executor(executor, contexts[0] if contexts else None)
         for node in nodes:
             spinner.add_node(node)
         spin(spinner)
@@ -152,7 +167,8 @@ def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
             spinner.shutdown(timeout_sec=SHUTDOWN_TIMEOUT)
         for node in nodes:
             node.destroy_node()
-        rclpy.try_shutdown()
+        for context in contexts or [None]:
+            rclpy.try_shutdown(context=context)
         faulthandler.cancel_dump_traceback_later()
         # Python resets its handlers to the default at exit, where a late repeat would then
         # kill the process with SIGINT; an ignored signal it leaves alone.

@@ -23,40 +23,31 @@ context in the process's own ``ROS_DOMAIN_ID``, then the two sites' contexts are
 Each site's node reports both directions on its domain's ``/diagnostics`` at 1 Hz.
 """
 from dataclasses import dataclass, replace
-import faulthandler
 import functools
 import math
-import signal
-import sys
 import time
 
 import rclpy
 from rclpy.clock import Clock, ClockType
-from rclpy.exceptions import NameValidationException, ParameterException
-from rclpy.executors import ExternalShutdownException
+from rclpy.exceptions import NameValidationException
 from rclpy.expand_topic_name import expand_topic_name
-from rclpy.experimental import EventsExecutor
-from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
-from haptic_util.executor import (request_stop, SHUTDOWN_TIMEOUT, spin, StartupError,
-                                  stop_requested, TEARDOWN_LIMIT)
+from haptic_util.executor import run_process, StartupError
 from haptic_util.parameters import declare_parameters, parameter
 from haptic_util.qos import HAPTIC_STREAM_QOS
 from remote_probe.link import DelayTrace, EmulatedLink, LinkConfig
 from remote_probe.relay import check_no_loop, message_class, parse_routes, Relay
 
-__all__ = ['LinkBridge', 'LinkBridgeParams', 'main', 'read_parameters']
+__all__ = ['LinkBridgeParams', 'join_sites', 'main', 'read_parameters']
 
 NODE_NAME = 'link_bridge'
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 LATE_WARNING = 1e-3  # [s] release lateness p99 above which the bridge itself distorts the link
 _STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() reads
-_CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException,
-                         NameValidationException, rclpy_implementation.RCLError)
 
 
 @dataclass(frozen=True)
@@ -181,11 +172,16 @@ class _Direction:
 
 
 class _SiteNode(Node):
-    """The bridge's node in one site's domain, reporting both directions there."""
+    """The bridge's node in one site's domain, reporting both directions there.
 
-    def __init__(self, name: str, context: rclpy.Context, relays: dict) -> None:
+    The operator's says the final counts as it goes (``says_totals``).
+    """
+
+    def __init__(self, name: str, context: rclpy.Context, relays: dict, *,
+                 says_totals: bool = False) -> None:
         super().__init__(name, context=context)
         self._relays = relays
+        self._says_totals = says_totals
         self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
 
     def report(self) -> Report:
@@ -200,95 +196,41 @@ class _SiteNode(Node):
 
     def destroy_node(self) -> bool:
         self.diagnostics.final()
+        if self._says_totals:
+            self.get_logger().info(', '.join(
+                f'{direction}: {relay.relayed} relayed, {relay.link.lost} lost'
+                for direction, relay in self._relays.items()))
         return super().destroy_node()
 
 
-class LinkBridge:
-    """The two sites' contexts and nodes, the two directions, and the executor of both."""
-
-    def __init__(self, params: LinkBridgeParams, args=None) -> None:
-        plan = _Plan(params)
-        self.relays = {direction: Relay(link) for direction, link in plan.links.items()}
-        self.contexts, self.nodes, self.executor = [], [], None
-        try:
-            for site, domain in (('operator', params.operator_domain),
-                                 ('remote', params.remote_domain)):
-                context = rclpy.Context()
-                rclpy.init(args=args, context=context, domain_id=domain,
-                           signal_handler_options=SignalHandlerOptions.NO)
-                self.contexts.append(context)
-                self.nodes.append(_SiteNode(f'{NODE_NAME}_{site}', context, self.relays))
-            operator, remote = self.nodes
-            self.directions = [
-                _Direction(self.relays['to_remote'], plan.to_remote, operator, remote),
-                _Direction(self.relays['to_operator'], plan.to_operator, remote, operator)]
-            self.executor = EventsExecutor(context=self.contexts[0])
-            for node in self.nodes:
-                self.executor.add_node(node)
-        except BaseException:
-            self.close()
-            raise
-        trace = f'trace {params.delay_trace}' if params.delay_trace else f'{params.delay:g} s'
-        operator.get_logger().info(
-            f'domain {params.operator_domain} <-> {params.remote_domain}: '
-            f'{len(plan.to_remote)} topics to remote, {len(plan.to_operator)} to operator; '
-            f'delay {trace}, jitter {params.jitter:g} s, loss {params.loss:g}, '
-            f'reorder {params.reorder}')
-
-    def close(self) -> None:
-        """Say the last counts, destroy the nodes and shut the contexts down (idempotent)."""
-        faulthandler.dump_traceback_later(TEARDOWN_LIMIT, exit=True)  # never hang silently
-        if self.executor is not None:  # it lets go of the nodes' entities first
-            for node in self.nodes:
-                self.executor.remove_node(node)
-            self.executor.shutdown(timeout_sec=SHUTDOWN_TIMEOUT)
-            self.executor = None
-        if self.nodes:
-            self.nodes[0].get_logger().info(', '.join(
-                f'{direction}: {relay.relayed} relayed, {relay.link.lost} lost'
-                for direction, relay in self.relays.items()))
-        for node in self.nodes:
-            node.destroy_node()
-        for context in self.contexts:
-            rclpy.try_shutdown(context=context)
-        self.nodes, self.contexts = [], []
-        faulthandler.cancel_dump_traceback_later()
-
-
-_starting = [False]  # a signal while the sites start interrupts the start itself
-
-
-def _on_signal(signum, frame) -> None:
-    first = not stop_requested()
-    request_stop()
-    if first and _starting[0]:
-        _starting[0] = False
-        raise KeyboardInterrupt  # no rclpy callback runs yet
+def join_sites(args, nodes: list, contexts: list) -> None:
+    """Join both sites' domains and wire both directions (``run_process``'s ``start``)."""
+    params = read_parameters(args)
+    plan = _Plan(params)
+    relays = {direction: Relay(link) for direction, link in plan.links.items()}
+    for site, domain in (('operator', params.operator_domain),
+                         ('remote', params.remote_domain)):
+        context = rclpy.Context()
+        rclpy.init(args=args, context=context, domain_id=domain,
+                   signal_handler_options=SignalHandlerOptions.NO)
+        contexts.append(context)
+        nodes.append(_SiteNode(f'{NODE_NAME}_{site}', context, relays,
+                               says_totals=site == 'operator'))
+    operator, remote = nodes
+    # Each direction lives on in its nodes' subscriptions and timer.
+    _Direction(relays['to_remote'], plan.to_remote, operator, remote)
+    _Direction(relays['to_operator'], plan.to_operator, remote, operator)
+    trace = f'trace {params.delay_trace}' if params.delay_trace else f'{params.delay:g} s'
+    operator.get_logger().info(
+        f'domain {params.operator_domain} <-> {params.remote_domain}: '
+        f'{len(plan.to_remote)} topics to remote, {len(plan.to_operator)} to operator; '
+        f'delay {trace}, jitter {params.jitter:g} s, loss {params.loss:g}, '
+        f'reorder {params.reorder}')
 
 
 def main(args=None) -> int:
     """Run the bridge until SIGINT or SIGTERM (exit 0); a bad configuration exits 2."""
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, _on_signal)
-    _starting[0] = True
-    bridge = None
-    try:
-        bridge = LinkBridge(read_parameters(args), args)
-        _starting[0] = False
-        spin(bridge.executor)
-    except _CONFIGURATION_ERRORS as error:
-        print(f'error: {" ".join(str(error).split())}', file=sys.stderr, flush=True)
-        return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        _starting[0] = False
-        if bridge is not None:
-            bridge.close()
-        # A late repeat of the signal must not kill the process at exit (see run_nodes).
-        for signum in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(signum, signal.SIG_IGN)
-    return 0
+    return run_process(functools.partial(join_sites, args))
 
 
 if __name__ == '__main__':
