@@ -133,11 +133,12 @@ def read_session(path: pathlib.Path, typestore) -> Session:
         scene=scene)
 
 
-def read_vectors(path: pathlib.Path, typestore, topics: dict) -> dict:
-    """Topic → (receive times s, (n, 3) vectors) of stamped poses (position) or wrenches (force).
+def read_vectors(path: pathlib.Path, typestore, topics: dict, stamped: bool = False) -> dict:
+    """Topic → (times s, (n, 3) vectors) of stamped poses (position) or wrenches (force).
 
     ``topics`` maps each topic to ``'pose'`` or ``'wrench'``; a topic absent from the bag gives
-    empty arrays.
+    empty arrays. The times are when the recorder received each message, or with ``stamped``
+    its header's stamp: when its publisher says it happened, which a busy recorder cannot delay.
     """
     series = {topic: ([], []) for topic in topics}
     with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
@@ -146,6 +147,8 @@ def read_vectors(path: pathlib.Path, typestore, topics: dict) -> dict:
             msg = reader.deserialize(raw, connection.msgtype)
             vector = (msg.pose.position if topics[connection.topic] == 'pose'
                       else msg.wrench.force)
+            if stamped:
+                stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
             series[connection.topic][0].append(stamp * 1e-9)
             series[connection.topic][1].append(_xyz(vector))
     return {topic: (np.array(times), np.array(vectors).reshape(-1, 3))
