@@ -1,0 +1,105 @@
+"""A telerobotic session on a full ROS 2 Jazzy install: two sites, two domains, a link between.
+
+    ros2 launch haptic_bringup teleop.launch.py scheme:=model delay:=0.05 [jitter:=0.005]
+        [loss:=0.01] [reorder:=true] [delay_trace:=<csv>] [record:=<bag dir>]
+        [remote_domain:=<id>] [experiment:=<waypoint file>] [duration:=<s>]
+        [params_file:=<yaml>]
+
+The operator's site (``wand_driver`` and ``teleop_leader``, one process) runs in the launch's
+``ROS_DOMAIN_ID``; the remote site (``sim_robot`` and ``teleop_follower``, one process) in
+``remote_domain`` (default: the next domain); ``link_bridge`` joins both and emulates the link.
+``record:=`` writes both sites into one bag with the project's recorder (the remote site's
+topics under ``/remote/``): ``ros2 bag record`` joins one domain only. Parameters come from each
+package's config/, then ``params_file``, then these arguments, exactly as the local launcher
+(``haptic_loop --teleop ...``) sets them. The session stands or falls together, as the loop
+does: when one process exits, the launch stops the others.
+"""
+import os
+import tempfile
+
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, OpaqueFunction, SetEnvironmentVariable
+from launch.substitutions import EnvironmentVariable, LaunchConfiguration
+from launch_ros.actions import Node
+import yaml
+
+from haptic_bringup.launch_actions import AllOrNothing, hear_sigint
+from haptic_bringup.launcher import (bridge_parameters, LoopConfig, node_parameters,
+                                     OPERATOR_SITE, REMOTE_SITE)
+
+ARGUMENTS = (  # name, default, description
+    ('scheme', 'model', 'bilateral scheme: direct | tdpa | model'),
+    ('delay', '0.0', 'one-way link delay [s]'),
+    ('jitter', '0.0', 'standard deviation of the delay [s]'),
+    ('loss', '0.0', 'probability that a message is lost'),
+    ('reorder', 'false', 'let a message overtake an earlier one'),
+    ('delay_trace', '', 'replay one-way delays from a CSV (time,delay in s)'),
+    ('remote_domain', '', "the remote site's DDS domain (default: ROS_DOMAIN_ID + 1)"),
+    ('experiment', '', "the operator's script (default: the scripted scan)"),
+    ('duration', '0.0', 'stop after this many seconds (0: the scan\'s own length)'),
+    ('record', '', 'record both sites to this bag directory'),
+    ('params_file', '', 'extra parameters YAML'),
+)
+
+
+def _written(values: dict) -> str:
+    with tempfile.NamedTemporaryFile('w', prefix='teleop_params_', suffix='.yaml',
+                                     delete=False) as out:
+        yaml.safe_dump(values, out)
+    return out.name
+
+
+def _config(context) -> LoopConfig:
+    """Return the session as the local launcher would run it, from the launch arguments."""
+    def argument(name: str) -> str:
+        return LaunchConfiguration(name).perform(context)
+
+    link = {'delay': float(argument('delay')), 'jitter': float(argument('jitter')),
+            'loss': float(argument('loss')), 'reorder': argument('reorder').lower() == 'true'}
+    if argument('delay_trace'):
+        link['delay_trace'] = os.path.abspath(argument('delay_trace'))
+    remote = argument('remote_domain')
+    return LoopConfig(teleop=argument('scheme'), link=link,
+                      domain_id=int(os.environ.get('ROS_DOMAIN_ID', '0')),
+                      remote_domain=int(remote) if remote else None,
+                      experiment=argument('experiment') or None,
+                      duration=float(argument('duration')), record=argument('record') or None,
+                      params_file=argument('params_file') or None)
+
+
+def _processes(context):
+    config = _config(context)
+    if config.teleop not in ('direct', 'tdpa', 'model'):
+        raise ValueError(f"scheme:={config.teleop!r}: choose direct, tdpa or model")
+    parameters = _written(node_parameters(config))
+    operator_env = {'ROS_DOMAIN_ID': str(config.domain_id)}
+    session = AllOrNothing()
+    actions = []
+    for name, nodes, domain in (('operator', OPERATOR_SITE, config.domain_id),
+                                ('remote', REMOTE_SITE, config.remote_domain_id)):
+        actions += session.add(name, Node(
+            package='haptic_bringup', executable='composed', arguments=list(nodes),
+            parameters=[parameters], additional_env={'ROS_DOMAIN_ID': str(domain)},
+            output='screen'))
+    # Over UDP, as the network it stands for: over shared memory, a stopped bridge stalled the
+    # sites' processes that publish to it.
+    actions += session.add('bridge', Node(
+        package='remote_probe', executable='link_bridge',
+        parameters=[_written(bridge_parameters(config))],
+        additional_env={**operator_env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}, output='screen'))
+    if config.record:
+        actions += session.add('recorder', Node(
+            package='haptic_bringup', executable='recorder', parameters=[parameters],
+            additional_env=operator_env, output='screen'))
+    return actions
+
+
+def generate_launch_description() -> LaunchDescription:
+    hear_sigint()
+    return LaunchDescription([
+        SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', EnvironmentVariable(
+            'ROS_AUTOMATIC_DISCOVERY_RANGE', default_value='LOCALHOST')),
+        *(DeclareLaunchArgument(name, default_value=default, description=description)
+          for name, default, description in ARGUMENTS),
+        OpaqueFunction(function=_processes),
+    ])
