@@ -190,7 +190,7 @@ def teleop_rows(demo_dir: Path, work_dir: Path, domain_id: int, quick: bool) -> 
     lockstep = [{'scheme': scheme, 'source': 'lockstep', **teleop_scan.figures(
         teleop_lockstep.as_series(teleop_lockstep.scan(
             scheme, delay, jitter=TELEOP_JITTER * delay, loss=TELEOP_LOSS)), delay)}
-        for delay in delays for scheme in TELEOP_SCHEMES]
+        for delay in delays for scheme in teleop_lockstep.SCHEMES]
     ros, traces = [], {}
     for scheme in TELEOP_SCHEMES:
         folder = work_dir / f'teleop_{scheme}'

@@ -7,7 +7,9 @@ scripted hand (the driver's ``SimulatedWand`` at 4 kHz, rendering the model loca
 the wrench), the leader, two ``EmulatedLink`` directions, the follower, the impedance robot on
 the abdomen's Hunt–Crossley tissue (a flat skin at the phantom's front) and its F/T sensor.
 What it shows is what the schemes do with a delay, free of a busy machine's timing; the ROS run
-(``teleop_scan.py``) shows that the nodes do the same.
+(``teleop_scan.py``) shows that the nodes do the same. Beside the launcher's three schemes it runs
+``tdpa-plain``: TDPA's operator-side controller on the wand itself, without the virtual coupling
+that ``tdpa`` puts between them, the baseline that chatters.
 """
 import argparse
 import math
@@ -37,7 +39,10 @@ from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
-__all__ = ['as_series', 'scan']
+__all__ = ['as_series', 'scan', 'SCHEMES']
+
+PLAIN_TDPA = 'tdpa-plain'  # TDPA's controller on the wand itself: the baseline of the coupling
+SCHEMES = ('direct', PLAIN_TDPA, 'tdpa', 'model')
 
 SCAN = 'package://remote_probe/config/scan.yaml'
 SKIN = -0.025  # [m] the phantom's front, under the probe's start
@@ -75,7 +80,13 @@ def _model(time: float, plane, tip) -> ContactModel:
 
 def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
          duration: float = SCAN_DURATION, seed: int = 0) -> dict:
-    """Run the scan; return per-tick arrays: time, wand, felt (applied), patient, tcp."""
+    """Run the scan; return per-tick arrays: time, wand, felt (applied), patient, tcp.
+
+    ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``.
+    """
+    leader_config = (LeaderConfig('tdpa', coupling=None) if scheme == PLAIN_TDPA
+                     else LeaderConfig(scheme))
+    scheme = leader_config.scheme
     device, renderer = _device(scheme)
     robot_config = ImpedanceRobotConfig()
     robot = ImpedanceRobot(robot_config, environment=Tissue(
@@ -85,7 +96,7 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     follower = Follower(FollowerConfig(scheme, robot_config.stiffness),
                         PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness)),
                         ContactModelEstimator(), surface=lambda tcp: (skin.point, skin.normal))
-    leader = Leader(LeaderConfig(scheme), ZERO, robot_config.initial_position)
+    leader = Leader(leader_config, ZERO, robot_config.initial_position)
     link = LinkConfig(delay, jitter, loss, seed=seed)
     to_robot, to_operator = EmulatedLink(link), EmulatedLink(LinkConfig(
         delay, jitter, loss, seed=seed + 1))
@@ -105,7 +116,7 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
             renderer.take(_model(now, leader.plane(now, state.position), state.position),
                           now + MODEL_LIFETIME)
         else:
-            device.apply(leader.force(now, state.linear_velocity, TICK), ZERO,
+            device.apply(leader.force(now, state.position, state.linear_velocity, TICK), ZERO,
                          until=now + MODEL_LIFETIME)
         state, remote = device.read(now + TICK), robot.read(now + TICK)
         rows.append((now, *state.position, *device.applied()[0], *remote.external_force,
@@ -125,8 +136,7 @@ def as_series(run: dict) -> dict:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--schemes', nargs='+', default=['direct', 'tdpa', 'model'],
-                        choices=['direct', 'tdpa', 'model'])
+    parser.add_argument('--schemes', nargs='+', default=list(SCHEMES), choices=SCHEMES)
     parser.add_argument('--delays', nargs='+', type=float,
                         default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
     parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')

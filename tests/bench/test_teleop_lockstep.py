@@ -21,11 +21,19 @@ def test_direct_reflection_gives_the_hand_energy_by_50_ms():
     assert baseline['net_work_j'] > 1.0  # joules: it diverges
 
 
-@pytest.mark.parametrize('delay', [0.05, 0.25])
-def test_tdpa_never_gives_the_hand_energy_and_keeps_the_patient_safe(delay):
+@pytest.mark.parametrize('delay', [0.025, 0.1, 0.25])
+def test_tdpa_is_stable_at_every_delay_and_keeps_the_patient_safe(delay):
     passive = figures('tdpa', delay)
-    assert passive['net_work_j'] <= 0.0
+    assert passive['stable'], passive
     assert passive['peak_patient_n'] <= MAX_PATIENT_FORCE
+
+
+def test_plain_tdpa_chatters_in_contact_where_the_coupling_does_not():
+    """The same controller acting on the wand itself: a relay on the wand's velocity."""
+    plain, coupled = figures('tdpa-plain', 0.05), figures('tdpa', 0.05)
+    assert plain['net_work_j'] <= 0.0  # passive, yet
+    assert plain['oscillation_percent'] > 2 * teleop_scan.STABLE_OSCILLATION
+    assert coupled['oscillation_percent'] <= teleop_scan.STABLE_OSCILLATION / 2
 
 
 @pytest.mark.parametrize('delay, transparency', [(0.025, 10.0), (0.1, 25.0), (0.25, None)])

@@ -9,6 +9,7 @@ from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.teleop import Command, Feedback, RemotePlane
 from remote_probe.tissue import HuntCrossley, PlaneSurface, Tissue
+from remote_probe.virtual_coupling import CouplingConfig
 from remote_probe.workspace_map import WorkspaceMap
 
 UP = np.array([0.0, 0.0, 1.0])
@@ -46,10 +47,10 @@ def test_direct_reflects_the_scaled_force_until_the_link_falls_silent():
     leader = Leader(LeaderConfig('direct', force_scale=0.3, link_timeout=0.1), np.zeros(3),
                     np.zeros(3))
     assert not leader.live(0.0)
-    np.testing.assert_array_equal(leader.force(0.0, np.zeros(3), 1e-3), np.zeros(3))
+    np.testing.assert_array_equal(leader.force(0.0, np.zeros(3), np.zeros(3), 1e-3), np.zeros(3))
     leader.receive(1.0, feedback(50.0))
-    np.testing.assert_allclose(leader.force(1.05, np.zeros(3), 1e-3), [0.0, 0.0, 1.5])
-    np.testing.assert_array_equal(leader.force(1.101, np.zeros(3), 1e-3), np.zeros(3))
+    np.testing.assert_allclose(leader.force(1.05, np.zeros(3), np.zeros(3), 1e-3), [0.0, 0.0, 1.5])
+    np.testing.assert_array_equal(leader.force(1.101, np.zeros(3), np.zeros(3), 1e-3), np.zeros(3))
 
 
 def test_an_older_or_repeated_feedback_is_ignored():
@@ -57,7 +58,8 @@ def test_an_older_or_repeated_feedback_is_ignored():
     assert leader.receive(1.0, feedback(50.0, (0.0, 0.0, 5.0)))
     assert not leader.receive(1.001, feedback(49.9, (0.0, 0.0, 9.0)))
     assert not leader.receive(1.002, feedback(50.0, (0.0, 0.0, 9.0)))
-    np.testing.assert_allclose(leader.force(1.003, np.zeros(3), 1e-3), [0.0, 0.0, 1.5])
+    np.testing.assert_allclose(leader.force(1.003, np.zeros(3), np.zeros(3), 1e-3),
+                               [0.0, 0.0, 1.5])
 
 
 def test_the_round_trip_comes_from_echoed_stamps_whatever_the_far_clock():
@@ -70,13 +72,20 @@ def test_the_round_trip_comes_from_echoed_stamps_whatever_the_far_clock():
     assert leader.round_trip.offset == pytest.approx(far)
 
 
-def test_tdpa_never_displays_more_energy_than_the_robot_put_in():
-    leader = Leader(LeaderConfig('tdpa', force_scale=1.0), np.zeros(3), np.zeros(3))
+@pytest.mark.parametrize('coupling', [CouplingConfig(), None])
+def test_tdpa_never_gives_the_hand_more_energy_than_the_robot_put_in(coupling):
+    """With or without the coupling: the wand moves out along the patient's force, where the
+    link would deliver 1 mJ a millisecond, and the robot has sent 2 mJ."""
+    leader = Leader(LeaderConfig('tdpa', force_scale=1.0, coupling=coupling), np.zeros(3),
+                    np.zeros(3))
     leader.receive(0.0, feedback(1.0, (0.0, 0.0, 10.0), energy=0.002))
-    velocity, dt, delivered = np.array([0.0, 0.0, 0.1]), 1e-3, 0.0
-    for k in range(50):  # the wand moves out along the force: the link would deliver 1 mJ/ms
-        delivered += float(leader.force(0.001 * k, velocity, dt) @ velocity) * dt
-    assert delivered == pytest.approx(0.002)
+    velocity, dt, given = np.array([0.0, 0.0, 0.1]), 1e-3, []
+    for k in range(90):  # the feedback lasts the leader's link timeout
+        force = leader.force(0.001 * k, k * dt * velocity, velocity, dt)
+        given.append(float(force @ velocity) * dt)  # the force is held over the tick
+    assert sum(given) <= 0.002 + 1e-12
+    assert max(np.cumsum(given)) <= 0.002 + 1e-12
+    assert max(np.cumsum(given)) > 0.0005  # it does pass the robot's energy on
 
 
 def test_the_model_is_the_remote_plane_in_the_wands_frame_with_felt_gains():

@@ -6,7 +6,9 @@ every wand pose at once from the newest feedback it holds, never waiting on the 
 - ``direct``: the patient's force, scaled, as the wand's force (the baseline; with delay, the
   force acts on an old motion and gives energy back);
 - ``tdpa``: the same force through the operator's passivity controller, which books the energy
-  at this port against what the robot's port has sent into the link (``remote_probe.tdpa``);
+  at this port against what the robot's port has sent into the link (``remote_probe.tdpa``),
+  and reaches the wand through a virtual coupling that keeps the controller's switching off the
+  hand (``remote_probe.virtual_coupling``);
 - ``model``: the remote site's estimated plane, mapped into the wand's workspace with the
   scaled gains, for the device to render at its own servo rate. Model updates are kept
   passive: an update that would store more energy in the wand's spring (the wand deeper in a
@@ -34,6 +36,7 @@ from remote_probe._checks import finite_number
 from remote_probe.link import RoundTripEstimator
 from remote_probe.tdpa import OperatorPassivity
 from remote_probe.teleop import Command, Feedback, RemotePlane, SCHEMES
+from remote_probe.virtual_coupling import CouplingConfig, VirtualCoupling
 from remote_probe.workspace_map import WorkspaceMap
 
 __all__ = ['Leader', 'LeaderConfig']
@@ -53,12 +56,16 @@ class LeaderConfig:
         Robot motion per wand motion.
     link_timeout : float, s
         Feedback older than this (since it arrived) is not rendered.
+    coupling : CouplingConfig or None
+        ``tdpa``: between the link's port and the wand. None: the controller acts on the wand
+        itself, as plain TDPA does (the baseline the coupling improves on: it chatters).
     """
 
     scheme: str = 'model'
     force_scale: float = 0.3
     position_scale: float = 1.0
     link_timeout: float = 0.1
+    coupling: CouplingConfig | None = CouplingConfig()
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:
@@ -87,6 +94,7 @@ class Leader:
         self._shown: RemotePlane | None = None  # the plane last shown, shift included
         self._shift = np.zeros(3)  # [m] wand frame: how far it is shown out from the estimate
         self._reserve = 0.0  # [J] energy model updates took out of the wand's spring, net
+        self._coupling: VirtualCoupling | None = None  # tdpa, while the link is live
 
     def receive(self, now: float, feedback: Feedback) -> bool:
         """Take ``feedback`` arrived at ``now`` (s); False if it is not newer than the held one."""
@@ -109,18 +117,29 @@ class Leader:
         return Command(stamp, target, self.map.velocity_to_robot(wand_velocity),
                        self.passivity.books.energy_in)
 
-    def force(self, now: float, wand_velocity, dt: float) -> np.ndarray:
-        """Return what the wand should push with, (3,) N, over the next ``dt`` s (not ``model``).
+    def force(self, now: float, wand, wand_velocity, dt: float) -> np.ndarray:
+        """Return the force (3,) N for the wand at ``wand`` (3,) m over the next ``dt`` s.
 
-        Zero while the link is silent or the clutch is engaged.
+        Not for ``model``. Zero while the link is silent or the clutch is engaged: for ``tdpa``
+        the coupling is then let go, and starts again at rest where the wand is.
         """
-        patient = np.zeros(3)
-        if self.live(now) and not self.map.clutched:
-            patient = self._feedback.force
-        if self.config.scheme == 'tdpa':
-            patient = self.passivity.control(patient, self.map.velocity_to_robot(wand_velocity),
-                                             dt)
-        return self.config.force_scale * patient
+        if not self.live(now) or self.map.clutched:
+            self._coupling = None
+            return np.zeros(3)
+        patient = self._feedback.force
+        if self.config.scheme != 'tdpa':
+            return self.config.force_scale * patient
+        if self.config.coupling is None:
+            return self.config.force_scale * self.passivity.control(
+                patient, self.map.velocity_to_robot(wand_velocity), dt)
+        if self._coupling is None:
+            self._coupling = VirtualCoupling(self.config.coupling, wand)
+        count, step = self._coupling.steps(dt)
+        for _ in range(count):  # the controller books each step's work on the mass
+            port = self.passivity.control(
+                patient, self.map.velocity_to_robot(self._coupling.velocity), step)
+            felt = self._coupling.step(self.config.force_scale * port, wand, wand_velocity, step)
+        return felt
 
     def plane(self, now: float, wand) -> RemotePlane | None:
         """Return the contact plane to show the wand at ``wand`` (3,) m (``model``); None: free.

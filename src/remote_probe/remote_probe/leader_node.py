@@ -25,6 +25,7 @@ from haptic_util.tally import Tally
 from remote_probe.leader import Leader, LeaderConfig
 from remote_probe.params import LeaderParams
 from remote_probe.teleop import Feedback, RemotePlane
+from remote_probe.virtual_coupling import CouplingConfig
 
 __all__ = ['LeaderNode', 'main']
 
@@ -46,7 +47,11 @@ class LeaderNode(Node):
         self.params = params = declare_parameters(self, LeaderParams)
         try:
             self.config = LeaderConfig(params.scheme, params.force_scale,
-                                       params.position_scale, params.link_timeout)
+                                       params.position_scale, params.link_timeout,
+                                       CouplingConfig(params.coupling_mass,
+                                                      params.coupling_stiffness,
+                                                      params.coupling_damping,
+                                                      params.coupling_ground_damping))
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self.leader: Leader | None = None  # from the first feedback on
@@ -129,7 +134,8 @@ class LeaderNode(Node):
         if self.params.scheme == 'model':
             self._answer(stamp_ns, self.leader.plane(now, position), position)
         else:
-            self._answer(stamp_ns, self.leader.force(now, velocity, max(period, 1e-6)))
+            self._answer(stamp_ns, self.leader.force(now, position, velocity,
+                                                     max(period, 1e-6)))
 
     def _answer(self, stamp_ns: int, answer, position=None) -> None:
         """Publish the wrench or model for the pose ``stamp_ns``; None: zero force, no model."""

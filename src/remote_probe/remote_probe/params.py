@@ -71,6 +71,14 @@ class LeaderParams:
     position_scale: float = parameter(1.0, 'robot motion per wand motion', low=1e-3, high=10.0)
     link_timeout: float = parameter(0.1, 'no feedback for this long: zero force', unit='s',
                                     low=0.001)
+    coupling_mass: float = parameter(0.1, 'tdpa: the virtual coupling\'s mass', unit='kg',
+                                     low=1e-3, high=10.0)
+    coupling_stiffness: float = parameter(400.0, 'tdpa: its spring to the wand', unit='N/m',
+                                          low=1.0, high=1e4)
+    coupling_damping: float = parameter(9.0, 'tdpa: its damper to the wand', unit='N*s/m',
+                                        low=0.0, high=1e3)
+    coupling_ground_damping: float = parameter(1.0, 'tdpa: its damper to the world',
+                                               unit='N*s/m', low=0.0, high=1e3)
     frame_id: str = parameter('world', 'the wand\'s frame')
     robot_frame: str = parameter('base_link', 'the robot\'s base frame, of the link\'s messages')
     force_limit: float = parameter(10.0, 'force limit sent with the contact model', unit='N',
