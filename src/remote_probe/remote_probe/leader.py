@@ -118,7 +118,7 @@ class Leader:
                        self.passivity.books.energy_in)
 
     def force(self, now: float, wand, wand_velocity, dt: float) -> np.ndarray:
-        """Return the force (3,) N for the wand at ``wand`` (3,) m over the next ``dt`` s.
+        """Return what the wand at ``wand`` (3,) m should push with over the next ``dt`` s, N.
 
         Not for ``model``. Zero while the link is silent or the clutch is engaged: for ``tdpa``
         the coupling is then let go, and starts again at rest where the wand is.
