@@ -4,7 +4,12 @@
 number: no tree, no pseudonormals, no code shared with the engine.
 """
 
-from ground_truth import hand_mesh_path, mesh_signed_distance, sample_near_surface
+from fuzzing import examples
+from ground_truth import (hand_mesh_path, mesh_signed_distance, sample_near_surface,
+                          simplex_distance)
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
 
@@ -94,6 +99,27 @@ def test_points_just_off_vertices_edges_and_faces(hand, offset):
     for points, direction in feature_points(hand, rng, 100):
         for sign in (1.0, -1.0):
             check(hand, points + sign * offset * direction, closest_too=False)
+
+
+def reference_triangle_bound2(corners, point) -> float:
+    """The larger squared distance from the point to the triangle's plane and to its box."""
+    normal = unit(np.cross(corners[1] - corners[0], corners[2] - corners[0]))
+    gaps = np.maximum(np.maximum(corners.min(axis=0) - point, 0.0), point - corners.max(axis=0))
+    return max(float(normal @ (point - corners[0])) ** 2, float(gaps @ gaps))
+
+
+@settings(max_examples=examples(300), deadline=None)
+@given(arrays(np.float64, (3, 3), elements=st.floats(-1.0, 1.0)),
+       arrays(np.float64, 3, elements=st.floats(-2.0, 2.0)))
+def test_the_triangle_bound_is_its_reference_and_below_the_distance(corners, point):
+    # The search skips a triangle whose bound is not below the best: it must never exceed the
+    # triangle's own distance (brute force, sharing no code).
+    normal = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+    assume(np.linalg.norm(normal) > 1e-3)
+    floats = np.concatenate((corners.ravel(), unit(normal)))
+    bound = bvh.triangle_bound2(floats, 0, 1, 0, *point)
+    assert bound == pytest.approx(reference_triangle_bound2(corners, point), rel=1e-12, abs=1e-15)
+    assert bound <= simplex_distance(corners - point) ** 2 * (1.0 + 1e-12) + 1e-15
 
 
 def test_tree_covers_every_triangle_once_in_nested_boxes(hand):

@@ -208,6 +208,8 @@ def test_zero_size_and_oversized_tools_are_refused(hand):
     ((0.0, 0.0, 0.0), (np.nan, 0.0, 0.0, 1.0)),
     ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
     ((0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),
+    ((0.0, 'x', 0.0), (0.0, 0.0, 0.0, 1.0)),
+    None,
 ])
 def test_bad_poses_are_refused(hand, pose):
     with pytest.raises(ValueError, match='tool pose'):

@@ -6,11 +6,13 @@ child first, skipping every box farther than the best distance found so far; the
 answer's triangle is tried first, which tightens the bound from the start on a trajectory. On
 each candidate triangle the closest point is computed exactly, in closed form
 (``signed_volumes.closest_point_on_triangle``: no iteration, no GJK), which also says which
-feature the nearest point lies on; the sign comes from that feature's angle-weighted
-pseudonormal (``pseudonormals``). The normal returned is the face's when the nearest point is
-inside a face, else the unit vector between the point and the surface (or, within 1e-9 of the
-mesh's size, where that vector is mostly rounding, the feature's pseudonormal). Vertices must be
-welded and the surface closed and consistently wound (``shapes.TriangleMesh`` checks).
+feature the nearest point lies on, unless a cheap lower bound on its distance (to its plane, to
+its box: ``triangle_bound2``) is not below the best so far; the sign comes from that feature's
+angle-weighted pseudonormal (``pseudonormals``). The normal returned is the face's when the
+nearest point is inside a face, else the unit vector between the point and the surface (or,
+within 1e-9 of the mesh's size, where that vector is mostly rounding, the feature's
+pseudonormal). Vertices must be welded and the surface closed and consistently wound
+(``shapes.TriangleMesh`` checks).
 
 Packed layout (one object's blocks; ``t`` triangles, ``e`` edges, ``n`` vertices, ``b`` nodes),
 triangles in tree-leaf order:
@@ -37,7 +39,7 @@ from collision_engine.signed_volumes import closest_point_on_triangle
 
 __all__ = ['FAR', 'LEAF_SIZE', 'box_distance2', 'build_tree', 'layout', 'mesh_distance',
            'nearest_triangle', 'pack_triangle_mesh', 'pseudonormal', 'search_stack_size',
-           'tree_depth', 'triangle_distance2']
+           'tree_depth', 'triangle_bound2', 'triangle_distance2']
 
 LEAF_SIZE = 4
 FAR = 2.0 ** 26  # mesh radii: beyond, a query is answered from a nearer point on its ray
@@ -204,6 +206,28 @@ def box_distance2(floats, b, qx, qy, qz):
 
 
 @jit
+def _gap(q, a, b, c):
+    """Distance from the coordinate q to the interval spanned by a, b and c (0 within it)."""
+    return max(min(a, b, c) - q, 0.0, q - max(a, b, c))
+
+
+@jit
+def triangle_bound2(floats, corners, n_tri, t, qx, qy, qz):
+    """Lower bound on the squared distance from q to triangle t (leaf order).
+
+    The larger of the distances to the triangle's plane and to its box: a few products, where
+    its closest point takes some hundred operations, so the search skips most of those.
+    """
+    c, f = corners + 9 * t, corners + 9 * n_tri + 3 * t
+    h = (floats[f] * (qx - floats[c]) + floats[f + 1] * (qy - floats[c + 1])
+         + floats[f + 2] * (qz - floats[c + 2]))
+    gx = _gap(qx, floats[c], floats[c + 3], floats[c + 6])
+    gy = _gap(qy, floats[c + 1], floats[c + 4], floats[c + 7])
+    gz = _gap(qz, floats[c + 2], floats[c + 5], floats[c + 8])
+    return max(h * h, gx * gx + gy * gy + gz * gz)
+
+
+@jit
 def triangle_distance2(floats, corners, t, qx, qy, qz):
     """Closest point of triangle t (leaf order) to q: ``closest_point_on_triangle``'s tuple."""
     c = corners + 9 * t
@@ -295,6 +319,8 @@ def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hin
             first = ints[nodes + 3 * node + 1]
             tested += ints[nodes + 3 * node + 2]
             for t in range(first, first + ints[nodes + 3 * node + 2]):
+                if triangle_bound2(floats, corners, n_tri, t, qx, qy, qz) >= best_d2:
+                    continue
                 d2, ux, uy, uz, f, w = triangle_distance2(floats, corners, t, qx, qy, qz)
                 if d2 < best_d2:
                     best_d2, vx, vy, vz, feature, which, best_t = d2, ux, uy, uz, f, w, t
