@@ -114,11 +114,15 @@ def rejoined(loop, client, name: str, since_ns: int) -> int:
     for attempt in range(REJOIN_ATTEMPTS):
         try:
             return wait_for_fresh_force(client, since_ns, REJOIN_TIMEOUT)
-        except TimeoutError:
-            REJOINS.append(name)
+        except TimeoutError as silence:
+            # Whether the restarted process was still running tells a silent one from a dead one.
+            REJOINS.append(f'{name} ({silence}; exit code {loop.child(name).returncode})')
             os.killpg(loop.child(name).pid, signal.SIGKILL)
             loop.restart(name)
-    return wait_for_fresh_force(client, since_ns, RECOVERY_TIMEOUT)
+    try:
+        return wait_for_fresh_force(client, since_ns, RECOVERY_TIMEOUT)
+    except TimeoutError as error:
+        raise TimeoutError(f'{error}; after restarting {name} again: {REJOINS}') from None
 
 
 REJOINS = []  # nodes restarted again because they did not rejoin
