@@ -171,3 +171,25 @@ def test_reordered_messages_from_the_link_are_ignored_by_stamp(tmp_path):
     patient_force = np.median(patient[window(patient_times - start, *PRESSING), 2])
     assert patient_force > 5.0
     assert felt_force == pytest.approx(patient_force, rel=0.15)
+
+
+def test_tdpa_over_the_link_gives_the_hand_no_energy_and_keeps_the_patient_safe(tmp_path):
+    """The whole scan with ``tdpa`` at 50 ms, both sites as processes: the leader's controller
+    through its coupling, stepped on the real pose periods. The work of what the device applied
+    on the hand, tick by tick (each force held over its tick, matched to the pose by stamp)."""
+    with teleop(tmp_path, scheme='tdpa', duration=SCAN_DURATION) as loop:
+        assert loop.wait(60.0) is not None, 'the scan did not end'
+    typestore = typestore_with(custom_definitions())
+    topics = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench'}
+    series = read_vectors(tmp_path / 'bag', typestore, topics, stamped=True)
+    pose_times, wand = series['/wand/pose']
+    felt_times, felt = series['/wand/applied_wrench']
+    _, at_pose, at_felt = np.intersect1d(pose_times, felt_times, return_indices=True)
+    following = np.flatnonzero(np.diff(at_pose) == 1)  # consecutive ticks, both recorded
+    steps = wand[at_pose[following + 1]] - wand[at_pose[following]]
+    work = float(np.einsum('ij,ij->', felt[at_felt[following + 1]], steps))
+    assert len(following) > 10_000
+    assert work <= 0.0, f'the hand was given {work:.4f} J'
+    patient = streams(tmp_path)['/remote/robot/ft_sensor/wrench'][1]
+    assert np.max(np.linalg.norm(patient, axis=1)) <= MAX_PATIENT_FORCE
+    assert np.max(np.linalg.norm(felt, axis=1)) > 0.5  # it does press, and is felt
