@@ -180,7 +180,8 @@ def test_tdpa_over_the_link_gives_the_hand_no_energy_and_keeps_the_patient_safe(
     with teleop(tmp_path, scheme='tdpa', duration=SCAN_DURATION) as loop:
         assert loop.wait(60.0) is not None, 'the scan did not end'
     typestore = typestore_with(custom_definitions())
-    topics = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench'}
+    topics = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
+              '/remote/robot/ft_sensor/wrench': 'wrench'}
     series = read_vectors(tmp_path / 'bag', typestore, topics, stamped=True)
     pose_times, wand = series['/wand/pose']
     felt_times, felt = series['/wand/applied_wrench']
@@ -190,6 +191,6 @@ def test_tdpa_over_the_link_gives_the_hand_no_energy_and_keeps_the_patient_safe(
     work = float(np.einsum('ij,ij->', felt[at_felt[following + 1]], steps))
     assert len(following) > 10_000
     assert work <= 0.0, f'the hand was given {work:.4f} J'
-    patient = streams(tmp_path)['/remote/robot/ft_sensor/wrench'][1]
+    patient = series['/remote/robot/ft_sensor/wrench'][1]
     assert np.max(np.linalg.norm(patient, axis=1)) <= MAX_PATIENT_FORCE
     assert np.max(np.linalg.norm(felt, axis=1)) > 0.5  # it does press, and is felt

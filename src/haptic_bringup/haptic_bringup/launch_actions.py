@@ -7,15 +7,23 @@ from functools import partial
 import signal
 import threading
 
-from launch.actions import EmitEvent, OpaqueFunction, RegisterEventHandler, TimerAction
+from launch.actions import (EmitEvent, OpaqueFunction, RegisterEventHandler,
+                            SetEnvironmentVariable, TimerAction)
 from launch.event_handlers import OnProcessExit
 from launch.events import matches_action, Shutdown
 from launch.events.process import SignalProcess
+from launch.substitutions import EnvironmentVariable
 from launch_ros.actions import Node
 
-__all__ = ['AllOrNothing', 'hear_sigint']
+__all__ = ['AllOrNothing', 'hear_sigint', 'local_discovery']
 
 STOP_TIMEOUT = 10.0  # [s] after a failure, the others' time to stop before launch escalates
+
+
+def local_discovery() -> SetEnvironmentVariable:
+    """Keep DDS discovery on this machine, unless the user exported another range."""
+    return SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', EnvironmentVariable(
+        'ROS_AUTOMATIC_DISCOVERY_RANGE', default_value='LOCALHOST'))
 
 
 def hear_sigint() -> None:

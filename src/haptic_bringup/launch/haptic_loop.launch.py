@@ -18,13 +18,12 @@ import tempfile
 
 from ament_index_python.packages import get_package_share_directory
 from launch import LaunchDescription
-from launch.actions import (DeclareLaunchArgument, ExecuteProcess, OpaqueFunction,
-                            SetEnvironmentVariable)
-from launch.substitutions import EnvironmentVariable, LaunchConfiguration
+from launch.actions import DeclareLaunchArgument, ExecuteProcess, OpaqueFunction
+from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 import yaml
 
-from haptic_bringup.launch_actions import AllOrNothing, hear_sigint
+from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
 from haptic_bringup.params import LOOP_TOPICS
 
 NODES = (('haptic_wand_driver', 'wand_driver', 'wand_driver'),
@@ -81,8 +80,7 @@ def _nodes(context):
 def generate_launch_description() -> LaunchDescription:
     hear_sigint()
     return LaunchDescription([
-        SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', EnvironmentVariable(
-            'ROS_AUTOMATIC_DISCOVERY_RANGE', default_value='LOCALHOST')),
+        local_discovery(),
         DeclareLaunchArgument('scene', default_value='',
                               description='scene YAML (default: each package config)'),
         DeclareLaunchArgument('experiment', default_value='',

@@ -18,12 +18,12 @@ import os
 import tempfile
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction, SetEnvironmentVariable
-from launch.substitutions import EnvironmentVariable, LaunchConfiguration
+from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 import yaml
 
-from haptic_bringup.launch_actions import AllOrNothing, hear_sigint
+from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
 from haptic_bringup.launcher import (bridge_parameters, LoopConfig, node_parameters,
                                      OPERATOR_SITE, REMOTE_SITE)
 
@@ -97,8 +97,7 @@ def _processes(context):
 def generate_launch_description() -> LaunchDescription:
     hear_sigint()
     return LaunchDescription([
-        SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', EnvironmentVariable(
-            'ROS_AUTOMATIC_DISCOVERY_RANGE', default_value='LOCALHOST')),
+        local_discovery(),
         *(DeclareLaunchArgument(name, default_value=default, description=description)
           for name, default, description in ARGUMENTS),
         OpaqueFunction(function=_processes),
