@@ -1,17 +1,20 @@
 """The haptic loop over ROS 2 against its floor, and the loop's round trip per layout and rate.
 
-    .venv/bin/python bench/bench_loop.py [--layouts separate composed] [--runs 3]
+    .venv/bin/python bench/bench_loop.py [--layouts separate composed composed-dds] [--runs 3]
                                          [--seconds 8] [--recorder off on]
     .venv/bin/python bench/bench_loop.py --sweep [--rates 500 1000 2000] [--duration 10]
     .venv/bin/python bench/bench_loop.py --cross-validation [--runs 3] [--seconds 8]
 
 The default compares the loop with its floor (``loop_floor.py``: the same topology with no work
-per hop), alternating floor and loop runs, each with one outside observer (a separate process
-subscribed to the poses and wrenches, as ``ros2 topic echo`` or RViz would be), without and
-with the recorder. Per run: CPU of every process over the window (100 % = one core), and, seen
-by the observer, the pose rate, the share of poses answered by a wrench, and pose -> wrench
-p50 and p99. Then the loop's figures as ratios to the floor's (medians over the runs), and
-whether each target of the CPU issue holds.
+per hop), alternating floor and loop runs, in each layout: ``separate`` (three processes),
+``composed`` (one process, its streams handed over in the process: ``haptic_util.intra_process``)
+and ``composed-dds`` (one process, its streams through DDS: the composed layout before that, its
+baseline; the floor of both is the bare chain in one process). Each run has one outside
+observer (a separate process subscribed to the poses and wrenches, as ``ros2 topic echo`` or RViz
+would be), without and with the recorder. Per run: CPU of every process over the window (100 %
+= one core), and, seen by the observer, the pose rate, the share of poses answered by a wrench,
+and pose -> wrench p50 and p99. Then the loop's figures as ratios to the floor's (medians over
+the runs), and whether each target of the CPU issue holds.
 
 ``--cross-validation`` runs the loop on the hand (where an FCL query costs the most) with the
 scene's FCL cross-check on and off, alternated, seen by the same observer: the cross-check runs
@@ -44,6 +47,8 @@ FLOOR = pathlib.Path(__file__).resolve().parent / 'loop_floor.py'
 WARM_UP = 3.0  # [s] from start to the window: discovery, the driver's probe, first contacts
 TAIL = 3.0  # [s] of experiment after the window: the cuboid's 10 s script ended inside it
 OBSERVER_SETTLE = 0.5  # [s] after the observer first hears both streams (see _observed)
+LAYOUTS = ('separate', 'composed', 'composed-dds')
+COMPOSED = ('composed', 'composed-dds')  # one process; its streams through DDS in the second
 TARGETS = {'cpu': 1.25, 'p99': 1.5, 'rate': 0.99, 'answered': 99.9}  # the CPU issue's
 
 
@@ -60,7 +65,8 @@ def run_once(layout: str, rate: float, duration: float, domain_id: int) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         stats = pathlib.Path(tmp) / 'stats.npz'
         config = LoopConfig(
-            composed=layout == 'composed', scene=SCENE, experiment='cuboid', duration=duration,
+            composed=layout in COMPOSED, intra_process=layout == 'composed', scene=SCENE,
+            experiment='cuboid', duration=duration,
             domain_id=domain_id, run_dir=pathlib.Path(tmp) / 'launch',
             overrides={'wand_driver': {'rate': float(rate), 'stats_file': str(stats)},
                        'collision_engine': {'marker_rate': 0.0},
@@ -90,7 +96,7 @@ def row(label: str, latencies: np.ndarray, record: dict) -> str:
 
 def _floor_children(layout: str, recorder: bool, folder: pathlib.Path, env: dict) -> list:
     python = sys.executable
-    roles = ['composed'] if layout == 'composed' else ['driver', 'collision', 'force']
+    roles = ['composed'] if layout in COMPOSED else ['driver', 'collision', 'force']
     children = [start_child(role, [python, str(FLOOR), role, '--ros-args'], env)
                 for role in roles]
     if recorder:
@@ -110,7 +116,8 @@ def session(kind: str, layout: str, recorder: bool, seconds: float, domain_id: i
         loop = None
         if kind == 'loop':
             loop = Loop(LoopConfig(
-                composed=layout == 'composed', scene=scene, experiment=experiment,
+                composed=layout in COMPOSED, intra_process=layout == 'composed', scene=scene,
+                experiment=experiment,
                 duration=WARM_UP + seconds + TAIL,
                 record=str(folder / 'bag') if recorder else None, domain_id=domain_id,
                 run_dir=folder / 'launch', overrides={'collision_engine': {'marker_rate': 0.0},
@@ -219,8 +226,7 @@ def verdicts(comparison: dict) -> list:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--layouts', nargs='+', default=['separate', 'composed'],
-                        choices=['separate', 'composed'])
+    parser.add_argument('--layouts', nargs='+', default=list(LAYOUTS), choices=LAYOUTS)
     parser.add_argument('--recorder', nargs='+', default=['off', 'on'], choices=['off', 'on'])
     parser.add_argument('--runs', type=int, default=3, help='floor/loop pairs per case')
     parser.add_argument('--seconds', type=float, default=8.0, help='measured window per run')

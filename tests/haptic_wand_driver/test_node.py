@@ -7,7 +7,7 @@ import rclpy
 from rclpy.context import Context
 
 from haptic_wand_driver.contact_model import Kind
-from haptic_wand_driver.node import MODEL, WandDriverNode
+from haptic_wand_driver.node import WandDriverNode
 
 
 class JumpingClock:
@@ -48,8 +48,8 @@ def test_rendering_locally_it_takes_the_model_alone_and_holds_the_wrench_of_a_la
     assert {s.topic_name for s in driver.subscriptions} == {'/wand/contact_model'}
     driver.tick()  # open loop: the session runs from the first tick
     pose = driver._last_probe_ns  # the stamp of the pose just published, which it answers
-    model = MODEL.encode(fields(kind=Kind.UNAVAILABLE, stamp=divmod(pose, 1_000_000_000),
-                                wrench=(1.0, 0.0, -0.5, 0.0, 0.0, 0.0)))
+    model = fields(kind=Kind.UNAVAILABLE, stamp=divmod(pose, 1_000_000_000),
+                   wrench=(1.0, 0.0, -0.5, 0.0, 0.0, 0.0))
     driver.on_model(model)
     state = driver.device.read(driver._device_time())
     force, torque = driver.renderer.wrench(driver._device_time(), [*state.position, 0.0, 0.0],

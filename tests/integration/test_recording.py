@@ -9,6 +9,7 @@ from domains import session_domain_id
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 import numpy as np
+import pytest
 import yaml
 
 from haptic_bringup.bag import FLUSH_PERIOD, recover, typestore_with
@@ -37,10 +38,12 @@ def stamps(messages: list) -> list:
     return [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in messages]
 
 
-def test_a_clean_stop_records_every_message_each_node_published(tmp_path):
-    with Loop(session_config(tmp_path, duration=DURATION)) as loop:
+@pytest.mark.parametrize('composed', [False, True], ids=['separate', 'composed'])
+def test_a_clean_stop_records_every_message_each_node_published(tmp_path, composed):
+    """Composed, the nodes hand their streams over in the process: the recorder's get all."""
+    with Loop(session_config(tmp_path, duration=DURATION, composed=composed)) as loop:
         ended = loop.wait(DURATION + 30.0)
-        assert ended is not None and ended.name == 'wand_driver'
+        assert ended is not None and ended.name == ('composed' if composed else 'wand_driver')
     bag = tmp_path / 'bag'
     info = yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
     assert info['version'] == 9 and info['storage_identifier'] == 'mcap'

@@ -7,8 +7,11 @@ about the tip (zero but for a scene's tool, whose face gives one: ``probe``): th
 wrench, which a device without local rendering applies. With it, one
 ``wand/contact_model`` (ContactModel): the local model the device renders at its servo rate.
 When no fresh state arrives for ``watchdog_timeout``, it publishes zero wrenches (and models that
-render nothing). The 1 kHz streams are read and written as CDR bytes (``haptic_util.cdr``).
+render nothing). The 1 kHz streams go through ``haptic_util.intra_process``: CDR bytes over DDS,
+leaf values within one process.
 """
+from typing import Sequence
+
 from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
@@ -28,9 +31,10 @@ from haptic_msgs.msg import CollisionState, ContactModel
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
+from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.qos import HAPTIC_STREAM_QOS, MARKER_QOS
+from haptic_util.qos import MARKER_QOS
 from haptic_util.tally import Tally
 
 __all__ = ['ForceNode', 'main']
@@ -74,15 +78,12 @@ class ForceNode(Node):
         self._zeroed = Tally()  # zero forces sent, by reason
         self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
         self._force = self._torque = _ZERO
-        self._wrench_pub = self.create_publisher(WrenchStamped, 'wand/wrench', HAPTIC_STREAM_QOS)
-        self._model_pub = self.create_publisher(ContactModel, 'wand/contact_model',
-                                                HAPTIC_STREAM_QOS)
-        self.create_subscription(CollisionState, 'collision/state', self.on_state,
-                                 HAPTIC_STREAM_QOS, raw=True)
+        self._wrench_pub = stream_publisher(self, WRENCH, 'wand/wrench')
+        self._model_pub = stream_publisher(self, MODEL, 'wand/contact_model')
+        stream_subscription(self, STATE, 'collision/state', self.on_state)
         uses_damping = any(max(damping) > 0.0 for _, damping in gains)
         if uses_damping and params.velocity_source == 'twist':
-            self.create_subscription(TwistStamped, 'wand/twist', self.on_twist,
-                                     HAPTIC_STREAM_QOS, raw=True)
+            stream_subscription(self, TWIST, 'wand/twist', self.on_twist)
         self.create_timer(params.watchdog_timeout / 2, self.check_stale)
         self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
         if params.marker_rate > 0:
@@ -128,12 +129,11 @@ class ForceNode(Node):
         laws = {name: SpringDamper(*gain) for name, gain in materials.items()}
         return PerObjectLaw(laws, SpringDamper(*default)), gains
 
-    def on_twist(self, data: bytes) -> None:
-        sec, nanosec, _, vx, vy, vz, _, _, _ = TWIST.decode(data)
+    def on_twist(self, fields: Sequence) -> None:
+        sec, nanosec, _, vx, vy, vz, _, _, _ = fields
         self._twist = (sec * 1_000_000_000 + nanosec, (vx, vy, vz))
 
-    def on_state(self, data: bytes) -> None:
-        fields = STATE.decode(data)
+    def on_state(self, fields: Sequence) -> None:
         (sec, nanosec, frame, name, status, distance, _, px, py, pz, nx, ny, nz, _, _, _,
          tx, ty, tz) = fields[:19]
         stamp_ns = sec * 1_000_000_000 + nanosec
@@ -160,10 +160,10 @@ class ForceNode(Node):
         # supersedes an answer to a newer pose still on its way to the driver.
         self._force = (float(force[0]), float(force[1]), float(force[2]))
         self._torque = self.pipeline.last_torque
-        self._wrench_pub.publish(WRENCH.encode((*self._header, *self._force, *self._torque)))
+        self._wrench_pub.publish((*self._header, *self._force, *self._torque))
         model = local_model(self.pipeline.law, self._contact, reason is Reason.OK,
                             self.params.model_radius)
-        self._model_pub.publish(MODEL.encode(self._model_fields(model)))
+        self._model_pub.publish(self._model_fields(model))
         self._published += 1
 
     def _model_fields(self, model) -> tuple:

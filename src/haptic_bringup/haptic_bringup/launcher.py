@@ -59,6 +59,7 @@ OPERATOR_RECORDED = ('/wand/pose', '/wand/twist', '/wand/applied_wrench', '/tele
 REMOTE_RECORDED = ('/robot/target_pose', '/robot/tcp_pose', '/robot/ft_sensor/wrench',
                    '/teleop/command', '/diagnostics')
 COMPOSED_MODULE = 'haptic_bringup.composed'
+NO_INTRA_PROCESS = '--no-intra-process'  # the composed process's streams through DDS
 RECORDER_MODULE = 'haptic_bringup.recorder'
 DEFAULT_DOMAIN_ID = 42
 DISCOVERY_TIMEOUT = 120.0  # [s] includes imports and, on a cold cache, compiling the kernels
@@ -72,6 +73,7 @@ class LoopConfig:
 
     nodes: tuple = tuple(NODES)
     composed: bool = False
+    intra_process: bool = True  # composed: the nodes' streams handed over in the process
     scene: Optional[str] = None
     experiment: Optional[str] = None
     duration: float = 0.0
@@ -178,16 +180,21 @@ def bridge_parameters(config: LoopConfig) -> dict:
 
 
 def teleop_endpoints(config: LoopConfig) -> dict:
-    """Domain → topic → (publishers, subscribers) that make the telerobotic session closed."""
+    """Domain → topic → (publishers, subscribers) that make the telerobotic session closed.
+
+    Each site is one process: a stream between its nodes is a DDS endpoint only without
+    intra-process delivery.
+    """
     recording = 1 if config.record else 0
+    site = 0 if config.intra_process else 1  # a subscriber in the publisher's process
     return {
-        config.domain_id: {'/wand/pose': (1, 1 + recording), '/teleop/command': (1, 1),
+        config.domain_id: {'/wand/pose': (1, site + recording), '/teleop/command': (1, 1),
                            '/teleop/feedback': (1, 1 + recording)},
         config.remote_domain_id: {'/teleop/command': (1, 1 + recording),
                                   '/teleop/feedback': (1, 1),
-                                  '/robot/target_pose': (1, 1 + recording),
-                                  '/robot/tcp_pose': (1, 1 + recording),
-                                  '/robot/ft_sensor/wrench': (1, 1 + recording)},
+                                  '/robot/target_pose': (1, site + recording),
+                                  '/robot/tcp_pose': (1, site + recording),
+                                  '/robot/ft_sensor/wrench': (1, site + recording)},
     }
 
 
@@ -195,15 +202,20 @@ def expected_endpoints(config: LoopConfig) -> dict:
     """Topic → (publishers, subscribers) that make the loop closed.
 
     The driver's own subscription is not among them: it takes the model or the wrench, as its
-    device can render, and it waits for that answer itself (it probes the loop end to end).
+    device can render, and it waits for that answer itself (it probes the loop end to end). Nor
+    is a subscriber that takes its stream in the publisher's process (``intra_process``).
     """
     recording = 1 if config.record else 0
     running = set(config.nodes)
+    over_dds = 0 if config.composed and config.intra_process else 1
+
+    def subscribers(node: str) -> int:
+        return recording + over_dds * (node in running)
     endpoints = {}
     if 'wand_driver' in running:
-        endpoints['/wand/pose'] = (1, recording + ('collision_engine' in running))
+        endpoints['/wand/pose'] = (1, subscribers('collision_engine'))
     if 'collision_engine' in running:
-        endpoints['/collision/state'] = (1, recording + ('force_renderer' in running))
+        endpoints['/collision/state'] = (1, subscribers('force_renderer'))
         endpoints.setdefault('/wand/pose', (0, 1))
     if 'force_renderer' in running:
         endpoints['/wand/wrench'] = endpoints['/wand/contact_model'] = (1, recording)
@@ -250,15 +262,20 @@ class Loop:
         if config.teleop:
             self._start_teleop(env, ros_args)
         elif config.composed:
-            self.children.append(start_child(
-                'composed', [config.python, '-m', COMPOSED_MODULE, *config.nodes, *ros_args],
-                env))
+            self.children.append(start_child('composed', self._composed(config.nodes, ros_args),
+                                             env))
         else:
             for name in config.nodes:
                 self.children.append(start_child(
                     name, [config.python, '-m', NODES[name][1], *ros_args], env))
         self._wait_for_discovery()
         self.startup_time = time.monotonic() - started
+
+    def _composed(self, nodes, ros_args: list) -> list:
+        """Return the command line of one process running ``nodes``."""
+        config = self.config
+        return [config.python, '-m', COMPOSED_MODULE, *nodes,
+                *([] if config.intra_process else [NO_INTRA_PROCESS]), *ros_args]
 
     def _start_teleop(self, env: dict, ros_args: list) -> None:
         """Start the two sites, each one process in its own domain, and the bridge."""
@@ -268,8 +285,7 @@ class Loop:
         bridge.write_text(yaml.safe_dump(bridge_parameters(config), sort_keys=False))
         for name, nodes, site_env in (('operator', OPERATOR_SITE, env),
                                       ('remote', REMOTE_SITE, remote_env)):
-            self.children.append(start_child(
-                name, [config.python, '-m', COMPOSED_MODULE, *nodes, *ros_args], site_env))
+            self.children.append(start_child(name, self._composed(nodes, ros_args), site_env))
         # The bridge stands for the network between the sites, so it talks to them over UDP,
         # as a remote peer would: over Fast DDS's shared memory, a bridge that stopped (SIGSTOP,
         # a link down for a second) stalled the sites' processes that publish to it.

@@ -21,7 +21,6 @@ traceback, counts it, and goes on. Each node decides what a failed callback mean
 import faulthandler
 import signal
 import sys
-import traceback
 from typing import Callable, Iterable, Optional
 
 import rclpy
@@ -32,6 +31,9 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
+
+from haptic_util import intra_process
+from haptic_util.callback_errors import callback_errors, log_callback_error
 
 __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'request_stop',
            'stop_requested', 'callback_errors', 'StartupError']
@@ -54,7 +56,6 @@ _CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException, NameValid
 # signal lands while the first handler holds it.
 # 'starting' is set while nodes are being built: a signal interrupts that.
 _flags = {'stop': False, 'starting': False}
-_errors: dict = {}  # (exception type, file, line) -> count
 
 
 def request_stop(*_) -> None:
@@ -65,11 +66,6 @@ def request_stop(*_) -> None:
 def stop_requested() -> bool:
     """Whether a stop was requested (a signal, or ``request_stop``)."""
     return _flags['stop']
-
-
-def callback_errors() -> int:
-    """How many callbacks raised in this process so far."""
-    return sum(_errors.values())
 
 
 def _on_signal(signum, frame) -> None:
@@ -106,17 +102,7 @@ def spin(executor: Executor, stop: Optional[Future] = None) -> None:
         except (KeyboardInterrupt, ExternalShutdownException):
             raise
         except Exception as error:  # any callback's failure is logged, not fatal
-            _log_once(error)
-
-
-def _log_once(error: Exception) -> None:
-    frames = traceback.extract_tb(error.__traceback__)
-    where = (type(error), frames[-1].filename, frames[-1].lineno) if frames else (type(error),)
-    _errors[where] = _errors.get(where, 0) + 1
-    if _errors[where] == 1:
-        text = ''.join(traceback.format_exception(error)).rstrip()
-        print(f'[ERROR] a callback raised; the node goes on (further ones from the same place '
-              f'are counted, not printed):\n{text}', file=sys.stderr, flush=True)
+            log_callback_error(error)
 
 
 def run_nodes(factories: Iterable[Callable[[], Node]], args=None, *,
@@ -165,6 +151,7 @@ def run_process(start: Callable[[list, list], None], *, executor: str = 'events'
             for node in nodes:
                 spinner.remove_node(node)
             spinner.shutdown(timeout_sec=SHUTDOWN_TIMEOUT)
+        intra_process.close()  # the nodes go one by one: none hears another's last words
         for node in nodes:
             node.destroy_node()
         for context in contexts or [None]:

@@ -9,6 +9,7 @@ import enum
 import math
 import pathlib
 import time
+from typing import Sequence
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 import numpy as np
@@ -19,9 +20,10 @@ from haptic_msgs.msg import ContactModel as ContactModelMessage
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
+from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
+from haptic_util.qos import LATCHED_QOS
 from haptic_util.tally import Tally
 from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
 from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
@@ -87,17 +89,16 @@ class WandDriverNode(Node):
         self._refused = Tally()  # wrenches not taken, by fault
         self._reported = (time.monotonic(), 0, 0)  # when, poses and answers at the last report
         self._recorder_ready = False
-        self._pose_pub = self.create_publisher(PoseStamped, 'wand/pose', HAPTIC_STREAM_QOS)
-        self._twist_pub = self.create_publisher(TwistStamped, 'wand/twist', HAPTIC_STREAM_QOS)
-        self._applied_pub = self.create_publisher(WrenchStamped, 'wand/applied_wrench',
-                                                  HAPTIC_STREAM_QOS)
+        self._pose_pub = stream_publisher(self, POSE, 'wand/pose')
+        self._twist_pub = stream_publisher(self, TWIST, 'wand/twist')
+        self._applied_pub = stream_publisher(self, WRENCH, 'wand/applied_wrench')
         # One answer per pose: the model when the device renders it (a model carries the wrench
         # of a law that has none), else the wrench. A stream it does not use costs a core's
         # percent or more at 1 kHz, for the publisher and for this node.
-        answers = ((ContactModelMessage, 'wand/contact_model', self.on_model)
+        answers = ((MODEL, 'wand/contact_model', self.on_model)
                    if self.renderer is not None else
-                   (WrenchStamped, 'wand/wrench', self.on_wrench))
-        self._answer_sub = self.create_subscription(*answers, HAPTIC_STREAM_QOS, raw=True)
+                   (WRENCH, 'wand/wrench', self.on_wrench))
+        self._answer_sub = stream_subscription(self, *answers)
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
         self.create_timer(1.0 / params.rate, self.tick)
@@ -170,8 +171,8 @@ class WandDriverNode(Node):
             state = self._state = self.device.read(device_now)
             if self.renderer is None:
                 self._apply(now, state)
-            self._publish(state, now_ns)
             self.stats.sent(now_ns)
+            self._publish(state, now_ns)
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
                 self._phase = Phase.DONE
                 self.get_logger().info(f'experiment done after {self.params.duration:g} s')
@@ -218,20 +219,25 @@ class WandDriverNode(Node):
         self.get_logger().info('loop closed: experiment started')
 
     def _publish(self, state, now_ns: int) -> None:
+        """Publish the state and what the device applied; its answer may come back inside.
+
+        The twist goes before the pose, and the pose is counted as sent before either: in one
+        process the pose's answer is computed (with this twist) and delivered inside the pose's
+        ``publish``.
+        """
         header = (*divmod(now_ns, 1_000_000_000), self.params.frame_id)
-        self._pose_pub.publish(POSE.encode((*header, *state.position.tolist(),
-                                            *state.orientation.tolist())))
-        self._twist_pub.publish(TWIST.encode((*header, *state.linear_velocity.tolist(),
-                                              *state.angular_velocity.tolist())))
         force, torque = self.device.applied()  # what the hand felt since the last tick
-        self._applied_pub.publish(WRENCH.encode((*header, *force.tolist(), *torque.tolist())))
         self._published += 1
         self._last_probe_ns = now_ns
+        self._twist_pub.publish((*header, *state.linear_velocity.tolist(),
+                                 *state.angular_velocity.tolist()))
+        self._pose_pub.publish((*header, *state.position.tolist(),
+                                *state.orientation.tolist()))
+        self._applied_pub.publish((*header, *force.tolist(), *torque.tolist()))
 
-    def on_wrench(self, data: bytes) -> None:
+    def on_wrench(self, wrench: Sequence) -> None:
         """Apply a wrench (remote rendering): held, kept passive, until its deadline."""
         now_ns = self.get_clock().now().nanoseconds
-        wrench = WRENCH.decode(data)
         stamp_ns = wrench[0] * 1_000_000_000 + wrench[1]
         if not self._answered(stamp_ns, now_ns):
             return
@@ -242,10 +248,9 @@ class WandDriverNode(Node):
             self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
         self._apply(now, state)
 
-    def on_model(self, data: bytes) -> None:
+    def on_model(self, fields: Sequence) -> None:
         """Hand a contact model to the device's renderer; a bad one gives zero force."""
         now_ns = self.get_clock().now().nanoseconds
-        fields = MODEL.decode(data)
         if not self._answered(fields[0] * 1_000_000_000 + fields[1], now_ns):
             return
         try:

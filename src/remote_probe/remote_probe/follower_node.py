@@ -9,6 +9,7 @@ surface as this site sees it (a depth camera's, here the phantom's mesh), for th
 contact.
 """
 import math
+from typing import Sequence
 
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 import numpy as np
@@ -19,9 +20,9 @@ from haptic_msgs.msg import TeleopCommand, TeleopFeedback
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
+from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.qos import HAPTIC_STREAM_QOS
 from haptic_util.tally import Tally
 from haptic_wand_driver.experiments import surface_projection
 from remote_probe.follower import Follower, FollowerConfig
@@ -68,16 +69,11 @@ class FollowerNode(Node):
         self._force = np.zeros(3)
         self._refused = Tally()
         self._sent = 0
-        self._target_pub = self.create_publisher(PoseStamped, 'robot/target_pose',
-                                                 HAPTIC_STREAM_QOS)
-        self._feedback_pub = self.create_publisher(TeleopFeedback, 'teleop/feedback',
-                                                   HAPTIC_STREAM_QOS)
-        self.create_subscription(TeleopCommand, 'teleop/command', self.on_command,
-                                 HAPTIC_STREAM_QOS, raw=True)
-        self.create_subscription(PoseStamped, 'robot/tcp_pose', self.on_tcp, HAPTIC_STREAM_QOS,
-                                 raw=True)
-        self.create_subscription(WrenchStamped, 'robot/ft_sensor/wrench', self.on_wrench,
-                                 HAPTIC_STREAM_QOS, raw=True)
+        self._target_pub = stream_publisher(self, POSE, 'robot/target_pose')
+        self._feedback_pub = stream_publisher(self, FEEDBACK, 'teleop/feedback')
+        stream_subscription(self, COMMAND, 'teleop/command', self.on_command)
+        stream_subscription(self, POSE, 'robot/tcp_pose', self.on_tcp)
+        stream_subscription(self, WRENCH, 'robot/ft_sensor/wrench', self.on_wrench)
         self.create_timer(self._period, self.tick)
         rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == 'model'
                                         else FORCE_FEEDBACK_RATE)
@@ -90,8 +86,7 @@ class FollowerNode(Node):
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def on_command(self, data: bytes) -> None:
-        fields = COMMAND.decode(data)
+    def on_command(self, fields: Sequence) -> None:
         if fields[2] != self.params.frame_id:
             self._refused.add(f'command in frame {fields[2]!r}')
             return
@@ -103,16 +98,14 @@ class FollowerNode(Node):
         if not self.follower.receive(self._now(), command):
             self._refused.add('command older than the held one')
 
-    def on_tcp(self, data: bytes) -> None:
-        fields = POSE.decode(data)
+    def on_tcp(self, fields: Sequence) -> None:
         now = self._now()
         position = np.array(fields[3:6], dtype=np.float64)
         if self._tcp is not None and now > self._tcp_time:
             self._tcp_velocity = (position - self._tcp) / (now - self._tcp_time)
         self._tcp, self._tcp_time = position, now
 
-    def on_wrench(self, data: bytes) -> None:
-        fields = WRENCH.decode(data)
+    def on_wrench(self, fields: Sequence) -> None:
         self._force, self._force_time = np.array(fields[3:6], dtype=np.float64), self._now()
         if not np.all(np.isfinite(self._force)):
             self._refused.add('F/T wrench not finite')
@@ -127,8 +120,8 @@ class FollowerNode(Node):
         velocity = self._tcp_velocity if self._tcp_velocity is not None else np.zeros(3)
         target = self.follower.target(now, self._tcp, velocity, force, self._period)
         sec, nanosec = divmod(self.get_clock().now().nanoseconds, 1_000_000_000)
-        self._target_pub.publish(POSE.encode((sec, nanosec, self.params.frame_id,
-                                              *target.tolist(), *_IDENTITY)))
+        self._target_pub.publish((sec, nanosec, self.params.frame_id,
+                                  *target.tolist(), *_IDENTITY))
 
     def send_feedback(self) -> None:
         if self._tcp is None:
@@ -141,10 +134,10 @@ class FollowerNode(Node):
         plane_fields = ((0.0,) * 15 if plane is None else
                         (*plane.point.tolist(), *plane.normal.tolist(), *[plane.stiffness] * 3,
                          *[plane.damping] * 3, 0.0, 0.0, 0.0))
-        self._feedback_pub.publish(FEEDBACK.encode((
+        self._feedback_pub.publish((
             *divmod(now_ns, 1_000_000_000), self.params.frame_id, *divmod(echo, 1_000_000_000),
             feedback.echo_hold, *feedback.force.tolist(), *feedback.tcp.tolist(),
-            feedback.energy_in, kind, *plane_fields)))
+            feedback.energy_in, kind, *plane_fields))
         self._sent += 1
 
     def report(self) -> Report:

@@ -9,6 +9,7 @@ the robot's anchor. ``teleop/clutch`` (Bool, true: engaged) re-centres the wand 
 the robot.
 """
 import math
+from typing import Sequence
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 import numpy as np
@@ -19,8 +20,9 @@ from haptic_msgs.msg import ContactModel, TeleopCommand, TeleopFeedback
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
+from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
+from haptic_util.qos import LATCHED_QOS
 from haptic_util.tally import Tally
 from remote_probe.leader import Leader, LeaderConfig
 from remote_probe.params import LeaderParams
@@ -55,22 +57,19 @@ class LeaderNode(Node):
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self.leader: Leader | None = None  # from the first feedback on
-        self._pending = None  # (stamp ns, position) of the pose waiting for its twist
+        self._pending = None  # (stamp ns, position) of the latest pose
+        self._twist = None  # (stamp ns, velocity) of a twist whose pose is not answered yet
         self._last_stamp_ns = None
         self._clutch = False
         self._refused = Tally()
         self._answers = 0
-        self._command_pub = self.create_publisher(TeleopCommand, 'teleop/command',
-                                                  HAPTIC_STREAM_QOS)
-        answer = ((ContactModel, 'wand/contact_model') if params.scheme == 'model'
-                  else (WrenchStamped, 'wand/wrench'))
-        self._answer_pub = self.create_publisher(*answer, HAPTIC_STREAM_QOS)
-        self.create_subscription(PoseStamped, 'wand/pose', self.on_pose, HAPTIC_STREAM_QOS,
-                                 raw=True)
-        self.create_subscription(TwistStamped, 'wand/twist', self.on_twist, HAPTIC_STREAM_QOS,
-                                 raw=True)
-        self.create_subscription(TeleopFeedback, 'teleop/feedback', self.on_feedback,
-                                 HAPTIC_STREAM_QOS, raw=True)
+        self._command_pub = stream_publisher(self, COMMAND, 'teleop/command')
+        answer = ((MODEL, 'wand/contact_model') if params.scheme == 'model'
+                  else (WRENCH, 'wand/wrench'))
+        self._answer_pub = stream_publisher(self, *answer)
+        stream_subscription(self, POSE, 'wand/pose', self.on_pose)
+        stream_subscription(self, TWIST, 'wand/twist', self.on_twist)
+        stream_subscription(self, FEEDBACK, 'teleop/feedback', self.on_feedback)
         self.create_subscription(Bool, 'teleop/clutch', self.on_clutch, LATCHED_QOS)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         self.get_logger().info(f'{params.scheme} scheme: force x{params.force_scale:g}, '
@@ -79,8 +78,7 @@ class LeaderNode(Node):
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def on_feedback(self, data: bytes) -> None:
-        fields = FEEDBACK.decode(data)
+    def on_feedback(self, fields: Sequence) -> None:
         if fields[2] != self.params.robot_frame:
             self._refused.add(f'feedback in frame {fields[2]!r}')
             return
@@ -102,21 +100,25 @@ class LeaderNode(Node):
         if not self.leader.receive(self._now(), feedback):
             self._refused.add('feedback older than the held one')
 
-    def on_pose(self, data: bytes) -> None:
-        fields = POSE.decode(data)
+    def on_pose(self, fields: Sequence) -> None:
         if fields[2] != self.params.frame_id:
             self._refused.add(f'pose in frame {fields[2]!r}')
             return
         self._pending = (fields[0] * 1_000_000_000 + fields[1],
                          np.array(fields[3:6], dtype=np.float64))
+        self._answer_when_paired()
 
-    def on_twist(self, data: bytes) -> None:
-        """Answer the pose of the same stamp: the driver publishes its twist right after it."""
-        fields = TWIST.decode(data)
-        stamp_ns = fields[0] * 1_000_000_000 + fields[1]
-        if self._pending is None or self._pending[0] != stamp_ns:
+    def on_twist(self, fields: Sequence) -> None:
+        self._twist = (fields[0] * 1_000_000_000 + fields[1], fields[3:6])
+        self._answer_when_paired()
+
+    def _answer_when_paired(self) -> None:
+        """Answer the pose once the twist of its stamp is in too, whichever came first."""
+        if self._pending is None or self._twist is None or self._twist[0] != self._pending[0]:
             return
-        position, velocity = self._pending[1], np.array(fields[3:6], dtype=np.float64)
+        stamp_ns, position = self._pending
+        velocity = np.array(self._twist[1], dtype=np.float64)
+        self._twist = None
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
             self._refused.add('wand pose or twist not finite')
             self._answer(stamp_ns, None)
@@ -127,9 +129,9 @@ class LeaderNode(Node):
         period = (stamp_ns - self._last_stamp_ns) * 1e-9 if self._last_stamp_ns else 1e-3
         self._last_stamp_ns = stamp_ns
         command = self.leader.command(stamp_ns * 1e-9, position, velocity)
-        self._command_pub.publish(COMMAND.encode((
+        self._command_pub.publish((
             *divmod(stamp_ns, 1_000_000_000), self.params.robot_frame,
-            *command.position.tolist(), *command.velocity.tolist(), command.energy_in)))
+            *command.position.tolist(), *command.velocity.tolist(), command.energy_in))
         now = self._now()
         if self.params.scheme == 'model':
             self._answer(stamp_ns, self.leader.plane(now, position), position)
@@ -143,7 +145,7 @@ class LeaderNode(Node):
         self._answers += 1
         if self.params.scheme != 'model':
             force = (0.0, 0.0, 0.0) if answer is None else tuple(answer.tolist())
-            self._answer_pub.publish(WRENCH.encode((*header, *force, 0.0, 0.0, 0.0)))
+            self._answer_pub.publish((*header, *force, 0.0, 0.0, 0.0))
             return
         tip = (0.0, 0.0, 0.0) if position is None else tuple(position.tolist())
         if answer is None:
@@ -152,9 +154,9 @@ class LeaderNode(Node):
             kind, count = ContactModel.KIND_PLANES, 1
             plane = (*answer.point.tolist(), *answer.normal.tolist(), *[answer.stiffness] * 3,
                      *[answer.damping] * 3, 0.0, 0.0, 0.0)
-        self._answer_pub.publish(MODEL.encode((
+        self._answer_pub.publish((
             *header, 'patient', kind, count, *plane, *_UNUSED_PLANES, self.params.force_limit,
-            self.params.model_lifetime, self.params.model_radius, *tip, *_ZERO_WRENCH)))
+            self.params.model_lifetime, self.params.model_radius, *tip, *_ZERO_WRENCH))
 
     def on_clutch(self, msg: Bool) -> None:
         if self.leader is None or self._pending is None:

@@ -9,6 +9,7 @@ A target in another frame, or with NaN, is refused (counted, reported at 1 Hz): 
 the last good one.
 """
 import time
+from typing import Sequence
 
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 import numpy as np
@@ -18,9 +19,9 @@ from collision_engine import load_scene
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report
 from haptic_util.executor import run_nodes, StartupError
+from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.qos import HAPTIC_STREAM_QOS
 from haptic_util.tally import Tally
 from remote_probe.ft_sensor import ForceTorqueSensor, ForceTorqueSensorConfig
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
@@ -58,11 +59,9 @@ class SimulatedRobotNode(Node):
         self._start = time.monotonic()
         self._refused = Tally()
         self._published = 0
-        self._pose_pub = self.create_publisher(PoseStamped, 'robot/tcp_pose', HAPTIC_STREAM_QOS)
-        self._wrench_pub = self.create_publisher(WrenchStamped, 'robot/ft_sensor/wrench',
-                                                 HAPTIC_STREAM_QOS)
-        self.create_subscription(PoseStamped, 'robot/target_pose', self.on_target,
-                                 HAPTIC_STREAM_QOS, raw=True)
+        self._pose_pub = stream_publisher(self, POSE, 'robot/tcp_pose')
+        self._wrench_pub = stream_publisher(self, WRENCH, 'robot/ft_sensor/wrench')
+        stream_subscription(self, POSE, 'robot/target_pose', self.on_target)
         self.create_timer(1.0 / params.rate, self.tick)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
 
@@ -70,8 +69,7 @@ class SimulatedRobotNode(Node):
         """Return the robot's clock (s): monotonic, so a step of the system clock moves nothing."""
         return time.monotonic() - self._start
 
-    def on_target(self, data: bytes) -> None:
-        fields = POSE.decode(data)
+    def on_target(self, fields: Sequence) -> None:
         if fields[2] != self.params.frame_id:
             self._refused.add(f'target in frame {fields[2]!r}')
             return
@@ -86,10 +84,10 @@ class SimulatedRobotNode(Node):
         reading = self.sensor.measure(state.time, state.external_force)
         sec, nanosec = divmod(self.get_clock().now().nanoseconds, 1_000_000_000)
         header = (sec, nanosec, self.params.frame_id)
-        self._pose_pub.publish(POSE.encode((*header, *state.position.tolist(),
-                                            *state.orientation.tolist())))
-        self._wrench_pub.publish(WRENCH.encode((*header, *reading.force.tolist(),
-                                                *reading.torque.tolist())))
+        self._pose_pub.publish((*header, *state.position.tolist(),
+                                *state.orientation.tolist()))
+        self._wrench_pub.publish((*header, *reading.force.tolist(),
+                                  *reading.torque.tolist()))
         self._published += 1
 
     def report(self) -> Report:

@@ -1,0 +1,167 @@
+"""The 1 kHz streams between nodes of one process, handed over in the process; DDS for the rest.
+
+Why: rclpy has no intra-process transport (rclcpp's ``use_intra_process_comms``). Between two
+nodes of one process, a stream went through Fast DDS all the same: serialized, written, a
+listener event, a take, the executor's dispatch and a parse, per message and per reader. With
+intra-process delivery on (``enable``, as the composed process does), a message published in
+the process is handed to the process's own subscriptions of its topic as its leaf values (what
+``haptic_util.cdr`` would have parsed), and serialized and written to DDS only while a reader of
+another process matches it (a recorder, RViz, ``ros2 topic echo``): a stream nobody outside
+reads costs no DDS at all. A subscription takes its topic over DDS only while no node of the
+process publishes it, so nothing arrives twice.
+
+Order: messages are delivered in the order they were published in the process (one first-in
+first-out queue). A ``publish`` from outside any delivery (a timer, a DDS callback) delivers
+before it returns, and with it everything its subscribers publish in turn: a node that publishes
+a request gets the answer of its own process inside that ``publish``. A callback that raises is
+logged and counted as the executor does it (``callback_errors``) and stops no other.
+
+Without ``enable`` (one node per process), a stream is CDR over DDS, parsed and serialized by
+its codec, and a publisher skips the write while nobody reads it. Streams use the haptic QoS.
+"""
+from collections import deque
+from typing import Callable, Sequence
+
+from rclpy.node import Node
+
+from haptic_util.callback_errors import log_callback_error
+from haptic_util.cdr import MessageCodec
+from haptic_util.qos import HAPTIC_STREAM_QOS
+
+__all__ = ['close', 'enable', 'enabled', 'stream_publisher', 'stream_subscription',
+           'StreamPublisher', 'StreamSubscription']
+
+_state = {'enabled': False}
+_topics: dict = {}  # resolved topic -> _Topic, while enabled
+_pending: deque = deque()  # (subscription, bytes) to deliver, in publishing order
+_draining = [False]
+
+
+def enable() -> None:
+    """Hand streams between this process's nodes over in the process (call before making them)."""
+    _state['enabled'] = True
+
+
+def close() -> None:
+    """Stop delivering in the process and forget its topics: its nodes are being destroyed."""
+    for record in _topics.values():
+        record.subscriptions.clear()  # the publishers hold these lists
+    _topics.clear()
+    _pending.clear()
+    _state['enabled'] = False
+
+
+def enabled() -> bool:
+    """Whether intra-process delivery is on in this process."""
+    return _state['enabled']
+
+
+class _Topic:
+    """A topic's local publishers and subscriptions, and its message type."""
+
+    def __init__(self, msg_type) -> None:
+        self.msg_type = msg_type
+        self.publishers: list = []
+        self.subscriptions: list = []
+
+
+def _topic(node: Node, msg_type, topic: str) -> _Topic | None:
+    """Return the process's record of ``topic`` (None while intra-process delivery is off)."""
+    if not _state['enabled']:
+        return None
+    name = node.resolve_topic_name(topic)
+    record = _topics.setdefault(name, _Topic(msg_type))
+    if record.msg_type is not msg_type:
+        raise ValueError(f'topic {name} is {record.msg_type.__name__} in this process, '
+                         f'not {msg_type.__name__}')
+    return record
+
+
+class StreamPublisher:
+    """Publishes leaf values: to the process's subscriptions, and to DDS when another reads it."""
+
+    def __init__(self, node: Node, codec: MessageCodec, topic: str) -> None:
+        self._codec = codec
+        self._dds = node.create_publisher(codec.message_class, topic, HAPTIC_STREAM_QOS)
+        self._topic = _topic(node, codec.message_class, topic)
+        self._local = self._topic.subscriptions if self._topic is not None else []
+        if self._topic is not None:
+            self._topic.publishers.append(self)
+            for subscription in self._topic.subscriptions:
+                subscription.served_locally()
+
+    @property
+    def topic_name(self) -> str:
+        """The resolved topic name."""
+        return self._dds.topic_name
+
+    def publish(self, values: Sequence) -> None:
+        """Publish one message, given as its leaf values in the codec's ``fields`` order."""
+        if len(values) != len(self._codec.fields):
+            raise ValueError(f'{self.topic_name}: {len(values)} values for the '
+                             f'{len(self._codec.fields)} fields of '
+                             f'{self._codec.message_class.__name__}')
+        if self._local:
+            _pending.extend((subscription, values) for subscription in self._local)
+            _drain()
+        if self._dds.get_subscription_count():
+            self._dds.publish(self._codec.encode(values))
+
+    def get_subscription_count(self) -> int:
+        """Return how many subscriptions match: of this process, and over DDS."""
+        return len(self._local) + self._dds.get_subscription_count()
+
+
+class StreamSubscription:
+    """Takes a topic's messages as leaf values: from the process's publishers, or over DDS."""
+
+    def __init__(self, node: Node, codec: MessageCodec, topic: str,
+                 callback: Callable[[Sequence], None]) -> None:
+        self.callback = callback
+        self._node = node
+        self._topic = _topic(node, codec.message_class, topic)
+        self._dds = None
+        if self._topic is not None:
+            self._topic.subscriptions.append(self)
+        if self._topic is None or not self._topic.publishers:
+            self._dds = node.create_subscription(
+                codec.message_class, topic, lambda data: callback(codec.decode(data)),
+                HAPTIC_STREAM_QOS, raw=True)
+
+    def served_locally(self) -> None:
+        """Stop taking the topic over DDS: a node of this process publishes it."""
+        if self._dds is not None:
+            self._node.destroy_subscription(self._dds)
+            self._dds = None
+
+    def get_publisher_count(self) -> int:
+        """Return how many publishers match: of this process, and over DDS."""
+        local = len(self._topic.publishers) if self._topic is not None else 0
+        return local + (self._dds.get_publisher_count() if self._dds is not None else 0)
+
+
+def _drain() -> None:
+    """Deliver the pending messages in order; the outermost ``publish`` does it."""
+    if _draining[0]:
+        return
+    _draining[0] = True
+    try:
+        while _pending:
+            subscription, values = _pending.popleft()
+            try:
+                subscription.callback(values)
+            except Exception as error:  # one node's failure does not stop the others
+                log_callback_error(error)
+    finally:
+        _draining[0] = False
+
+
+def stream_publisher(node: Node, codec: MessageCodec, topic: str) -> StreamPublisher:
+    """Return a publisher of a 1 kHz stream of ``codec``'s message type on ``topic``."""
+    return StreamPublisher(node, codec, topic)
+
+
+def stream_subscription(node: Node, codec: MessageCodec, topic: str,
+                        callback: Callable[[Sequence], None]) -> StreamSubscription:
+    """Return a subscription of a 1 kHz stream: ``callback`` gets each message's leaf values."""
+    return StreamSubscription(node, codec, topic, callback)

@@ -1,0 +1,154 @@
+"""Streams between nodes of one process: handed over in it, in order; DDS only for the outside.
+
+The "outside" is a node of a second rclpy context: its own DDS participant, as another process
+would have, whose subscriptions the bus does not know.
+"""
+import time
+
+from domains import session_domain_id
+from geometry_msgs.msg import PoseStamped, WrenchStamped
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+
+from haptic_util import intra_process
+from haptic_util.callback_errors import callback_errors
+from haptic_util.cdr import MessageCodec
+from haptic_util.intra_process import stream_publisher, stream_subscription
+from haptic_util.qos import HAPTIC_STREAM_QOS
+
+POSE = MessageCodec(PoseStamped)
+WRENCH = MessageCodec(WrenchStamped)
+VALUES = (12, 345, 'world', 0.1, -0.2, 0.3, 0.0, 0.0, 0.0, 1.0)
+MATCH_TIMEOUT = 10.0  # [s] for DDS discovery between two participants
+
+
+@pytest.fixture
+def context():
+    context = Context()
+    rclpy.init(context=context, domain_id=session_domain_id())
+    yield context
+    rclpy.try_shutdown(context=context)
+
+
+@pytest.fixture
+def bus():
+    intra_process.enable()
+    yield
+    intra_process.close()
+
+
+def node(context, name):
+    return Node(name, context=context)
+
+
+def spin_until(context, nodes, done, timeout=MATCH_TIMEOUT) -> bool:
+    executor = SingleThreadedExecutor(context=context)
+    for each in nodes:
+        executor.add_node(each)
+    deadline = time.monotonic() + timeout
+    while not done() and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.01)
+    return done()
+
+
+def test_in_one_process_a_message_reaches_its_subscriber_as_values_before_publish_returns(
+        context, bus):
+    got = []
+    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    subscriber = node(context, 'collision')
+    stream_subscription(subscriber, POSE, 'wand/pose', got.append)
+    publisher.publish(VALUES)
+    assert got == [VALUES]
+    assert list(subscriber.subscriptions) == []  # nothing taken over DDS
+
+
+def test_a_subscription_made_before_its_publisher_stops_taking_the_topic_over_dds(
+        context, bus):
+    subscriber = node(context, 'collision')
+    subscription = stream_subscription(subscriber, POSE, 'wand/pose', lambda values: None)
+    assert [s.topic_name for s in subscriber.subscriptions] == ['/wand/pose']
+    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    assert list(subscriber.subscriptions) == []
+    assert publisher.get_subscription_count() == 1 and subscription.get_publisher_count() == 1
+
+
+def test_messages_are_delivered_in_the_order_they_were_published(context, bus):
+    seen = []
+    pose_out = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    relay = node(context, 'relay')
+    wrench_out = stream_publisher(relay, WRENCH, 'wand/wrench')
+
+    def answer(values):
+        seen.append(('relay', values[1]))
+        wrench_out.publish((*values[:3], 1.0, 2.0, 3.0, 0.0, 0.0, 0.0))
+        seen.append(('relay published', values[1]))
+    stream_subscription(relay, POSE, 'wand/pose', answer)
+    stream_subscription(node(context, 'observer'), POSE, 'wand/pose',
+                        lambda values: seen.append(('observer', values[1])))
+    stream_subscription(node(context, 'driver_in'), WRENCH, 'wand/wrench',
+                        lambda values: seen.append(('wrench', values[1])))
+    pose_out.publish(VALUES)
+    seen.append('returned')
+    # The relay's wrench waits for the relay's callback and the pose's other subscriber.
+    assert seen == [('relay', 345), ('relay published', 345), ('observer', 345),
+                    ('wrench', 345), 'returned']
+
+
+def test_a_raising_subscriber_is_counted_and_the_others_still_get_the_message(context, bus,
+                                                                              capsys):
+    got = []
+    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+
+    def fails(values):
+        raise RuntimeError('a bad pose')
+    stream_subscription(node(context, 'flaky'), POSE, 'wand/pose', fails)
+    stream_subscription(node(context, 'steady'), POSE, 'wand/pose', got.append)
+    errors = callback_errors()
+    publisher.publish(VALUES)
+    publisher.publish(VALUES)
+    assert got == [VALUES, VALUES] and callback_errors() == errors + 2
+    assert capsys.readouterr().err.count('RuntimeError: a bad pose') == 1  # once per place
+
+
+def test_dds_carries_a_message_only_while_a_reader_of_another_process_matches(context, bus):
+    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    stream_subscription(node(context, 'collision'), POSE, 'wand/pose', lambda values: None)
+    writes = []
+    write = publisher._dds.publish
+    publisher._dds.publish = lambda data: (writes.append(data), write(data))
+    publisher.publish(VALUES)
+    assert writes == []  # the one reader is in the process
+    outside = Context()
+    rclpy.init(context=outside, domain_id=session_domain_id())
+    try:
+        recorder = node(outside, 'recorder')
+        received = []
+        recorder.create_subscription(PoseStamped, 'wand/pose', received.append,
+                                     HAPTIC_STREAM_QOS, raw=True)
+        assert spin_until(outside, [recorder], lambda: publisher.get_subscription_count() == 2)
+        assert spin_until(outside, [recorder],
+                          lambda: publisher.publish(VALUES) or bool(received))
+        assert POSE.decode(received[0]) == list(VALUES) and writes[0] == received[0]
+    finally:
+        rclpy.try_shutdown(context=outside)
+
+
+def test_without_it_a_stream_is_cdr_over_dds_and_parsed_for_the_callback(context):
+    got = []
+    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    subscriber = node(context, 'collision')
+    stream_subscription(subscriber, POSE, 'wand/pose', got.append)
+    assert [s.topic_name for s in subscriber.subscriptions] == ['/wand/pose']
+    assert spin_until(context, [subscriber], lambda: publisher.publish(VALUES) or bool(got))
+    assert got[0] == list(VALUES)
+
+
+def test_a_topic_of_two_types_or_a_message_of_the_wrong_length_is_refused(context, bus):
+    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    with pytest.raises(ValueError, match='wand/pose is PoseStamped in this process'):
+        stream_subscription(node(context, 'other'), WRENCH, 'wand/pose', lambda values: None)
+    with pytest.raises(ValueError, match='9 values for the 10 fields of PoseStamped'):
+        publisher.publish(VALUES[:-1])
