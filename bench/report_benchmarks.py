@@ -34,7 +34,7 @@ TELEOP_DELAYS = (0.0, 0.01, 0.025, 0.05, 0.1, 0.25)  # [s] one way
 TELEOP_PLOTTED = 0.1  # [s] the delay whose runs over ROS 2 are plotted
 TELEOP_JITTER, TELEOP_LOSS = 0.1, 0.01  # of the delay; a probability
 TELEOP_DEMO_DELAY = 0.05  # [s] the demo's run (haptic_bringup.demo)
-LOOP_LAYOUTS = ('separate', 'composed')
+LOOP_LAYOUTS = ('separate', 'composed', 'composed-dds')
 TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 ITERATION_CAPS = (1, 2, 3, 4, 6, 8, 12, 16, 100)
 

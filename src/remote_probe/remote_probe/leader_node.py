@@ -58,7 +58,8 @@ class LeaderNode(Node):
             raise StartupError(f'{self.get_name()}: {error}') from None
         self.leader: Leader | None = None  # from the first feedback on
         self._pending = None  # (stamp ns, position) of the latest pose
-        self._twist = None  # (stamp ns, velocity) of a twist whose pose is not answered yet
+        self._twist = None  # (stamp ns, velocity) of the latest twist
+        self._answered_ns = None  # the stamp of the pose answered last
         self._last_stamp_ns = None
         self._clutch = False
         self._refused = Tally()
@@ -113,12 +114,13 @@ class LeaderNode(Node):
         self._answer_when_paired()
 
     def _answer_when_paired(self) -> None:
-        """Answer the pose once the twist of its stamp is in too, whichever came first."""
-        if self._pending is None or self._twist is None or self._twist[0] != self._pending[0]:
+        """Answer the pose once the twist of its stamp is in too, whichever came first; once."""
+        if (self._pending is None or self._twist is None or self._twist[0] != self._pending[0]
+                or self._pending[0] == self._answered_ns):
             return
         stamp_ns, position = self._pending
         velocity = np.array(self._twist[1], dtype=np.float64)
-        self._twist = None
+        self._answered_ns = stamp_ns
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
             self._refused.add('wand pose or twist not finite')
             self._answer(stamp_ns, None)
