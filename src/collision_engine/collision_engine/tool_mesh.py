@@ -15,13 +15,14 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   separation, exact to GJK's tolerance, and its feature's pseudonormal at the tool's witness
   says whether the tool is outside.
 * Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
-  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). The
-  signed distance is 1-Lipschitz, so a shell point closer to an already measured one than that
-  one's distance above the deepest so far cannot be deeper, and is skipped; so is one with a
-  triangle nearer than the deepest depth so far (a search bounded by that radius). The first
-  point measured is the one deepest along the contact triangle's normal. When no shell point is
-  inside (a feature of the mesh reaches into the tool between shell points), the answer is the
-  contact itself: depth zero at GJK's contact point, with that triangle's normal.
+  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``, its search
+  starting from the last point's nearest triangle). The signed distance is 1-Lipschitz, so a
+  shell point closer to an already measured one than that one's distance above the deepest so
+  far cannot be deeper, and is skipped; every measured point's exact distance, outside ones
+  included, serves that test. The first point measured is the one deepest along the contact
+  triangle's normal. When no shell point is inside (a feature of the mesh reaches into the tool
+  between shell points), the answer is the contact itself: depth zero at GJK's contact point,
+  with that triangle's normal.
 """
 
 import math
@@ -274,15 +275,14 @@ def _ruled_out(tool_floats, work, measured, px, py, pz, best):
 
 
 @jit
-def _deepest_shell_point(floats, fo, ints, io, lay, tool_floats, tool_ints, rel, nx, ny, nz,
-                         ax, ay, az, hint, stack, stack_d2):
+def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, nx, ny, nz, ax, ay,
+                         az, hint, stack, stack_d2):
     """Find the shell point of least signed distance, if any is inside (module docstring).
 
     (nx, ny, nz) is the contact's outward normal and a a point on the surface there, which
     order the shell. Returns (found, distance, x, y, z, normal x, y, z, leaf triangle,
     original triangle, triangles tested).
     """
-    n_tri, corners, _, _, _, boxes, _, _, _, nodes = lay
     n_shell, shell = tool_ints[1], int(tool_floats[6])
     work = int(tool_floats[7]) + 12 + BOX_FLOATS
     first = _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az)
@@ -295,27 +295,14 @@ def _deepest_shell_point(floats, fo, ints, io, lay, tool_floats, tool_ints, rel,
                               tool_floats[shell + 3 * i + 2])
         if _ruled_out(tool_floats, work, measured, px, py, pz, best):
             continue
-        # A triangle nearer than the deepest depth so far: p is not deeper. Its distance then
-        # bounds p's signed distance from below, for the Lipschitz test. The last nearest
-        # triangle (of a neighbouring shell point) is tried before a search.
-        limit2 = best * best if found else 0.0
-        d2, t = bvh.triangle_distance2(floats, corners, hint, px, py, pz)[0], hint
-        tested += 1
-        if not d2 < limit2:
-            d2, t, _, _, _, _, _, count = bvh.nearest_triangle(
-                floats, corners, boxes, ints, nodes, n_tri, px, py, pz, -1, stack, stack_d2,
-                limit2)
-            tested += count
-        if t >= 0:
-            d, hint = -math.sqrt(d2), t
-        else:
-            d, qx, qy, qz, ux, uy, uz, t, original, count = bvh.mesh_distance(
-                floats, fo, ints, io, px, py, pz, hint, stack, stack_d2)
-            tested += count
-            hint = t
-            if d < best:
-                best, found = d, True
-                x, y, z, mx, my, mz, leaf_t, triangle = qx, qy, qz, ux, uy, uz, t, original
+        # The search starts from the last nearest triangle (a neighbouring shell point's).
+        d, qx, qy, qz, ux, uy, uz, t, original, count = bvh.mesh_distance(
+            floats, fo, ints, io, px, py, pz, hint, stack, stack_d2)
+        tested += count
+        hint = t
+        if d < best:
+            best, found = d, True
+            x, y, z, mx, my, mz, leaf_t, triangle = qx, qy, qz, ux, uy, uz, t, original
         w = work + 4 * measured
         tool_floats[w], tool_floats[w + 1], tool_floats[w + 2], tool_floats[w + 3] = (
             px, py, pz, d)
@@ -355,8 +342,8 @@ def mesh_tool_distance(floats, fo, ints, io, tool_floats, tool_ints, tool_kind, 
     f = face_normals + 3 * t
     fx, fy, fz = floats[f], floats[f + 1], floats[f + 2]
     found, depth, x, y, z, nx, ny, nz, leaf_t, triangle, more = _deepest_shell_point(
-        floats, fo, ints, io, lay, tool_floats, tool_ints, rel, fx, fy, fz, ax, ay, az, t,
-        stack, stack_d2)
+        floats, fo, ints, io, tool_floats, tool_ints, rel, fx, fy, fz, ax, ay, az, t, stack,
+        stack_d2)
     if not found:
         return (STATUS_OK, -radius, -radius, ax, ay, az, fx, fy, fz, tested + more,
                 ints[original + t], t)
