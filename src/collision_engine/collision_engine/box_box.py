@@ -45,14 +45,14 @@ def _cross(u, v):
 
 @jit
 def _half_width(half, axes, u):
-    """Half width of a box (half extents, axes: a tuple of three unit vectors) along u."""
+    """Return a box's half width along u (half extents; axes: three unit vectors)."""
     return (half[0] * abs(_dot(axes[0], u)) + half[1] * abs(_dot(axes[1], u))
             + half[2] * abs(_dot(axes[2], u)))
 
 
 @jit
 def _overlap(half_a, axes_a, half_b, axes_b, t, u):
-    """Overlap of the boxes along u (unit), and the sign that turns u from A toward B."""
+    """Return the boxes' overlap along u (unit), and the sign that turns u from A toward B."""
     along = _dot(t, u)
     width = _half_width(half_a, axes_a, u) + _half_width(half_b, axes_b, u)
     return width - abs(along), 1.0 if along >= 0.0 else -1.0
@@ -114,7 +114,7 @@ def _on_face(face_half, face_axes, face_centre, k, feature_half, feature_axes, m
 
 @jit
 def _edges_meet(half_a, axes_a, half_b, axes_b, t, i, j, n, scale):
-    """Point of A's deepest edge (along axis i) nearest B's (along axis j): (ok, point).
+    """Return the point of A's deepest edge (axis i) nearest B's (axis j): (ok, point).
 
     Once B is moved out along n the two edges touch there; each must be the deepest feature of
     its box along n, and the point within both edges.
@@ -159,7 +159,7 @@ def _witness(half_a, axes_a, half_b, axes_b, t, kind, first, second, n, depth, s
 
 @jit
 def box_box_depth(half_a, half_b, rel):
-    """Penetration depth of box B into box A, B posed by ``rel`` in A's frame (module doc).
+    """Return the depth of box B in box A, B posed by ``rel`` in A's frame (module doc).
 
     ``half_a`` and ``half_b`` are the half extents (3-tuples), ``rel`` (12,) B's pose in A's
     frame (``gjk.support_difference``). Returns (ok, depth, witness on A x, y, z, normal x, y,
