@@ -267,7 +267,7 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
         pull = FAR * scale / reach
         sx, sy, sz = cx + (qx - cx) * pull, cy + (qy - cy) * pull, cz + (qz - cz) * pull
     best_d2, best_t, feature, which, vx, vy, vz, tested = nearest_triangle(
-        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2, np.inf)
+        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2)
     if reach > FAR * scale:
         x, y, z = sx + vx, sy + vy, sz + vz
         nx, ny, nz = unit3(qx - x, qy - y, qz - z)
@@ -289,15 +289,14 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
 
 @jit
 def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
-                     stack_d2, limit2):
+                     stack_d2):
     """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
 
-    Only triangles nearer than ``sqrt(limit2)`` are searched for (inf: all); with none, the
-    triangle returned is -1. Returns (squared distance, triangle in leaf order, feature, which,
-    vx, vy, vz, triangles tested) with v from q to the nearest point and the feature as
+    Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
+    tested) with v from q to the nearest point and the feature as
     ``closest_point_on_triangle``'s.
     """
-    best_d2 = limit2
+    best_d2 = np.inf
     best_t, feature, which = -1, 0, 0
     vx = vy = vz = 0.0
     tested = 0

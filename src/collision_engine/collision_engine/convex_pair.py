@@ -2,8 +2,8 @@
 
 ``distance_between(shape_a, pose_a, shape_b, pose_b, request)`` answers with a fresh, frozen
 ``PairResult``, as ``distance`` does for a point. The sign, normal and witness rules, and how
-each pair is measured (closed forms for spheres and capsules, GJK apart, EPA in overlap), are
-in ``narrowphase``, which holds the compiled kernels.
+each pair is measured (closed forms for spheres and capsules, GJK apart, EPA or, for two boxes,
+a closed form in overlap), are in ``narrowphase``, which holds the compiled kernels.
 """
 
 from dataclasses import dataclass

@@ -31,7 +31,7 @@ __all__ = ['BOX_FLOATS', 'DEFAULT_SHELL_SPACING', 'FLOAT_HEADER', 'INT_HEADER',
 
 DEFAULT_SHELL_SPACING = 0.005  # m
 FLOAT_HEADER = 8  # radius, bounding radius, bounding centre (3), spacing, shell at, work at
-INT_HEADER = 2  # kind, shell points
+INT_HEADER = 3  # kind, shell points, where the shell's orders along the tool's axes start
 BOX_FLOATS = 25  # the tool's extents in an object's frame (``tool_mesh._set_tool_box``)
 MAX_FACE_POINTS = 32  # as haptic_msgs/CollisionState's contact sequences
 _FACE_TOLERANCE = 1e-9  # m: a hull vertex this near the lowest z lies on the face
@@ -229,7 +229,8 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
     work offset], the shape's float block, the shell (n, 3), then work space: the tool's pose
     in an object's frame (12), its extents there (``BOX_FLOATS``) and the shell points measured
     so far with bounds on their distances (4 n).
-    ints = [kind, n], the shape's int block.
+    ints = [kind, n, orders offset], the shape's int block, then the shell's indices sorted
+    along the tool's x, y and z axes (3, n), which order the overlap search (``tool_mesh``).
 
     Raises
     ------
@@ -249,7 +250,9 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
     header = [radius, bounding, *centre, spacing, shell_at, work_at]
     work = np.zeros(12 + BOX_FLOATS + 4 * len(shell))
     floats = np.concatenate((header, shape_floats, shell.ravel(), work))
-    ints = np.concatenate(([kind, len(shell)], shape_ints)).astype(np.int64)
+    orders = np.argsort(shell, axis=0, kind='stable').T.ravel()
+    ints = np.concatenate(([kind, len(shell), INT_HEADER + len(shape_ints)], shape_ints,
+                           orders)).astype(np.int64)
     packed = (floats, ints)
     _PACKED[shape] = packed
     return packed

@@ -15,13 +15,16 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   separation, exact to GJK's tolerance, and its feature's pseudonormal at the tool's witness
   says whether the tool is outside.
 * Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
-  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). The
-  signed distance is 1-Lipschitz, so a shell point closer to an already measured one than that
-  one's distance above the deepest so far cannot be deeper, and is skipped; so is one with a
-  triangle nearer than the deepest depth so far (a search bounded by that radius). The first
-  point measured is the one deepest along the contact triangle's normal. When no shell point is
-  inside (a feature of the mesh reaches into the tool between shell points), the answer is the
-  contact itself: depth zero at GJK's contact point, with that triangle's normal.
+  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``, its search
+  starting from the last point's nearest triangle). The signed distance is 1-Lipschitz, so a
+  shell point closer to an already measured one than that one's distance above the deepest so
+  far cannot be deeper, and is skipped; every measured point's exact distance, outside ones
+  included, serves that test. The first point measured is the one deepest along the contact
+  triangle's normal; the others follow from the highest down, along the tool's axis nearest
+  that normal, so that the far points, measured early, rule out many of their neighbours (for
+  the probe near the hand, 19 searches a query where the shell's own order took 25). When no
+  shell point is inside (a feature of the mesh reaches into the tool between shell points), the
+  answer is the contact itself: depth zero at GJK's contact point, with that triangle's normal.
 """
 
 import math
@@ -240,10 +243,7 @@ def _outside(floats, ints, lay, t, ax, ay, az, vx, vy, vz):
 def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
     """Return the shell point deepest below the plane through a with normal n.
 
-    It is measured first.
-
-    The others follow in the shell's own order, in which neighbours follow each other, so
-    that each search starts from its neighbour's nearest triangle.
+    It is measured first: the deepest depth so far widens every later Lipschitz test.
     """
     first, deepest = 0, -math.inf
     for i in range(n_shell):
@@ -256,12 +256,32 @@ def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
 
 
 @jit
+def _highest_first(tool_ints, n_shell, rel, nx, ny, nz):
+    """Return the shell's order from the highest point down along n, roughly: (start, step).
+
+    It is the order along the tool's axis nearest n (``tool.pack_tool`` sorts the shell along
+    each), read from its end when that axis points up. High points are far from the surface,
+    and each one measured rules out a wide ball of its neighbours.
+    """
+    up = (rel[0] * nx + rel[3] * ny + rel[6] * nz, rel[1] * nx + rel[4] * ny + rel[7] * nz,
+          rel[2] * nx + rel[5] * ny + rel[8] * nz)  # n in the tool's frame: R^T n
+    k = 0
+    for j in (1, 2):
+        if abs(up[j]) > abs(up[k]):
+            k = j
+    order = tool_ints[2] + k * n_shell
+    if up[k] > 0.0:
+        return order + n_shell - 1, -1
+    return order, 1
+
+
+@jit
 def _ruled_out(tool_floats, work, measured, px, py, pz, best):
     """Return whether a point measured so far rules p out.
 
     It does when its signed distance minus its distance to p (a lower bound on p's, the signed
-    distance being 1-Lipschitz) is not below ``best``. The latest points, the neighbours of p
-    in the shell's order, are tried first.
+    distance being 1-Lipschitz) is not below ``best``. The latest points, most often p's
+    neighbours in the order of the search, are tried first.
     """
     for j in range(measured - 1, -1, -1):
         w = work + 4 * j
@@ -274,48 +294,37 @@ def _ruled_out(tool_floats, work, measured, px, py, pz, best):
 
 
 @jit
-def _deepest_shell_point(floats, fo, ints, io, lay, tool_floats, tool_ints, rel, nx, ny, nz,
-                         ax, ay, az, hint, stack, stack_d2):
+def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, nx, ny, nz, ax, ay,
+                         az, hint, stack, stack_d2):
     """Find the shell point of least signed distance, if any is inside (module docstring).
 
     (nx, ny, nz) is the contact's outward normal and a a point on the surface there, which
     order the shell. Returns (found, distance, x, y, z, normal x, y, z, leaf triangle,
     original triangle, triangles tested).
     """
-    n_tri, corners, _, _, _, boxes, _, _, _, nodes = lay
     n_shell, shell = tool_ints[1], int(tool_floats[6])
     work = int(tool_floats[7]) + 12 + BOX_FLOATS
     first = _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az)
+    start, stride = _highest_first(tool_ints, n_shell, rel, nx, ny, nz)
     best, found, measured, tested = 0.0, False, 0, 0
     x = y = z = mx = my = mz = 0.0
     leaf_t = triangle = -1
-    for step in range(n_shell):
-        i = first if step == 0 else (step - 1 if step - 1 < first else step)
+    for step in range(-1, n_shell):
+        i = first if step < 0 else tool_ints[start + stride * step]
+        if step >= 0 and i == first:
+            continue
         px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
                               tool_floats[shell + 3 * i + 2])
         if _ruled_out(tool_floats, work, measured, px, py, pz, best):
             continue
-        # A triangle nearer than the deepest depth so far: p is not deeper. Its distance then
-        # bounds p's signed distance from below, for the Lipschitz test. The last nearest
-        # triangle (of a neighbouring shell point) is tried before a search.
-        limit2 = best * best if found else 0.0
-        d2, t = bvh.triangle_distance2(floats, corners, hint, px, py, pz)[0], hint
-        tested += 1
-        if not d2 < limit2:
-            d2, t, _, _, _, _, _, count = bvh.nearest_triangle(
-                floats, corners, boxes, ints, nodes, n_tri, px, py, pz, -1, stack, stack_d2,
-                limit2)
-            tested += count
-        if t >= 0:
-            d, hint = -math.sqrt(d2), t
-        else:
-            d, qx, qy, qz, ux, uy, uz, t, original, count = bvh.mesh_distance(
-                floats, fo, ints, io, px, py, pz, hint, stack, stack_d2)
-            tested += count
-            hint = t
-            if d < best:
-                best, found = d, True
-                x, y, z, mx, my, mz, leaf_t, triangle = qx, qy, qz, ux, uy, uz, t, original
+        # The search starts from the last nearest triangle.
+        d, qx, qy, qz, ux, uy, uz, t, original, count = bvh.mesh_distance(
+            floats, fo, ints, io, px, py, pz, hint, stack, stack_d2)
+        tested += count
+        hint = t
+        if d < best:
+            best, found = d, True
+            x, y, z, mx, my, mz, leaf_t, triangle = qx, qy, qz, ux, uy, uz, t, original
         w = work + 4 * measured
         tool_floats[w], tool_floats[w + 1], tool_floats[w + 2], tool_floats[w + 3] = (
             px, py, pz, d)
@@ -355,8 +364,8 @@ def mesh_tool_distance(floats, fo, ints, io, tool_floats, tool_ints, tool_kind, 
     f = face_normals + 3 * t
     fx, fy, fz = floats[f], floats[f + 1], floats[f + 2]
     found, depth, x, y, z, nx, ny, nz, leaf_t, triangle, more = _deepest_shell_point(
-        floats, fo, ints, io, lay, tool_floats, tool_ints, rel, fx, fy, fz, ax, ay, az, t,
-        stack, stack_d2)
+        floats, fo, ints, io, tool_floats, tool_ints, rel, fx, fy, fz, ax, ay, az, t, stack,
+        stack_d2)
     if not found:
         return (STATUS_OK, -radius, -radius, ax, ay, az, fx, fy, fz, tested + more,
                 ints[original + t], t)
