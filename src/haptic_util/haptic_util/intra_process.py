@@ -14,7 +14,8 @@ Order: messages are delivered in the order they were published in the process (o
 first-out queue). A ``publish`` from outside any delivery (a timer, a DDS callback) delivers
 before it returns, and with it everything its subscribers publish in turn: a node that publishes
 a request gets the answer of its own process inside that ``publish``. A callback that raises is
-logged and counted as the executor does it (``callback_errors``) and stops no other.
+logged and counted as the executor does it (``callback_errors``) and stops no other. The
+process's executor is single-threaded (``executor.EXECUTORS``), so the queue takes no lock.
 
 Without ``enable`` (one node per process), a stream is CDR over DDS, parsed and serialized by
 its codec, and a publisher skips the write while nobody reads it. Streams use the haptic QoS.
@@ -28,12 +29,12 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.cdr import MessageCodec
 from haptic_util.qos import HAPTIC_STREAM_QOS
 
-__all__ = ['close', 'enable', 'enabled', 'stream_publisher', 'stream_subscription',
+__all__ = ['close', 'enable', 'stream_publisher', 'stream_subscription',
            'StreamPublisher', 'StreamSubscription']
 
 _state = {'enabled': False}
 _topics: dict = {}  # resolved topic -> _Topic, while enabled
-_pending: deque = deque()  # (subscription, bytes) to deliver, in publishing order
+_pending: deque = deque()  # (subscription, leaf values) to deliver, in publishing order
 _draining = [False]
 
 
@@ -49,11 +50,6 @@ def close() -> None:
     _topics.clear()
     _pending.clear()
     _state['enabled'] = False
-
-
-def enabled() -> bool:
-    """Whether intra-process delivery is on in this process."""
-    return _state['enabled']
 
 
 class _Topic:
