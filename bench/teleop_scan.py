@@ -156,7 +156,8 @@ def print_row(r: dict) -> None:
     print(f'{r["scheme"]:>6} {1e3 * r["delay"]:6.0f} {"yes" if r["stable"] else "NO":>6} '
           f'{1e3 * r["net_work_j"]:9.1f} {r["oscillation_percent"]:6.1f} '
           f'{r["transparency_n"]:7.2f} {r["transparency_percent"]:6.1f} '
-          f'{r["peak_patient_n"]:7.2f} {1e3 * r["tracking_m"]:8.2f}', flush=True)
+          f'{r["peak_patient_n"]:7.2f} {1e3 * r["tracking_m"]:8.2f} {r.get("site_streams", "")}',
+          flush=True)
 
 
 def main(argv=None) -> int:
