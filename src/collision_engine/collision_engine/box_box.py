@@ -25,6 +25,7 @@ GJK's contact, which EPA measures).
 import math
 
 from collision_engine._jit import jit
+from collision_engine.vector3 import cross3, dot3
 
 __all__ = ['CONDITION', 'box_box_depth']
 
@@ -34,26 +35,16 @@ _SLACK = 1e-12  # relative: how far off its features rounding may put a witness
 
 
 @jit
-def _dot(u, v):
-    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
-
-
-@jit
-def _cross(u, v):
-    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-
-
-@jit
 def _half_width(half, axes, u):
     """Return a box's half width along u (half extents; axes: three unit vectors)."""
-    return (half[0] * abs(_dot(axes[0], u)) + half[1] * abs(_dot(axes[1], u))
-            + half[2] * abs(_dot(axes[2], u)))
+    return (half[0] * abs(dot3(axes[0], u)) + half[1] * abs(dot3(axes[1], u))
+            + half[2] * abs(dot3(axes[2], u)))
 
 
 @jit
 def _overlap(half_a, axes_a, half_b, axes_b, t, u):
     """Return the boxes' overlap along u (unit), and the sign that turns u from A toward B."""
-    along = _dot(t, u)
+    along = dot3(t, u)
     width = _half_width(half_a, axes_a, u) + _half_width(half_b, axes_b, u)
     return width - abs(along), 1.0 if along >= 0.0 else -1.0
 
@@ -68,7 +59,7 @@ def _deepest_feature(half, axes, centre, n):
     mx, my, mz = centre
     free = -1
     for k in range(3):
-        c = _dot(axes[k], n)
+        c = dot3(axes[k], n)
         if abs(c) <= _TIE:
             if free >= 0:
                 return False, centre, -1
@@ -103,9 +94,9 @@ def _on_face(face_half, face_axes, face_centre, k, feature_half, feature_axes, m
     slack = _SLACK * scale
     for j in range(3):
         if j != k:
-            offset = _dot((middle[0] - face_centre[0], middle[1] - face_centre[1],
+            offset = dot3((middle[0] - face_centre[0], middle[1] - face_centre[1],
                            middle[2] - face_centre[2]), face_axes[j])
-            lo, hi = _narrow(lo, hi, offset, _dot(u, face_axes[j]), face_half[j] + slack)
+            lo, hi = _narrow(lo, hi, offset, dot3(u, face_axes[j]), face_half[j] + slack)
     if not lo <= hi:
         return False, middle
     s = 0.5 * (lo + hi)
@@ -125,10 +116,10 @@ def _edges_meet(half_a, axes_a, half_b, axes_b, t, i, j, n, scale):
         return False, m_a
     e, f = axes_a[i], axes_b[j]
     d = (m_b[0] - m_a[0], m_b[1] - m_a[1], m_b[2] - m_a[2])
-    c = _dot(e, f)
+    c = dot3(e, f)
     sin2 = 1.0 - c * c
-    lam = (_dot(e, d) - c * _dot(f, d)) / sin2
-    mu = (c * _dot(e, d) - _dot(f, d)) / sin2
+    lam = (dot3(e, d) - c * dot3(f, d)) / sin2
+    mu = (c * dot3(e, d) - dot3(f, d)) / sin2
     slack = _SLACK * scale
     if abs(lam) > half_a[i] + slack or abs(mu) > half_b[j] + slack:
         return False, m_a
@@ -179,8 +170,8 @@ def box_box_depth(half_a, half_b, rel):
                 depth, kind, first, n = o, face, k, (s * axis[0], s * axis[1], s * axis[2])
     for i in range(3):
         for j in range(3):
-            w = _cross(axes_a[i], axes_b[j])
-            length = math.sqrt(_dot(w, w))
+            w = cross3(axes_a[i], axes_b[j])
+            length = math.sqrt(dot3(w, w))
             if length < CONDITION:
                 return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
             u = (w[0] / length, w[1] / length, w[2] / length)

@@ -22,6 +22,7 @@ import numpy as np
 
 from collision_engine._jit import jit
 from collision_engine.bvh import build_tree, tree_depth
+from collision_engine.vector3 import cross3, dot3
 
 __all__ = ['self_intersections']
 
@@ -121,16 +122,6 @@ def _orient(a, b, c, d):
 
 
 @jit
-def _cross(u, v):
-    return u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]
-
-
-@jit
-def _dot(u, v):
-    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
-
-
-@jit
 def _minus(p, q):
     return p[0] - q[0], p[1] - q[1], p[2] - q[2]
 
@@ -175,7 +166,7 @@ def _segment_meets_triangle(p, q, t):
 @jit
 def _drop_axis(a):
     """Find the axis along which triangle a (3, 3) has its largest normal component."""
-    n = _cross(_minus(a[1], a[0]), _minus(a[2], a[0]))
+    n = cross3(_minus(a[1], a[0]), _minus(a[2], a[0]))
     axis = 0
     if abs(n[1]) > abs(n[axis]):
         axis = 1
@@ -236,8 +227,8 @@ def _in_angle(u, v, w):
 
     w must lie in the plane of u and v.
     """
-    n = _cross(u, v)
-    return _dot(_cross(u, w), n) >= 0.0 and _dot(_cross(w, v), n) >= 0.0
+    n = cross3(u, v)
+    return dot3(cross3(u, w), n) >= 0.0 and dot3(cross3(w, v), n) >= 0.0
 
 
 @jit
@@ -248,7 +239,7 @@ def _meet_beyond_corner(a, i, b, j):
     """
     u1, v1 = _minus(a[(i + 1) % 3], a[i]), _minus(a[(i + 2) % 3], a[i])
     u2, v2 = _minus(b[(j + 1) % 3], b[j]), _minus(b[(j + 2) % 3], b[j])
-    d = _cross(_cross(u1, v1), _cross(u2, v2))
+    d = cross3(cross3(u1, v1), cross3(u2, v2))
     if d[0] == 0.0 and d[1] == 0.0 and d[2] == 0.0:  # coplanar: do the corner angles overlap?
         return (_in_angle(u1, v1, u2) or _in_angle(u1, v1, v2) or _in_angle(u2, v2, u1)
                 or _in_angle(u2, v2, v1))
@@ -275,4 +266,4 @@ def _folded_onto_each_other(a, b, face_a, face_b):
     if _orient(p, q, apex_a, apex_b) != 0.0:
         return False
     edge = _minus(q, p)
-    return _dot(_cross(edge, _minus(apex_a, p)), _cross(edge, _minus(apex_b, p))) > 0.0
+    return dot3(cross3(edge, _minus(apex_a, p)), cross3(edge, _minus(apex_b, p))) > 0.0
