@@ -24,7 +24,8 @@ __all__ = ['main']
 def main(args=None) -> int:
     argv = sys.argv if args is None else args
     ros_start = argv.index('--ros-args') if '--ros-args' in argv else len(argv)
-    names = [name for name in argv[1:ros_start] if name != NO_INTRA_PROCESS] or list(NODES)
+    given = argv[1:ros_start]
+    names = [name for name in given if name != NO_INTRA_PROCESS] or list(NODES)
     known = {**NODES, **TELEOP_NODES}
     unknown = [n for n in names if n not in known]
     if unknown:
@@ -32,7 +33,7 @@ def main(args=None) -> int:
         return 2
     classes = [getattr(importlib.import_module(module), cls)
                for _, module, cls in (known[n] for n in names)]
-    if NO_INTRA_PROCESS not in argv[1:ros_start]:
+    if NO_INTRA_PROCESS not in given:
         intra_process.enable()
     return run_nodes(classes, argv)
 
