@@ -44,13 +44,16 @@ def node(context, name):
     return Node(name, context=context)
 
 
-def spin_until(context, nodes, done, timeout=MATCH_TIMEOUT) -> bool:
-    executor = SingleThreadedExecutor(context=context)
+def spin_until(nodes, done, timeout=MATCH_TIMEOUT) -> bool:
+    """Spin the nodes, of any contexts (one executor each), until ``done()`` or the timeout."""
+    executors = {}
     for each in nodes:
-        executor.add_node(each)
+        executors.setdefault(each.context, SingleThreadedExecutor(context=each.context))
+        executors[each.context].add_node(each)
     deadline = time.monotonic() + timeout
     while not done() and time.monotonic() < deadline:
-        executor.spin_once(timeout_sec=0.01)
+        for executor in executors.values():
+            executor.spin_once(timeout_sec=0.005)
     return done()
 
 
@@ -114,7 +117,8 @@ def test_a_raising_subscriber_is_counted_and_the_others_still_get_the_message(co
 
 
 def test_dds_carries_a_message_only_while_a_reader_of_another_process_matches(context, bus):
-    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    driver = node(context, 'driver')
+    publisher = stream_publisher(driver, POSE, 'wand/pose')
     stream_subscription(node(context, 'collision'), POSE, 'wand/pose', lambda values: None)
     writes = []
     write = publisher._dds.publish
@@ -123,26 +127,32 @@ def test_dds_carries_a_message_only_while_a_reader_of_another_process_matches(co
     assert writes == []  # the one reader is in the process
     outside = Context()
     rclpy.init(context=outside, domain_id=session_domain_id())
+    recorder = node(outside, 'recorder')
+    received = []
+    reader = recorder.create_subscription(PoseStamped, 'wand/pose', received.append,
+                                          HAPTIC_STREAM_QOS, raw=True)
     try:
-        recorder = node(outside, 'recorder')
-        received = []
-        recorder.create_subscription(PoseStamped, 'wand/pose', received.append,
-                                     HAPTIC_STREAM_QOS, raw=True)
-        assert spin_until(outside, [recorder], lambda: publisher.get_subscription_count() == 2)
-        assert spin_until(outside, [recorder],
+        assert spin_until([driver, recorder], lambda: publisher.get_subscription_count() == 2)
+        assert spin_until([driver, recorder],
                           lambda: publisher.publish(VALUES) or bool(received))
         assert POSE.decode(received[0]) == list(VALUES) and writes[0] == received[0]
+        recorder.destroy_subscription(reader)
+        assert spin_until([driver, recorder], lambda: publisher._readers == 0)
+        written = len(writes)
+        publisher.publish(VALUES)
+        assert len(writes) == written  # the reader left: no more DDS writes
     finally:
         rclpy.try_shutdown(context=outside)
 
 
 def test_without_it_a_stream_is_cdr_over_dds_and_parsed_for_the_callback(context):
     got = []
-    publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
+    driver = node(context, 'driver')
+    publisher = stream_publisher(driver, POSE, 'wand/pose')
     subscriber = node(context, 'collision')
     stream_subscription(subscriber, POSE, 'wand/pose', got.append)
     assert [s.topic_name for s in subscriber.subscriptions] == ['/wand/pose']
-    assert spin_until(context, [subscriber], lambda: publisher.publish(VALUES) or bool(got))
+    assert spin_until([driver, subscriber], lambda: publisher.publish(VALUES) or bool(got))
     assert got[0] == list(VALUES)
 
 

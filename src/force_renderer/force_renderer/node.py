@@ -35,6 +35,7 @@ from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import MARKER_QOS
+from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 
 __all__ = ['ForceNode', 'main']
@@ -151,7 +152,7 @@ class ForceNode(Node):
         return twist[1]
 
     def render(self, velocity) -> None:
-        now = self.get_clock().now().nanoseconds * 1e-9
+        now = clock_ns(self.get_clock()) * 1e-9
         force = self.pipeline.step(self._contact, velocity, now)
         reason = self.pipeline.last_reason
         if reason is not Reason.OK:
@@ -181,7 +182,7 @@ class ForceNode(Node):
         """Publish zero force while the collision state is stale (after the first one)."""
         if self._contact is None:
             return
-        now = self.get_clock().now().nanoseconds * 1e-9
+        now = clock_ns(self.get_clock()) * 1e-9
         if now - self._contact.stamp > self.params.watchdog_timeout:
             self.render(None)
 

@@ -32,6 +32,7 @@ from haptic_bringup.params import LATCHED_TOPICS, LOOP_TOPICS, RecorderParams, R
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
 from haptic_util.qos import LATCHED_QOS, RECORDER_QOS, RELIABLE_RECORDER_QOS
+from haptic_util.stamps import clock_ns
 
 __all__ = ['BagRecorder', 'main', 'custom_definitions']
 
@@ -122,7 +123,7 @@ class BagRecorder(Node):
 
         def write(data: bytes) -> None:
             with self._lock:
-                self.bag.write(topic, clock.now().nanoseconds, data)
+                self.bag.write(topic, clock_ns(clock), data)
         return write
 
     def destroy_node(self) -> bool:

@@ -19,10 +19,15 @@ process's executor is single-threaded (``executor.EXECUTORS``), so the queue tak
 
 Without ``enable`` (one node per process), a stream is CDR over DDS, parsed and serialized by
 its codec, and a publisher skips the write while nobody reads it. Streams use the haptic QoS.
+
+A publisher learns its DDS readers from the matched events its node's executor delivers, not
+by asking DDS on every message (about 1.3 µs a call, six streams a tick): like any ROS 2
+node, it must be spun.
 """
 from collections import deque
 from typing import Callable, Sequence
 
+from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.node import Node
 
 from haptic_util.callback_errors import log_callback_error
@@ -78,7 +83,10 @@ class StreamPublisher:
 
     def __init__(self, node: Node, codec: MessageCodec, topic: str) -> None:
         self._codec = codec
-        self._dds = node.create_publisher(codec.message_class, topic, HAPTIC_STREAM_QOS)
+        self._dds = node.create_publisher(
+            codec.message_class, topic, HAPTIC_STREAM_QOS,
+            event_callbacks=PublisherEventCallbacks(matched=self._matched))
+        self._readers = self._dds.get_subscription_count()  # DDS readers, kept by _matched
         self._topic = _topic(node, codec.message_class, topic)
         self._local = self._topic.subscriptions if self._topic is not None else []
         if self._topic is not None:
@@ -100,12 +108,15 @@ class StreamPublisher:
         if self._local:
             _pending.extend((subscription, values) for subscription in self._local)
             _drain()
-        if self._dds.get_subscription_count():
+        if self._readers:
             self._dds.publish(self._codec.encode(values))
 
     def get_subscription_count(self) -> int:
         """Return how many subscriptions match: of this process, and over DDS."""
         return len(self._local) + self._dds.get_subscription_count()
+
+    def _matched(self, info) -> None:
+        self._readers = info.current_count
 
 
 class StreamSubscription:

@@ -24,6 +24,7 @@ from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.qos import LATCHED_QOS
+from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
 from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
@@ -152,7 +153,7 @@ class WandDriverNode(Node):
                 and (not params.wait_for_recorder or self._recorder_ready))
 
     def tick(self) -> None:
-        now_ns = self.get_clock().now().nanoseconds
+        now_ns = clock_ns(self.get_clock())
         now = now_ns * 1e-9
         if self._phase is Phase.WAITING:
             if not self.ready():
@@ -195,7 +196,7 @@ class WandDriverNode(Node):
         13 µs past its lifetime).
         """
         device = self._device_time()
-        return self.get_clock().now().nanoseconds * 1e-9 - device
+        return clock_ns(self.get_clock()) * 1e-9 - device
 
     def _ros_minus_device_estimate(self, reads: int = 100) -> float:
         """Return ROS time minus the device's clock [s] as precisely as it can be read.
@@ -206,7 +207,7 @@ class WandDriverNode(Node):
         width, estimate = math.inf, 0.0
         for _ in range(reads):
             before = self._device_time()
-            ros = self.get_clock().now().nanoseconds * 1e-9
+            ros = clock_ns(self.get_clock()) * 1e-9
             after = self._device_time()
             if after - before < width:
                 width, estimate = after - before, ros - 0.5 * (before + after)
@@ -237,7 +238,7 @@ class WandDriverNode(Node):
 
     def on_wrench(self, wrench: Sequence) -> None:
         """Apply a wrench (remote rendering): held, kept passive, until its deadline."""
-        now_ns = self.get_clock().now().nanoseconds
+        now_ns = clock_ns(self.get_clock())
         stamp_ns = wrench[0] * 1_000_000_000 + wrench[1]
         if not self._answered(stamp_ns, now_ns):
             return
@@ -250,7 +251,7 @@ class WandDriverNode(Node):
 
     def on_model(self, fields: Sequence) -> None:
         """Hand a contact model to the device's renderer; a bad one gives zero force."""
-        now_ns = self.get_clock().now().nanoseconds
+        now_ns = clock_ns(self.get_clock())
         if not self._answered(fields[0] * 1_000_000_000 + fields[1], now_ns):
             return
         try:

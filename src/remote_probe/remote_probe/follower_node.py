@@ -23,6 +23,7 @@ from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
+from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.experiments import surface_projection
 from remote_probe.follower import Follower, FollowerConfig
@@ -84,7 +85,7 @@ class FollowerNode(Node):
                                f'{params.max_patient_force:g} N')
 
     def _now(self) -> float:
-        return self.get_clock().now().nanoseconds * 1e-9
+        return clock_ns(self.get_clock()) * 1e-9
 
     def on_command(self, fields: Sequence) -> None:
         if fields[2] != self.params.frame_id:
@@ -119,14 +120,14 @@ class FollowerNode(Node):
         force = self._force if fresh else np.full(3, np.nan)
         velocity = self._tcp_velocity if self._tcp_velocity is not None else np.zeros(3)
         target = self.follower.target(now, self._tcp, velocity, force, self._period)
-        sec, nanosec = divmod(self.get_clock().now().nanoseconds, 1_000_000_000)
+        sec, nanosec = divmod(clock_ns(self.get_clock()), 1_000_000_000)
         self._target_pub.publish((sec, nanosec, self.params.frame_id,
                                   *target.tolist(), *_IDENTITY))
 
     def send_feedback(self) -> None:
         if self._tcp is None:
             return
-        now_ns = self.get_clock().now().nanoseconds
+        now_ns = clock_ns(self.get_clock())
         feedback = self.follower.feedback(now_ns * 1e-9)
         echo = round(feedback.echo * 1e9)
         plane = feedback.plane

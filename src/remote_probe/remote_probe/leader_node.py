@@ -23,6 +23,7 @@ from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.qos import LATCHED_QOS
+from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from remote_probe.leader import Leader, LeaderConfig
 from remote_probe.params import LeaderParams
@@ -77,7 +78,7 @@ class LeaderNode(Node):
                                f'motion x{params.position_scale:g}; waiting for the robot')
 
     def _now(self) -> float:
-        return self.get_clock().now().nanoseconds * 1e-9
+        return clock_ns(self.get_clock()) * 1e-9
 
     def on_feedback(self, fields: Sequence) -> None:
         if fields[2] != self.params.robot_frame:

@@ -22,6 +22,7 @@ from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
+from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from remote_probe.ft_sensor import ForceTorqueSensor, ForceTorqueSensorConfig
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
@@ -82,7 +83,7 @@ class SimulatedRobotNode(Node):
     def tick(self) -> None:
         state = self.robot.read(self._now())
         reading = self.sensor.measure(state.time, state.external_force)
-        sec, nanosec = divmod(self.get_clock().now().nanoseconds, 1_000_000_000)
+        sec, nanosec = divmod(clock_ns(self.get_clock()), 1_000_000_000)
         header = (sec, nanosec, self.params.frame_id)
         self._pose_pub.publish((*header, *state.position.tolist(),
                                 *state.orientation.tolist()))
