@@ -6,10 +6,12 @@
 The simulated wand taps a wall (``tests/haptic_wand_driver/taps.py``: pushed 10 mm in, held,
 lifted), the model of each pose reaching the device one 1 ms tick later. Per servo rate, with the
 contact rendered on the device: the cost of one servo period (the wand's dynamics and the local
-law, median and p99 in µs, over every tick of every tap), the highest stiffness that stays at one
-contact per tap with no energy given to the hand, and the felt latency (from the tip crossing
-into the wall to the first period with a force). Beside it, remote rendering (the wrench of the
-tick-old pose, held) at the same stiffnesses: its contacts per tap and latency, the baseline.
+law, median and p99 in µs, over every tick of every tap; in the wand's Python loop, observed
+period by period, and compiled as the driver runs it, ``servo_loop``), the highest stiffness
+that stays at one contact per tap with no energy given to the hand, and the felt latency (from
+the tip crossing into the wall to the first period with a force). Beside it, remote rendering
+(the wrench of the tick-old pose, held) at the same stiffnesses: its contacts per tap and
+latency, the baseline.
 """
 import argparse
 from pathlib import Path
@@ -18,7 +20,7 @@ import sys
 import machine
 import numpy as np
 sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests' / 'haptic_wand_driver'))
-from taps import tap  # noqa: E402 -- the harness the tests use
+from taps import servo_cost, tap  # noqa: E402 -- the harness the tests use
 
 __all__ = ['main', 'rows']
 
@@ -30,10 +32,13 @@ def rows(rates, stiffnesses) -> list[dict]:
         local = {k: tap(k, local=True, servo_rate=rate) for k in stiffnesses}
         remote = {k: tap(k, local=False, servo_rate=rate) for k in stiffnesses}
         costs = np.concatenate([r.substep_cost for r in local.values()])
+        compiled = np.concatenate([servo_cost(k, servo_rate=rate) for k in stiffnesses])
         clean = [k for k, r in local.items() if r.contacts == 1 and r.work <= 0.0]
         table.append({
             'rate': rate, 'cost_p50_us': 1e6 * float(np.median(costs)),
             'cost_p99_us': 1e6 * float(np.percentile(costs, 99)),
+            'compiled_p50_us': 1e6 * float(np.median(compiled)),
+            'compiled_p99_us': 1e6 * float(np.percentile(compiled, 99)),
             'stiffest_clean': max(clean, default=float('nan')),
             'latency_ms': 1e3 * float(np.median([r.felt_latency for r in local.values()])),
             'local_contacts': {k: r.contacts for k, r in local.items()},
@@ -50,13 +55,15 @@ def main(argv=None) -> int:
                         default=[1e3, 1e4, 1e5, 2e5, 5e5, 1e6])
     args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")}')
-    print(f'{"servo Hz":>9} {"period p50 us":>13} {"p99 us":>7} {"stiffest clean N/m":>18} '
+    print(f'{"servo Hz":>9} {"Python p50 us":>13} {"p99 us":>7} {"compiled p50":>12} '
+          f'{"p99":>5} {"stiffest clean N/m":>18} '
           f'{"felt ms":>8}  contacts per tap, local | remote, at K = '
           f'{", ".join(f"{k:g}" for k in args.stiffness)}')
     for row in rows(args.rates, args.stiffness):
         local = ' '.join(str(c) for c in row['local_contacts'].values())
         remote = ' '.join(str(c) for c in row['remote_contacts'].values())
         print(f'{row["rate"]:9.0f} {row["cost_p50_us"]:13.1f} {row["cost_p99_us"]:7.1f} '
+              f'{row["compiled_p50_us"]:12.1f} {row["compiled_p99_us"]:5.1f} '
               f'{row["stiffest_clean"]:18g} {row["latency_ms"]:8.3f}  {local} | {remote} '
               f'(remote felt {row["remote_latency_ms"]:.2f} ms)', flush=True)
     return 0

@@ -85,15 +85,46 @@ def _wall_model(stiffness: float, tip) -> ContactModel:
 
 def tap(stiffness: float, *, local: bool, servo_rate: float = 4000.0,
         round_trip: int = 1, contact_damping_ratio: float = 1.0) -> TapResult:
-    """Run one tap; ``round_trip`` in ticks."""
+    """Run one tap; ``round_trip`` in ticks. The law runs in the wand's Python loop, observed."""
+    law = _law(contact_damping_ratio if local else 0.0)
+    recording = _Recording(law)
+    costs = _press(recording, law, stiffness, local, servo_rate, round_trip)
+    rows = np.array(recording.rows)
+    times, z, force = rows[:, 0], rows[:, 1], rows[:, 2]
+    inside = int(np.argmax(z < 0.0))  # between this period's start and the one before
+    crossing = times[inside - 1] + (times[inside] - times[inside - 1]) * z[inside - 1] / (
+        z[inside - 1] - z[inside])
+    first_force = times[np.argmax(force != 0.0)]
+    return TapResult(contacts=len(contacts(z)), work=float(np.sum(force[:-1] * np.diff(z))),
+                     depth=float(-z.min()), peak_force=float(force.max()),
+                     felt_latency=float(first_force - crossing), substep_cost=costs)
+
+
+def servo_cost(stiffness: float, *, servo_rate: float = 4000.0) -> np.ndarray:
+    """Return each tick's wall time per servo period of a local tap, the law compiled.
+
+    The law is given to the wand unobserved, as the driver gives it (``servo_loop``).
+    """
+    law = _law(1.0)
+    return _press(law, law, stiffness, True, servo_rate, 1)
+
+
+def _law(contact_damping_ratio: float) -> LocalRenderer:
+    return LocalRenderer(force_limit=10.0, torque_limit=0.5,
+                         passivity=PortPassivity(max_damping=50.0), mass=(MASS,) * 3,
+                         contact_damping_ratio=contact_damping_ratio)
+
+
+def _press(device_law, law: LocalRenderer, stiffness: float, local: bool, servo_rate: float,
+           round_trip: int) -> np.ndarray:
+    """Tap with ``device_law`` in the wand's servo loop and ``law`` taking what the loop sends.
+
+    Returns each tick's wall time of ``read``, per servo period.
+    """
     config = SimulatedWandConfig(step=1.0 / servo_rate,
                                  initial_position=np.array([0.0, 0.0, 0.005]))
     wand = SimulatedWand(config, operator=OperatorHand(WaypointScript.from_rows(SCRIPT)))
-    law = LocalRenderer(force_limit=10.0, torque_limit=0.5,
-                        passivity=PortPassivity(max_damping=50.0), mass=(MASS,) * 3,
-                        contact_damping_ratio=contact_damping_ratio if local else 0.0)
-    recording = _Recording(law)
-    wand.render_locally(recording)
+    wand.render_locally(device_law)
     in_flight, costs = deque(), []
     for tick in range(round(DURATION / TICK)):
         start = time.perf_counter()
@@ -109,12 +140,4 @@ def tap(stiffness: float, *, local: bool, servo_rate: float = 4000.0,
                 law.take(arrived, deadline=math.inf)
             else:
                 law.take_wrench(arrived, (0.0, 0.0, 0.0), deadline=math.inf)
-    rows = np.array(recording.rows)
-    times, z, force = rows[:, 0], rows[:, 1], rows[:, 2]
-    inside = int(np.argmax(z < 0.0))  # between this period's start and the one before
-    crossing = times[inside - 1] + (times[inside] - times[inside - 1]) * z[inside - 1] / (
-        z[inside - 1] - z[inside])
-    first_force = times[np.argmax(force != 0.0)]
-    return TapResult(contacts=len(contacts(z)), work=float(np.sum(force[:-1] * np.diff(z))),
-                     depth=float(-z.min()), peak_force=float(force.max()),
-                     felt_latency=float(first_force - crossing), substep_cost=np.array(costs))
+    return np.array(costs)

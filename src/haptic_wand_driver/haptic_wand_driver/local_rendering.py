@@ -21,19 +21,32 @@ to the limit, so a wall pressed past its force limit still takes energy out on t
 
 Thread safety: ``take`` swaps one tuple, which a servo thread reads whole; the passivity books are
 the servo thread's alone.
+
+``packed`` is the same law as floats, for the simulated wand's compiled servo loop
+(``servo_loop``), rewritten with every ``take``, ``take_wrench`` or ``clear``: the force and torque
+limits, the contact damping ratio, the mass (3); the mode (``MODE_*``), the deadline, the model's
+force limit, valid radius and tip (3), the held wrench (6), the plane count, the damping cap per
+mass and period (``MAX_DAMPING_PER_MASS``); from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats
+each (point, normal, stiffness, damping, tool point).
 """
 import math
 from typing import Sequence
 
-from haptic_wand_driver.contact_model import ContactModel, Kind
+import numpy as np
+
+from haptic_wand_driver.contact_model import ContactModel, Kind, MAX_PLANES
 from haptic_wand_driver.orientation import roll_axis
 from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.wrench_input import saturate_components
 
-__all__ = ['LocalRenderer', 'MAX_DAMPING_PER_MASS']
+__all__ = ['LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE', 'MODE_PLANES',
+           'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT']
 
 _ZERO = (0.0, 0.0, 0.0)
 MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
+MODE_NONE, MODE_WRENCH, MODE_PLANES = 0.0, 1.0, 2.0  # what ``packed`` holds
+PLANES_AT, PLANE_SIZE = 21, 15
+LAW_SIZE = PLANES_AT + MAX_PLANES * PLANE_SIZE
 
 
 class LocalRenderer:
@@ -59,19 +72,35 @@ class LocalRenderer:
         self.passivity = passivity
         self.mass = tuple(mass)
         self.contact_damping_ratio = contact_damping_ratio
-        self._held: tuple = (None, None, -math.inf)  # (model, wrench, deadline: device clock)
+        self.packed = np.zeros(LAW_SIZE)  # (servo_loop's layout)
+        self.clear()
 
     def take(self, model: ContactModel, deadline: float) -> None:
         """Render ``model`` from now until ``deadline`` (s, the device's clock)."""
         self._held = (model, None, deadline)
+        mode = MODE_PLANES if model.kind == Kind.PLANES else MODE_NONE
+        planes = [value for plane in model.planes for vector in (
+            plane.point, plane.normal, plane.stiffness, plane.damping, plane.tool_point)
+            for value in vector]
+        self._pack(mode, deadline, model.force_limit, model.valid_radius, model.tip, _ZERO * 2,
+                   len(model.planes), planes)
 
     def take_wrench(self, force, torque, deadline: float) -> None:
         """Render a fixed wrench until ``deadline``: for a law that has no model to send."""
         self._held = (None, (tuple(force), tuple(torque)), deadline)
+        self._pack(MODE_WRENCH, deadline, 0.0, 0.0, _ZERO, (*force, *torque), 0, [])
 
     def clear(self) -> None:
         """Drop what is held: zero force until the next model or wrench."""
         self._held = (None, None, -math.inf)
+        self._pack(MODE_NONE, -math.inf, 0.0, 0.0, _ZERO, _ZERO * 2, 0, [])
+
+    def _pack(self, mode, deadline, force_limit, valid_radius, tip, wrench, count,
+              planes) -> None:
+        self.packed[:PLANES_AT + len(planes)] = (
+            self.force_limit, self.torque_limit, self.contact_damping_ratio, *self.mass, mode,
+            deadline, force_limit, valid_radius, *tip, *wrench, count, MAX_DAMPING_PER_MASS,
+            *planes)
 
     def wrench(self, time: float, coordinates: Sequence[float], rates: Sequence[float],
                period: float) -> tuple[tuple, tuple]:

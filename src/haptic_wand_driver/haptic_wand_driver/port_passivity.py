@@ -20,6 +20,8 @@ renderer's controller; ``force_renderer.passivity`` says why.
 """
 import math
 
+import numpy as np
+
 __all__ = ['BOOKS_CLOSE_AFTER', 'PortPassivity']
 
 BOOKS_CLOSE_AFTER = 0.05  # [s] of zero force that ends a contact's books (a bounce is shorter)
@@ -81,6 +83,22 @@ class PortPassivity:
             scale = max(0.0, 1.0 - alpha * speed / magnitude)  # lowered, never turned round
         self._force = (force[0] * scale, force[1] * scale, force[2] * scale)
         return self._force
+
+    def books(self) -> np.ndarray:
+        """Return the controller's state as floats, for a compiled servo loop (``servo_loop``).
+
+        Energy, net work, the held force (3), the last position (3), whether there is one, the
+        time since the force went to zero, and ``max_damping``.
+        """
+        position = self._position or (0.0, 0.0, 0.0)
+        return np.array((self.energy, self.net_work, *self._force, *position,
+                         float(self._position is not None), self._free, self.max_damping))
+
+    def restore(self, books: np.ndarray) -> None:
+        """Take back the state ``books`` returned, once a compiled loop has run on it."""
+        self.energy, self.net_work, fx, fy, fz, px, py, pz, known, self._free, _ = books.tolist()
+        self._force = (fx, fy, fz)
+        self._position = (px, py, pz) if known else None
 
     def _observe(self, position: Vector3) -> None:
         """Book the work the held force did on the tip since the last call."""

@@ -18,7 +18,10 @@ instants gets the same states, bit for bit. The held wrench applies from the nex
 and substep k pulls toward the hand's target at k · step seconds of the wand's clock.
 
 The substeps run in the haptic loop's thread, once or twice per 1 kHz tick, so the joints are
-plain floats: numpy's per-call cost on 5-vectors is larger than the arithmetic. Everything that
+plain floats: numpy's per-call cost on 5-vectors is larger than the arithmetic. With the
+device's own law (a ``LocalRenderer``, as the driver gives it) they run compiled
+(``servo_loop``): the same arithmetic in the same order, of which this module's Python loop,
+run for any other law, is the reference. Everything that
 enters (the configuration, the applied wrench, the hand's targets) is finite where it enters and
 the stops bound the coordinates, so the states it returns need no second check.
 """
@@ -30,6 +33,7 @@ import numpy as np
 
 from haptic_wand_driver._checks import checked_number, finite_components, finite_vector
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState
+from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import impedance, OperatorHand
 from haptic_wand_driver.orientation import roll_axis
 from haptic_wand_driver.wrench_input import saturate_components
@@ -134,13 +138,14 @@ class SimulatedWand(HapticDevice):
                       else np.array([operator.stiffness, operator.damping]))
         self._joints = list(zip(*hand_gains.tolist(), inverse_inertia.tolist(),
                                 damping_decay.tolist(), lower.tolist(), upper.tolist()))
+        self._joint_table = np.array(self._joints)  # (5, 6), for servo_loop
         self._coordinates = config.initial_coordinates.tolist()
         self._rates = [0.0] * 5
         self._force = self._torque = _ZERO
         self._until = math.inf
         self._start: float | None = None
         self._steps_done = 0
-        self._law = None
+        self._law = self._compiled = None
         self._rendered = [0.0] * 6  # sum of force and torque over the substeps since applied()
         self._rendered_steps = 0
         self._pushing = False
@@ -189,9 +194,16 @@ class SimulatedWand(HapticDevice):
         self._until = until
 
     def render_locally(self, law) -> None:
-        """Run ``law`` at every substep instead of the held wrench (see ``HapticDevice``)."""
+        """Run ``law`` at every substep instead of the held wrench (see ``HapticDevice``).
+
+        The device's own law (a ``LocalRenderer``) is compiled here, before the loop starts.
+        """
         self._raise_if_closed()
-        self._law = law
+        self._law, self._compiled = law, None
+        if isinstance(law, LocalRenderer):
+            from haptic_wand_driver import servo_loop  # numba: only for a wand that needs it
+            servo_loop.compile_now()
+            self._compiled = servo_loop.advance
 
     def applied(self) -> tuple[np.ndarray, np.ndarray]:
         """Return the mean force and torque rendered over the substeps since the last call."""
@@ -203,7 +215,7 @@ class SimulatedWand(HapticDevice):
     def close(self) -> None:
         """Drop the held wrench and the local law, and stop."""
         self._force = self._torque = _ZERO
-        self._law = None
+        self._law = self._compiled = None
         super().close()
 
     def _time(self) -> float:
@@ -219,6 +231,9 @@ class SimulatedWand(HapticDevice):
 
     def _advance(self, target_steps: int) -> None:
         """Substep semi-implicit Euler on every joint up to ``target_steps``; stops hold."""
+        if self._compiled is not None:
+            self._advance_compiled(target_steps, self._law)
+            return
         step = self._step
         force_x, force_y, force_z = self._force
         torque_x, torque_y, torque_z = self._torque
@@ -265,6 +280,31 @@ class SimulatedWand(HapticDevice):
             coordinates, rates = moved, kept
         self._coordinates, self._rates = coordinates, rates
         self._rendered_steps += target_steps - self._steps_done
+        self._steps_done = target_steps
+
+    def _advance_compiled(self, target_steps: int, law: LocalRenderer) -> None:
+        """``_advance`` with the device's own law, in ``servo_loop``."""
+        first, step = self._steps_done, self._step
+        if self._operator is None:
+            targets = np.zeros((target_steps - first, 2, 5))
+        else:
+            hand = self._operator.target_components
+            targets = np.array([hand(done * step) for done in range(first, target_steps)])
+        coordinates, rates = np.array(self._coordinates), np.array(self._rates)
+        rendered = np.array(self._rendered)
+        edges = np.empty(target_steps - first, dtype=np.int64)
+        books, limits = law.passivity.books(), self._config.limits
+        pushing, written = self._compiled(
+            coordinates, rates, self._joint_table, targets, law.packed, books,
+            limits.force_limit, limits.torque_limit, self._start, first, step, rendered, edges,
+            self._pushing)
+        law.passivity.restore(books)
+        for done in edges[:written].tolist():
+            self._pushing = not self._pushing
+            self.force_edges.append((self._start + done * step, self._pushing))
+        self._rendered = rendered.tolist()
+        self._coordinates, self._rates = coordinates.tolist(), rates.tolist()
+        self._rendered_steps += target_steps - first
         self._steps_done = target_steps
 
 

@@ -1,0 +1,206 @@
+"""The simulated wand's servo periods with the device's law (``LocalRenderer``), compiled.
+
+Why: the wand runs its dynamics and the local law at the servo rate, four periods a 1 kHz tick
+at 4 kHz. In Python a period cost about 10 µs (``bench/servo_rate.py``), the largest piece of the
+driver's tick. This is the same arithmetic in the same order, compiled: the Python path
+(``SimulatedWand`` with any other law, which calls ``LocalRenderer.wrench``) is its reference,
+and the tests hold the two to the same trajectory, force and energy books.
+
+The module is self-contained (numba caches a kernel by its own file, so a kernel here must not
+call one elsewhere), and imported only by a wand given such a law, which calls ``compile_now``
+before its loop starts. Its inputs, float64 arrays:
+
+* ``law``: the renderer's settings and what it holds (``LocalRenderer.packed``, whose layout
+  ``local_rendering`` defines);
+* ``books``: the port's passivity (``PortPassivity.books``);
+* ``joints`` (5, 6): per joint, the hand's stiffness and damping, the inverse inertia, the
+  damping decay per period and the workspace stops (lower, upper);
+* ``targets`` (n, 2, 5): the hand's target and its rate at each period.
+"""
+import math
+
+from numba import njit
+import numpy as np
+
+from haptic_wand_driver.local_rendering import (LAW_SIZE, MODE_PLANES, MODE_WRENCH, PLANE_SIZE,
+                                                PLANES_AT)
+from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
+
+__all__ = ['advance', 'compile_now']
+
+
+@njit(cache=True, nogil=True)
+def _saturate(x, y, z, limit):
+    norm = math.sqrt(x * x + y * y + z * z)
+    if norm <= limit:
+        return x, y, z
+    scale = limit / norm
+    return x * scale, y * scale, z * scale
+
+
+@njit(cache=True, nogil=True)
+def _cross(ax, ay, az, bx, by, bz):
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@njit(cache=True, nogil=True)
+def _plane_force(law, at, depth, vx, vy, vz, limit, period):
+    """One plane's force on its point (``ContactModel.wrench``), damped as the device damps."""
+    nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
+    kx, ky, kz = law[at + 6], law[at + 7], law[at + 8]
+    fx = kx * (depth * nx) - law[at + 9] * vx
+    fy = ky * (depth * ny) - law[at + 10] * vy
+    fz = kz * (depth * nz) - law[at + 11] * vz
+    pushing = fx * nx + fy * ny + fz * nz
+    if pushing < 0.0:
+        fx -= pushing * nx
+        fy -= pushing * ny
+        fz -= pushing * nz
+    ratio = law[2]
+    if ratio <= 0.0:
+        return fx, fy, fz
+    stiffness = kx * nx * nx + ky * ny * ny + kz * nz * nz
+    inertia = law[3] * nx * nx + law[4] * ny * ny + law[5] * nz * nz
+    damping = 2.0 * ratio * math.sqrt(stiffness * inertia)
+    cap = law[20] * inertia / period
+    if cap < damping:
+        damping = cap
+    fx, fy, fz = _saturate(fx, fy, fz, limit)
+    push = fx * nx + fy * ny + fz * nz
+    speed = vx * nx + vy * ny + vz * nz
+    change = -push
+    if -damping * speed > change:
+        change = -damping * speed
+    return fx + change * nx, fy + change * ny, fz + change * nz
+
+
+@njit(cache=True, nogil=True)
+def _planes(law, coordinates, rates, limit, period):
+    """Force and torque of the held planes (``ContactModel.wrench``), world frame."""
+    roll, yaw = coordinates[3], coordinates[4]
+    cr, sr, cy, sy = math.cos(roll), math.sin(roll), math.cos(yaw), math.sin(yaw)
+    wx, wy, wz = rates[3] * cy, rates[3] * sy, rates[3] * 0.0 + rates[4]
+    fx = fy = fz = tx = ty = tz = 0.0
+    for k in range(int(law[19])):
+        at = PLANES_AT + PLANE_SIZE * k
+        x, y, z = law[at + 12], law[at + 13], law[at + 14]
+        y, z = cr * y - sr * z, sr * y + cr * z
+        ax, ay, az = cy * x - sy * y, sy * x + cy * y, z
+        depth = (law[at + 3] * (law[at] - (coordinates[0] + ax))
+                 + law[at + 4] * (law[at + 1] - (coordinates[1] + ay))
+                 + law[at + 5] * (law[at + 2] - (coordinates[2] + az)))
+        if depth <= 0.0:
+            continue
+        sx, sy_, sz = _cross(wx, wy, wz, ax, ay, az)
+        px, py, pz = _plane_force(law, at, depth, rates[0] + sx, rates[1] + sy_, rates[2] + sz,
+                                  limit, period)
+        qx, qy, qz = _cross(ax, ay, az, px, py, pz)
+        fx, fy, fz = fx + px, fy + py, fz + pz
+        tx, ty, tz = tx + qx, ty + qy, tz + qz
+    return fx, fy, fz, tx, ty, tz
+
+
+@njit(cache=True, nogil=True)
+def _passive(books, fx, fy, fz, coordinates, rates, period):
+    """The port's passivity controller on this force (``PortPassivity.control``)."""
+    if books[8] != 0.0:
+        work = (books[2] * (coordinates[0] - books[5]) + books[3] * (coordinates[1] - books[6])
+                + books[4] * (coordinates[2] - books[7]))
+        books[0] -= work
+        books[1] += work
+    books[5], books[6], books[7], books[8] = coordinates[0], coordinates[1], coordinates[2], 1.0
+    magnitude = math.sqrt(fx ** 2 + fy ** 2 + fz ** 2)
+    if magnitude == 0.0:
+        books[9] += period
+        if books[9] >= BOOKS_CLOSE_AFTER:
+            books[0] = 0.0
+        books[2] = books[3] = books[4] = 0.0
+        return 0.0, 0.0, 0.0
+    books[9] = 0.0
+    speed = (fx * rates[0] + fy * rates[1] + fz * rates[2]) / magnitude
+    predicted = books[0] - magnitude * speed * period
+    scale = 1.0
+    if predicted < 0.0 and speed > 0.0 and period > 0.0:
+        alpha = -predicted / (period * speed * speed)
+        if books[10] < alpha:
+            alpha = books[10]
+        scale = 1.0 - alpha * speed / magnitude
+        if not scale > 0.0:
+            scale = 0.0
+    books[2], books[3], books[4] = fx * scale, fy * scale, fz * scale
+    return books[2], books[3], books[4]
+
+
+@njit(cache=True, nogil=True)
+def _law_wrench(law, books, time, coordinates, rates, period):
+    """What ``LocalRenderer.wrench`` renders this period: force and torque, saturated."""
+    fx = fy = fz = tx = ty = tz = 0.0
+    limit = law[0]
+    mode, live = law[6], time + period <= law[7]
+    if mode == MODE_WRENCH and live:
+        fx, fy, fz, tx, ty, tz = law[13], law[14], law[15], law[16], law[17], law[18]
+    elif mode == MODE_PLANES and live:
+        dx, dy, dz = coordinates[0] - law[10], coordinates[1] - law[11], coordinates[2] - law[12]
+        if dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
+            if law[8] < limit:
+                limit = law[8]
+            fx, fy, fz, tx, ty, tz = _planes(law, coordinates, rates, limit, period)
+    fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period)
+    fx, fy, fz = _saturate(fx, fy, fz, limit)
+    tx, ty, tz = _saturate(tx, ty, tz, law[1])
+    return fx, fy, fz, tx, ty, tz
+
+
+@njit(cache=True, nogil=True)
+def advance(coordinates, rates, joints, targets, law, books, force_limit, torque_limit, start,
+            first, step, rendered, edges, pushing):
+    """Run ``len(targets)`` servo periods from period ``first``, in place.
+
+    Adds each period's force and torque to ``rendered`` (6,), writes to ``edges`` the periods at
+    which the force switched on or off, and returns (pushing after the last one, edges written).
+    """
+    written = 0
+    for k in range(targets.shape[0]):
+        done = first + k
+        fx, fy, fz, tx, ty, tz = _law_wrench(law, books, start + done * step, coordinates,
+                                             rates, step)
+        fx, fy, fz = _saturate(fx, fy, fz, force_limit)
+        tx, ty, tz = _saturate(tx, ty, tz, torque_limit)
+        rendered[0] += fx
+        rendered[1] += fy
+        rendered[2] += fz
+        rendered[3] += tx
+        rendered[4] += ty
+        rendered[5] += tz
+        now_pushing = fx != 0.0 or fy != 0.0 or fz != 0.0
+        if now_pushing != pushing:
+            pushing = now_pushing
+            edges[written] = done
+            written += 1
+        cy, sy = math.cos(coordinates[4]), math.sin(coordinates[4])
+        efforts = (fx, fy, fz, cy * tx + sy * ty + 0.0 * tz, tz)
+        for j in range(5):
+            stiffness, damping, inverse_inertia, decay, lower, upper = (
+                joints[j, 0], joints[j, 1], joints[j, 2], joints[j, 3], joints[j, 4],
+                joints[j, 5])
+            coordinate, rate = coordinates[j], rates[j]
+            effort = efforts[j] + (stiffness * (targets[k, 0, j] - coordinate)
+                                   + damping * (targets[k, 1, j] - rate))
+            rate = (rate + step * effort * inverse_inertia) * decay
+            coordinate += step * rate
+            if coordinate < lower:
+                coordinate = lower
+                if rate < 0.0:
+                    rate = 0.0
+            elif coordinate > upper:
+                coordinate = upper
+                if rate > 0.0:
+                    rate = 0.0
+            coordinates[j], rates[j] = coordinate, rate
+    return pushing, written
+
+
+def compile_now() -> None:
+    """Compile ``advance`` for the types the wand passes (or load it from numba's cache)."""
+    advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)), np.zeros(LAW_SIZE),
+            np.zeros(11), 1.0, 1.0, 0.0, 0, 1.0, np.zeros(6), np.empty(0, dtype=np.int64), False)

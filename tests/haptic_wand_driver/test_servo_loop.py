@@ -1,0 +1,125 @@
+"""The compiled servo loop against its reference: the wand's Python substeps with the same law.
+
+Two simulated wands, the same hand, the same models at the same instants. One is given its
+``LocalRenderer`` as the driver gives it (compiled, ``servo_loop``); the other the same law behind
+a wrapper, which the wand runs in its Python loop through ``LocalRenderer.wrench``. Random
+models: up to three planes, tilted, with tool points off the tip (torque), stiff enough to
+saturate and to wake the port's passivity, valid for less than a tick or until the radius is
+left; held wrenches; a model dropped. Every state, force and energy must be the same float.
+"""
+import math
+
+from contact_model_fields import fields
+import numpy as np
+import pytest
+
+from haptic_wand_driver.contact_model import ContactModel, Kind
+from haptic_wand_driver.local_rendering import LocalRenderer
+from haptic_wand_driver.operator import OperatorHand
+from haptic_wand_driver.port_passivity import PortPassivity
+from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+
+TICK = 0.001  # [s]
+TICKS = 400
+
+
+class _Sweep:
+    """A hand's target moving on every joint: down through z = 0, rolling and yawing."""
+
+    def target_components(self, t):
+        w = 2.0 * math.pi
+        return ((0.01 * math.sin(w * t), 0.005 * math.cos(w * t), 0.004 - 0.03 * t,
+                 0.4 * math.sin(w * t), 0.3 * math.cos(w * t)),
+                (0.01 * w * math.cos(w * t), -0.005 * w * math.sin(w * t), -0.03,
+                 0.4 * w * math.cos(w * t), -0.3 * w * math.sin(w * t)))
+
+
+class _Python:
+    """The same law, hidden from the wand's compiled path."""
+
+    def __init__(self, law: LocalRenderer) -> None:
+        self.law = law
+
+    def wrench(self, *args):
+        return self.law.wrench(*args)
+
+
+def _renderer(ratio: float) -> LocalRenderer:
+    return LocalRenderer(force_limit=8.0, torque_limit=0.3,
+                         passivity=PortPassivity(max_damping=50.0), mass=(0.15, 0.12, 0.18),
+                         contact_damping_ratio=ratio)
+
+
+def _random_plane(rng, tip):
+    normal = rng.normal(size=3) + (0.0, 0.0, 2.0)
+    normal /= np.linalg.norm(normal)
+    point = np.asarray(tip) + rng.uniform(-0.003, 0.003, size=3)
+    stiffness = 10.0 ** rng.uniform(2.0, 5.5, size=3)
+    damping = rng.uniform(0.0, 5.0, size=3)
+    tool_point = rng.uniform(-0.02, 0.02, size=3) * (rng.random() < 0.7)
+    return tuple(map(tuple, (point, normal, stiffness, damping, tool_point)))
+
+
+def _give(law: LocalRenderer, rng, tip, now: float) -> None:
+    """Hand the law what the loop might: a model, a held wrench, or nothing."""
+    choice = rng.random()
+    deadline = now + rng.choice([0.0004, 0.0011, 0.003, math.inf])
+    if choice < 0.1:
+        law.clear()
+    elif choice < 0.25:
+        law.take_wrench(rng.uniform(-12.0, 12.0, size=3), rng.uniform(-0.5, 0.5, size=3),
+                        deadline)
+    else:
+        count = int(rng.integers(0, 4))
+        kind = Kind.PLANES if count else Kind.FREE
+        planes = [_random_plane(rng, tip) for _ in range(count)]
+        model = ContactModel.from_fields(
+            fields(planes, kind=kind, limit=float(rng.uniform(3.0, 12.0)),
+                   radius=float(rng.choice([0.0005, 0.002, 0.05])), tip=tuple(tip)), 'world')
+        law.take(model, deadline)
+
+
+def _run(seed: int, ratio: float, hand: bool):
+    config = SimulatedWandConfig(initial_position=np.array([0.0, 0.0, 0.004]), initial_roll=0.1)
+    wands, laws = [], []
+    for wrap in (False, True):
+        law = _renderer(ratio)
+        wand = SimulatedWand(config, operator=OperatorHand(_Sweep()) if hand else None)
+        wand.render_locally(_Python(law) if wrap else law)
+        wands.append(wand)
+        laws.append(law)
+    assert wands[0]._compiled is not None and wands[1]._compiled is None  # the two paths
+    rng = np.random.default_rng(seed)
+    rows = [[], []]
+    for tick in range(TICKS):
+        now = tick * TICK + rng.uniform(0.0, 0.0006)  # reads at jittered instants
+        states = [wand.read(now) for wand in wands]
+        tip = states[0].position.tolist()
+        draw = rng.bit_generator.state
+        for law, row, wand, state in zip(laws, rows, wands, states):
+            rng.bit_generator.state = draw  # the same model for both
+            _give(law, rng, tip, now)
+            force, torque = wand.applied()
+            row.append((*state.position, state.roll, state.yaw, *state.linear_velocity,
+                        state.roll_rate, state.yaw_rate, *force, *torque,
+                        law.passivity.energy, law.passivity.net_work))
+    return np.array(rows), [wand.force_edges for wand in wands]
+
+
+@pytest.mark.parametrize('seed', range(6))
+@pytest.mark.parametrize('ratio', [0.0, 1.0])
+def test_the_compiled_loop_gives_its_reference_trajectory_float_for_float(seed, ratio):
+    (compiled, reference), (edges, reference_edges) = _run(seed, ratio, hand=seed % 3 != 2)
+    assert np.array_equal(compiled, reference)
+    assert edges == reference_edges
+
+
+def test_the_runs_compared_press_rotate_saturate_and_wake_the_passivity():
+    """What the comparison covers: contact on and off, torque, saturation, energy taken out."""
+    (compiled, _), (edges, _) = _run(0, 1.0, hand=True)
+    force, torque = compiled[:, 10:13], compiled[:, 13:16]
+    assert len(edges) >= 6
+    assert np.abs(compiled[:, 3:5]).max() > 0.1  # rolled and yawed
+    assert np.linalg.norm(torque, axis=1).max() > 0.0
+    assert np.linalg.norm(force, axis=1).max() > 7.9  # at the renderer's limits
+    assert np.abs(compiled[:, 16]).max() > 0.0  # the passivity's books moved
