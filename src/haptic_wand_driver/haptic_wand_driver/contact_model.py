@@ -26,6 +26,7 @@ __all__ = ['Kind', 'ModelRefused', 'Plane', 'ContactModel', 'MAX_PLANES', 'UNIT_
 MAX_PLANES = 3
 UNIT_TOLERANCE = 1e-6  # |normal| may differ from 1 by this much
 Vector3 = tuple[float, float, float]
+_PLANE_VECTORS = ('point', 'normal', 'stiffness', 'damping', 'tool_point')
 
 
 class Kind(enum.IntEnum):
@@ -34,6 +35,9 @@ class Kind(enum.IntEnum):
     FREE = 0
     PLANES = 1
     UNAVAILABLE = 2
+
+
+_KINDS = frozenset(int(kind) for kind in Kind)
 
 
 class ModelRefused(ValueError):
@@ -88,26 +92,26 @@ class ContactModel:
         """Check the leaf fields of a ``ContactModel`` message and build the model.
 
         Raises ModelRefused naming the first bad field (an unknown frame, a NaN, a normal that
-        is not unit, a negative gain, more than three planes, an unknown kind).
+        is not unit, a negative gain, more than three planes, an unknown kind). It runs with
+        every answer, so a model whose numbers are all finite and whose limits are not
+        negative skips the field-by-field checks that find the culprit.
         """
         sec, nanosec, frame, _, kind, count = fields[:6]
         if frame != frame_id:
             raise ModelRefused('header.frame_id', f'is {frame!r}, not {frame_id!r}')
-        if kind not in tuple(Kind):
+        if kind not in _KINDS:
             raise ModelRefused('kind', f'is {kind}, not one of {[k.value for k in Kind]}')
         if count > MAX_PLANES:
             raise ModelRefused('plane_count', f'is {count}, more than {MAX_PLANES}')
         force_limit, valid_for, valid_radius = fields[51:54]
-        for name, value in (('force_limit', force_limit), ('valid_for', valid_for),
-                            ('valid_radius', valid_radius)):
-            _non_negative(name, value)
-        tip = tuple(fields[54:57])
-        _finite('tip', tip)
-        held_wrench = tuple(fields[57:63])
-        _finite('wrench', held_wrench)
+        if not (all(map(math.isfinite, fields[51:63]))
+                and all(map(math.isfinite, fields[6:6 + 15 * count]))
+                and min(force_limit, valid_for, valid_radius) >= 0.0):
+            _refuse(fields, count)
         planes = tuple(_plane(k, fields[6 + 15 * k:21 + 15 * k]) for k in range(count))
         return cls(sec + nanosec * 1e-9, Kind(kind), planes if kind == Kind.PLANES else (),
-                   force_limit, valid_for, valid_radius, tip, held_wrench)
+                   force_limit, valid_for, valid_radius, tuple(fields[54:57]),
+                   tuple(fields[57:63]))
 
     def valid(self, position: Sequence[float]) -> bool:
         """Whether ``position`` (3,) m is within ``valid_radius`` of the model's tip."""
@@ -160,17 +164,28 @@ def _damped_along(force: Vector3, normal: Vector3, velocity: Sequence[float],
             force[2] + change * normal[2])
 
 
+def _refuse(fields: Sequence, count: int) -> None:
+    """Raise ModelRefused naming the first bad number, in the order the fields are read."""
+    for name, value in zip(('force_limit', 'valid_for', 'valid_radius'), fields[51:54]):
+        _non_negative(name, value)
+    _finite('tip', fields[54:57])
+    _finite('wrench', fields[57:63])
+    for k in range(count):
+        values = fields[6 + 15 * k:21 + 15 * k]
+        for label, at in zip(_PLANE_VECTORS, range(0, 15, 3)):
+            _finite(f'planes[{k}].{label}', values[at:at + 3])
+        _plane(k, values)
+
+
 def _plane(k: int, values: Sequence[float]) -> Plane:
-    name = f'planes[{k}]'
+    """Return plane k of a model whose numbers are finite, its gains and normal checked."""
     vectors = [tuple(values[i:i + 3]) for i in range(0, 15, 3)]
-    for label, vector in zip(('point', 'normal', 'stiffness', 'damping', 'tool_point'), vectors):
-        _finite(f'{name}.{label}', vector)
     for label, vector in zip(('stiffness', 'damping'), vectors[2:4]):
         if min(vector) < 0.0:
-            raise ModelRefused(f'{name}.{label}', f'is negative: {list(vector)}')
+            raise ModelRefused(f'planes[{k}].{label}', f'is negative: {list(vector)}')
     norm = math.sqrt(sum(c * c for c in vectors[1]))
     if abs(norm - 1.0) > UNIT_TOLERANCE:
-        raise ModelRefused(f'{name}.normal', f'is not unit (|n| = {norm:.9g})')
+        raise ModelRefused(f'planes[{k}].normal', f'is not unit (|n| = {norm:.9g})')
     return Plane(*vectors)
 
 
