@@ -14,7 +14,8 @@ z, w, as geometry_msgs) so that orientation control can come later without a new
 ``read(now)`` advances in fixed substeps of ``step`` seconds with semi-implicit Euler (velocity
 first, the damping implicit), as ``haptic_wand_driver.simulated`` does: the trajectory depends
 only on the commands given before each substep, never on when ``read`` is called. A new target
-applies from the next substep on.
+applies from the next substep on. The substeps run twice a 1 kHz tick in the remote site's loop,
+so the state is plain floats: numpy's cost per call on a 3-vector is larger than the arithmetic.
 """
 
 from dataclasses import dataclass, field
@@ -131,12 +132,13 @@ class ImpedanceRobot:
                  environment: Environment | None = None):
         self._config = config
         self._environment = environment
-        self._position = config.initial_position.copy()
-        self._velocity = np.zeros(3)
+        self._position = tuple(config.initial_position.tolist())
+        self._velocity = (0.0, 0.0, 0.0)
         self._external_force = self._environment_force()
-        self._target = config.initial_position.copy()
+        self._target = self._position
         self._start: float | None = None
         self._steps_done = 0
+        self._limits = tuple(zip(config.workspace_lower.tolist(), config.workspace_upper.tolist()))
 
     @property
     def config(self) -> ImpedanceRobotConfig:
@@ -146,7 +148,7 @@ class ImpedanceRobot:
     @property
     def target(self) -> np.ndarray:
         """The commanded TCP position (3,) m, as given (the workspace stops the TCP, not it)."""
-        return self._target.copy()
+        return np.array(self._target)
 
     def command(self, position, orientation=_IDENTITY) -> None:
         """Pull the TCP toward ``position`` (3,) m from the next substep on.
@@ -156,7 +158,7 @@ class ImpedanceRobot:
         """
         position = finite_vector(position, 3, 'ImpedanceRobot.command position')
         unit_vector(orientation, 4, 'ImpedanceRobot.command orientation')
-        self._target = position.copy()
+        self._target = tuple(position.tolist())
 
     def read(self, now: float) -> RobotState:
         """Advance to the last substep at or before ``now`` (s) and return the state there.
@@ -177,8 +179,8 @@ class ImpedanceRobot:
 
     def state(self) -> RobotState:
         """Return the state at the last substep, without advancing."""
-        return RobotState(self._time(), self._position.copy(), self._velocity.copy(),
-                          self._config.initial_orientation, self._external_force.copy())
+        return RobotState(self._time(), np.array(self._position), np.array(self._velocity),
+                          self._config.initial_orientation, np.array(self._external_force))
 
     def _time(self) -> float:
         return (self._start or 0.0) + self._steps_done * self._config.step
@@ -186,24 +188,26 @@ class ImpedanceRobot:
     def _substep(self) -> None:
         """One semi-implicit Euler step: speed limited, then the workspace walls stop the TCP."""
         config = self._config
-        step = config.step
-        force = config.stiffness * (self._target - self._position) + self._external_force
-        velocity = ((self._velocity + step * force / config.mass)
-                    / (1.0 + step * config.damping / config.mass))
-        speed = float(np.linalg.norm(velocity))
+        step, mass, stiffness = config.step, config.mass, config.stiffness
+        decay = 1.0 + step * config.damping / mass
+        velocity = [(v + step * (stiffness * (t - p) + f) / mass) / decay for p, v, t, f in zip(
+            self._position, self._velocity, self._target, self._external_force)]
+        speed = math.sqrt(velocity[0] ** 2 + velocity[1] ** 2 + velocity[2] ** 2)
         if speed > config.max_speed:
-            velocity *= config.max_speed / speed
-        position = self._position + step * velocity
-        lower, upper = config.workspace_lower, config.workspace_upper
-        velocity[(position <= lower) & (velocity < 0.0)] = 0.0
-        velocity[(position >= upper) & (velocity > 0.0)] = 0.0
-        self._position = np.clip(position, lower, upper)
-        self._velocity = velocity
+            scale = config.max_speed / speed
+            velocity = [v * scale for v in velocity]
+        position = []
+        for k, (p, (lower, upper)) in enumerate(zip(self._position, self._limits)):
+            p += step * velocity[k]
+            if p <= lower and velocity[k] < 0.0 or p >= upper and velocity[k] > 0.0:
+                velocity[k] = 0.0
+            position.append(min(max(p, lower), upper))
+        self._position, self._velocity = tuple(position), tuple(velocity)
         self._external_force = self._environment_force()
 
-    def _environment_force(self) -> np.ndarray:
+    def _environment_force(self) -> tuple:
         """Return the environment's force at the current state (and for the next substep)."""
         if self._environment is None:
-            return np.zeros(3)
-        return finite_vector(self._environment(self._position, self._velocity), 3,
-                             'environment force')
+            return (0.0, 0.0, 0.0)
+        force = self._environment(np.array(self._position), np.array(self._velocity))
+        return tuple(finite_vector(force, 3, 'environment force').tolist())
