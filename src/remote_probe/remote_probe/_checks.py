@@ -36,10 +36,11 @@ def finite_vector(value, size: int, name: str, *, minimum: float | None = None) 
         vector = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
         vector = np.full(0, math.nan)
-    # The array's own all() and any(): np.all's dispatch took 7 % of the remote site's process,
-    # which checks its vectors at every tick.
-    if vector.shape != (size,) or not np.isfinite(vector).all() or (
-            minimum is not None and (vector < minimum).any()):
+    # Its components as floats: numpy's per-call dispatch (np.all took 7 % of the remote site's
+    # process, the array's own isfinite().all() 1.2 µs) costs more than checking three floats.
+    components = vector.tolist() if vector.shape == (size,) else [math.nan]
+    if not all(map(math.isfinite, components)) or (
+            minimum is not None and min(components) < minimum):
         bound = '' if minimum is None else f' >= {minimum:g}'
         raise ValueError(f'{name} must be {size} finite numbers{bound}, got {value!r}')
     vector.flags.writeable = False
