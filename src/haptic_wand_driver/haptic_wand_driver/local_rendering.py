@@ -22,12 +22,13 @@ to the limit, so a wall pressed past its force limit still takes energy out on t
 Thread safety: ``take`` swaps one tuple, which a servo thread reads whole; the passivity books are
 the servo thread's alone.
 
-``packed`` is the same law as floats, for the simulated wand's compiled servo loop
-(``servo_loop``), rewritten with every ``take``, ``take_wrench`` or ``clear``: the force and torque
-limits, the contact damping ratio, the mass (3); the mode (``MODE_*``), the deadline, the model's
-force limit, valid radius and tip (3), the held wrench (6), the plane count, the damping cap per
-mass and period (``MAX_DAMPING_PER_MASS``); from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats
-each (point, normal, stiffness, damping, tool point).
+``packed`` is the same law as floats for the simulated wand's compiled servo loop
+(``servo_loop``, run in the thread that calls ``take``: the packing is not atomic), rewritten by
+every ``take``, ``take_wrench`` or ``clear``: the force and torque limits, the contact damping
+ratio, the mass (3); the mode (``MODE_*``), the deadline, the model's force limit, valid radius
+and tip (3), the held wrench (6), the plane count, the damping cap per mass and period
+(``MAX_DAMPING_PER_MASS``); from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point,
+normal, stiffness, damping, tool point).
 """
 import math
 from typing import Sequence

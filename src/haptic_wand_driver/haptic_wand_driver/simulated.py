@@ -21,9 +21,9 @@ The substeps run in the haptic loop's thread, once or twice per 1 kHz tick, so t
 plain floats: numpy's per-call cost on 5-vectors is larger than the arithmetic. With the
 device's own law (a ``LocalRenderer``, as the driver gives it) they run compiled
 (``servo_loop``): the same arithmetic in the same order, of which this module's Python loop,
-run for any other law, is the reference. Everything that
-enters (the configuration, the applied wrench, the hand's targets) is finite where it enters and
-the stops bound the coordinates, so the states it returns need no second check.
+run for any other law, is the reference. Everything that enters (the configuration, the applied
+wrench, the hand's targets) is finite where it enters and the stops bound the coordinates, so
+the states it returns need no second check.
 """
 
 from dataclasses import dataclass, field
