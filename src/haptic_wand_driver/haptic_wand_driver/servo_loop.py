@@ -102,7 +102,7 @@ def _planes(law, coordinates, rates, limit, period):
 
 @njit(cache=True, nogil=True)
 def _passive(books, fx, fy, fz, coordinates, rates, period):
-    """The port's passivity controller on this force (``PortPassivity.control``)."""
+    """Return the force the port's passivity controller lets through (``PortPassivity``)."""
     if books[8] != 0.0:
         work = (books[2] * (coordinates[0] - books[5]) + books[3] * (coordinates[1] - books[6])
                 + books[4] * (coordinates[2] - books[7]))
@@ -133,7 +133,7 @@ def _passive(books, fx, fy, fz, coordinates, rates, period):
 
 @njit(cache=True, nogil=True)
 def _law_wrench(law, books, time, coordinates, rates, period):
-    """What ``LocalRenderer.wrench`` renders this period: force and torque, saturated."""
+    """Return what ``LocalRenderer.wrench`` renders this period: force and torque, saturated."""
     fx = fy = fz = tx = ty = tz = 0.0
     limit = law[0]
     mode, live = law[6], time + period <= law[7]
