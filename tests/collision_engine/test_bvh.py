@@ -101,6 +101,26 @@ def test_points_just_off_vertices_edges_and_faces(hand, offset):
             check(hand, points + sign * offset * direction, closest_too=False)
 
 
+def test_a_search_told_what_is_enough_stops_only_within_it(hand):
+    # The probe's overlap search asks only whether a shell point lies within the deepest depth
+    # so far: a triangle that near answers it (a bound from above, sign unknown); a point with
+    # none that near gets its exact signed distance.
+    floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces)
+    size = search_stack_size(ints)
+    stack, stack_d2 = np.zeros(size, dtype=np.int64), np.zeros(size)
+    points, _ = sample_near_surface(hand.vertices, hand.faces, 600, 0.004,
+                                    np.random.default_rng(15))
+    truth, _ = mesh_signed_distance(points, hand.vertices, hand.faces)
+    enough = 0.002
+    answers = np.array([bvh.mesh_distance(floats, 0, ints, 0, *p, -1, stack, stack_d2,
+                                          enough * enough)[0] for p in points])
+    within = np.abs(truth) <= enough
+    assert 0 < np.count_nonzero(within) < len(points)
+    assert np.all(np.abs(answers[within]) <= enough)
+    assert np.all(np.abs(answers[within]) >= np.abs(truth[within]) - 1e-14)
+    np.testing.assert_allclose(answers[~within], truth[~within], rtol=0, atol=1e-14)
+
+
 def reference_triangle_bound2(corners, point) -> float:
     """The larger squared distance from the point to the triangle's plane and to its box."""
     normal = unit(np.cross(corners[1] - corners[0], corners[2] - corners[0]))

@@ -128,7 +128,7 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2
     triangle = -1
     if kind == TRIANGLE_MESH:
         distance, x, y, z, nx, ny, nz, leaf_t, triangle, iterations = bvh.mesh_distance(
-            floats, fo, ints, io, qx, qy, qz, ints[entry + 4], stack, stack_d2)
+            floats, fo, ints, io, qx, qy, qz, ints[entry + 4], stack, stack_d2, -1.0)
         ints[entry + 4] = leaf_t
         status, lower = STATUS_OK, distance
     else:

@@ -238,11 +238,13 @@ def triangle_distance2(floats, corners, t, qx, qy, qz):
 
 
 @jit
-def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
+def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2, enough2):
     """Signed distance from q to a packed triangle mesh, local frame.
 
     ``hint`` is a triangle (leaf order) to try first, or -1. ``stack`` (int) and ``stack_d2``
-    (float) are scratch, each at least ``search_stack_size`` long (module docstring).
+    (float) are scratch, each at least ``search_stack_size`` long (module docstring). The search
+    stops at the first triangle whose squared distance is at most ``enough2`` (-1: none), and
+    answers from it: then only the distance's magnitude means anything, as an upper bound.
 
     A point farther than ``FAR`` mesh radii R from the mesh's centre is outside, and is searched
     from the point moved toward the mesh to ``FAR`` radii on the same ray: far off, the rounding
@@ -267,7 +269,7 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
         pull = FAR * scale / reach
         sx, sy, sz = cx + (qx - cx) * pull, cy + (qy - cy) * pull, cz + (qz - cz) * pull
     best_d2, best_t, feature, which, vx, vy, vz, tested = nearest_triangle(
-        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2)
+        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2, enough2)
     if reach > FAR * scale:
         x, y, z = sx + vx, sy + vy, sz + vz
         nx, ny, nz = unit3(qx - x, qy - y, qz - z)
@@ -289,8 +291,10 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
 
 @jit
 def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
-                     stack_d2):
+                     stack_d2, enough2):
     """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
+
+    It stops early at a triangle within ``enough2`` (squared; -1 for none).
 
     Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
     tested) with v from q to the nearest point and the feature as
@@ -308,7 +312,7 @@ def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hin
     stack[0] = 0
     stack_d2[0] = box_distance2(floats, boxes, qx, qy, qz)
     top = 1
-    while top > 0:
+    while top > 0 and best_d2 > enough2:
         top -= 1
         node = stack[top]
         if stack_d2[top] >= best_d2:

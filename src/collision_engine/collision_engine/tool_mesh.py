@@ -15,16 +15,21 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   separation, exact to GJK's tolerance, and its feature's pseudonormal at the tool's witness
   says whether the tool is outside.
 * Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
-  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``, its search
-  starting from the last point's nearest triangle). The signed distance is 1-Lipschitz, so a
-  shell point closer to an already measured one than that one's distance above the deepest so
-  far cannot be deeper, and is skipped; every measured point's exact distance, outside ones
-  included, serves that test. The first point measured is the one deepest along the contact
-  triangle's normal; the others follow from the highest down, along the tool's axis nearest
-  that normal, so that the far points, measured early, rule out many of their neighbours (for
-  the probe near the hand, 19 searches a query where the shell's own order took 25). When no
-  shell point is inside (a feature of the mesh reaches into the tool between shell points), the
-  answer is the contact itself: depth zero at GJK's contact point, with that triangle's normal.
+  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). Only a
+  point deeper than the deepest so far matters, and two bounds rule points out unsearched: the
+  signed distance is 1-Lipschitz, so a shell point closer to an already measured one than that
+  one's distance above the deepest so far cannot be deeper (every measured point's distance,
+  outside ones included, serves that test); and it is at least minus the distance to any
+  surface point, so a shell point within the deepest depth of a surface point found is no
+  deeper. For the same reason a search stops at the first triangle within the deepest depth
+  (its distance is then kept as the bound), and it starts from the triangle of the surface
+  point found nearest the shell point. The first point measured is the one deepest along the
+  contact triangle's normal; the others follow from the highest down, along the tool's axis
+  nearest that normal, so that the far points, measured early, rule out many of their
+  neighbours (for the probe near the hand, 19 searches a query where the shell's own order
+  took 25). When no shell point is inside (a feature of the mesh reaches into the tool between
+  shell points), the answer is the contact itself: depth zero at GJK's contact point, with that
+  triangle's normal.
 """
 
 import math
@@ -36,7 +41,7 @@ from collision_engine.narrowphase import core_of
 from collision_engine.norms import norm3, unit3
 from collision_engine.signed_volumes import closest_point_on_triangle
 from collision_engine.support import POINT, support, TRIANGLE
-from collision_engine.tool import BOX_FLOATS, FLOAT_HEADER, INT_HEADER
+from collision_engine.tool import BOX_FLOATS, FLOAT_HEADER, INT_HEADER, MEASURED_FLOATS
 
 __all__ = ['mesh_tool_distance']
 
@@ -276,21 +281,28 @@ def _highest_first(tool_ints, n_shell, rel, nx, ny, nz):
 
 
 @jit
-def _ruled_out(tool_floats, work, measured, px, py, pz, best):
-    """Return whether a point measured so far rules p out.
+def _ruled_out(tool_floats, work, measured, px, py, pz, best, hint):
+    """Return whether what the points measured so far found rules p out, and where to search.
 
-    It does when its signed distance minus its distance to p (a lower bound on p's, the signed
-    distance being 1-Lipschitz) is not below ``best``. The latest points, most often p's
-    neighbours in the order of the search, are tried first.
+    A measured point q rules p out when its signed distance minus its distance to p (a lower
+    bound on p's, the signed distance being 1-Lipschitz) is not below ``best``; so does a
+    surface point a found for q when |p - a| <= -best (p's signed distance is at least
+    -|p - a|). Returns (ruled out, the triangle of the surface point nearest p, else ``hint``).
+    The latest points, most often p's neighbours in the order of the search, are tried first.
     """
+    nearest2 = math.inf
     for j in range(measured - 1, -1, -1):
-        w = work + 4 * j
+        w = work + MEASURED_FLOATS * j
         reach = tool_floats[w + 3] - best
         if reach >= 0.0:
             dx, dy, dz = px - tool_floats[w], py - tool_floats[w + 1], pz - tool_floats[w + 2]
             if dx * dx + dy * dy + dz * dz <= reach * reach:
-                return True
-    return False
+                return True, hint
+        dx, dy, dz = px - tool_floats[w + 4], py - tool_floats[w + 5], pz - tool_floats[w + 6]
+        d2 = dx * dx + dy * dy + dz * dz
+        if d2 < nearest2:
+            nearest2, hint = d2, int(tool_floats[w + 7])
+    return nearest2 <= best * best, hint
 
 
 @jit
@@ -315,19 +327,25 @@ def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, nx, 
             continue
         px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
                               tool_floats[shell + 3 * i + 2])
-        if _ruled_out(tool_floats, work, measured, px, py, pz, best):
+        ruled_out, hint = _ruled_out(tool_floats, work, measured, px, py, pz, best, hint)
+        if ruled_out:
             continue
-        # The search starts from the last nearest triangle.
+        # The search starts from the triangle of the nearest surface point found, and stops at
+        # any triangle within the deepest depth so far: p is then no deeper (its signed
+        # distance is at least minus that triangle's distance), and that bound is kept of it.
+        enough2 = best * best
         d, qx, qy, qz, ux, uy, uz, t, original, count = bvh.mesh_distance(
-            floats, fo, ints, io, px, py, pz, hint, stack, stack_d2)
+            floats, fo, ints, io, px, py, pz, hint, stack, stack_d2, enough2)
         tested += count
-        hint = t
-        if d < best:
+        if d * d <= enough2:
+            d = -abs(d)
+        elif d < best:
             best, found = d, True
             x, y, z, mx, my, mz, leaf_t, triangle = qx, qy, qz, ux, uy, uz, t, original
-        w = work + 4 * measured
-        tool_floats[w], tool_floats[w + 1], tool_floats[w + 2], tool_floats[w + 3] = (
-            px, py, pz, d)
+        w = work + MEASURED_FLOATS * measured
+        tool_floats[w], tool_floats[w + 1], tool_floats[w + 2], tool_floats[w + 3] = px, py, pz, d
+        tool_floats[w + 4], tool_floats[w + 5], tool_floats[w + 6] = qx, qy, qz
+        tool_floats[w + 7] = t
         measured += 1
     return found, best, x, y, z, mx, my, mz, leaf_t, triangle, tested
 
@@ -347,7 +365,7 @@ def mesh_tool_distance(floats, fo, ints, io, tool_floats, tool_ints, tool_kind, 
     core = core_of(tool)
     if core[0] == POINT:
         d, x, y, z, nx, ny, nz, t, original, tested = bvh.mesh_distance(
-            floats, fo, ints, io, rel[9], rel[10], rel[11], hint, stack, stack_d2)
+            floats, fo, ints, io, rel[9], rel[10], rel[11], hint, stack, stack_d2, -1.0)
         return STATUS_OK, d - radius, d - radius, x, y, z, nx, ny, nz, tested, original, t
     lay = bvh.layout(floats, fo, ints, io)
     n_tri, corners, face_normals, _, _, boxes, _, _, original, nodes = lay
