@@ -6,14 +6,21 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   is the mesh's exact point query at its centre, minus its radius.
 * Separation: the mesh's AABB tree is searched depth-first, nearer child first, skipping every
   node, and every triangle, whose lower bound is not below the nearest triangle so far; each
-  other triangle is measured by GJK against the tool. The bound is the largest of these
-  separating-axis bounds, along the mesh's axes (against the tool's box there, from six support
-  points) and along the tool's own axes (against its extents along them): the distance is at
-  least the root sum of squares of the gaps along any three orthogonal axes; and, once a
-  triangle is measured, the gap along the direction from it to the tool, which prunes the
-  surface that curves away from the nearest point. The nearest triangle's distance is the
-  separation, exact to GJK's tolerance, and its feature's pseudonormal at the tool's witness
-  says whether the tool is outside.
+  other triangle is measured by GJK against the tool, starting toward the tool's centre (so a
+  triangle's answer, to its last bit, does not depend on the order of the search). The bound
+  is the largest of these separating-axis bounds, along the mesh's axes (against the tool's box
+  there, from six support points) and along the tool's own axes (against its extents along
+  them): the distance is at least the root sum of squares of the gaps along any three
+  orthogonal axes; and, once a triangle is measured, the gap along the direction from it to the
+  tool, which prunes the surface that curves away from the nearest point. Of two children as
+  near (both at zero, often, under a tool that reaches into the surface) the one whose box
+  centre is nearer the tool's goes first: there the search meets a triangle in contact sooner.
+  The last query's triangle is measured first when it lies within the tool's diagonal, else in
+  its turn: a stale hint is a GJK call for a bound that prunes nothing. (For the probe near the
+  hand, 3 GJK calls a query in overlap and 10 apart, where the children's own order and every
+  hint took 8 and 16.) The nearest triangle's distance is the separation, exact to GJK's
+  tolerance, and its feature's pseudonormal at the tool's witness says whether the tool is
+  outside.
 * Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
   point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). Only a
   point deeper than the deepest so far matters, and two bounds rule points out unsearched: the
@@ -149,16 +156,35 @@ def _triangle_bound2(floats, c, box):
 
 
 @jit
+def _diagonal2(box):
+    """Squared diagonal of the tool's box along its own axes."""
+    return ((box[16] - box[15]) ** 2 + (box[18] - box[17]) ** 2 + (box[20] - box[19]) ** 2)
+
+
+@jit
+def _centre_nearer(floats, a, b, centre):
+    """Whether the node box at floats[a:a + 6] has its centre nearer ``centre`` than b's."""
+    cx, cy, cz = centre
+    ax = floats[a] + floats[a + 3] - 2.0 * cx
+    ay = floats[a + 1] + floats[a + 4] - 2.0 * cy
+    az = floats[a + 2] + floats[a + 5] - 2.0 * cz
+    bx = floats[b] + floats[b + 3] - 2.0 * cx
+    by = floats[b + 1] + floats[b + 4] - 2.0 * cy
+    bz = floats[b + 2] + floats[b + 5] - 2.0 * cz
+    return ax * ax + ay * ay + az * az < bx * bx + by * by + bz * bz
+
+
+@jit
 def _nearest_triangle(floats, ints, corners, boxes, nodes, n_tri, core, rel, box, hint, size,
                       rel_tol, abs_tol, max_iter, W, stack, stack_d2):
     """Search the tree for the triangle nearest the core; stop at the first one in contact.
 
-    The hint triangle is measured first. Returns (contact, triangle, distance, a, v, status,
-    lower, iterations) with a on the triangle and v = a - b (module docstring).
+    The hint triangle is measured first if it is near (module docstring). Returns (contact,
+    triangle, distance, a, v, status, lower, iterations) with a on the triangle and v = a - b.
     """
     centre = (0.5 * (box[0] + box[3]), 0.5 * (box[1] + box[4]), 0.5 * (box[2] + box[5]))
     state = (math.inf, -1, STATUS_OK, 0.0, math.inf, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, False)
-    if 0 <= hint < n_tri:
+    if 0 <= hint < n_tri and _triangle_bound2(floats, corners + 9 * hint, box) < _diagonal2(box):
         state = _measure(floats, ints, corners, hint, 1, core, rel, box, centre, size, rel_tol,
                          abs_tol, max_iter, W, state)
     stack[0], stack_d2[0] = 0, _node_bound2(floats, boxes, box)
@@ -178,7 +204,8 @@ def _nearest_triangle(floats, ints, corners, boxes, nodes, n_tri, core, rel, box
         near_d2 = _node_bound2(floats, boxes + 6 * child, box)
         far_d2 = _node_bound2(floats, boxes + 6 * (child + 1), box)
         near, far = child, child + 1
-        if far_d2 < near_d2:
+        if far_d2 < near_d2 or (far_d2 == near_d2 and _centre_nearer(
+                floats, boxes + 6 * far, boxes + 6 * near, centre)):
             near, far, near_d2, far_d2 = far, near, far_d2, near_d2
         if far_d2 < best2:
             stack[top], stack_d2[top] = far, far_d2
@@ -207,11 +234,9 @@ def _measure(floats, ints, corners, first, count, core, rel, box, centre, size, 
         c = corners + 9 * t
         if _triangle_bound2(floats, c, box) >= best * best:
             continue
-        # The search starts along the nearest triangle's direction so far, else toward the
-        # tool's centre.
-        gx, gy, gz = -vx, -vy, -vz
-        if best_t < 0:
-            gx, gy, gz = cx - floats[c], cy - floats[c + 1], cz - floats[c + 2]
+        # The search starts toward the tool's centre, whatever was measured before: a
+        # triangle's answer, to its last bit, is then the same in any order of the search.
+        gx, gy, gz = cx - floats[c], cy - floats[c + 1], cz - floats[c + 2]
         s, touch, _, ux, uy, uz, low, iterations, _, px, py, pz = gjk(
             (TRIANGLE, floats, c, ints, 0), core, rel, gx, gy, gz, size, rel_tol, abs_tol,
             max_iter, W[:12], W[12:24])
