@@ -121,6 +121,40 @@ def test_a_search_told_what_is_enough_stops_only_within_it(hand):
     np.testing.assert_allclose(answers[~within], truth[~within], rtol=0, atol=1e-14)
 
 
+def test_the_distance_grid_holds_exact_signed_distances_that_bound_the_field(hand):
+    # The probe's overlap search rules shell points out by the grid's bounds: its values must
+    # be the exact signed distance (brute force), and the bounds must hold around them.
+    floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces, grid_vertices=5000)
+    grid = len(floats) - len(bvh.distance_grid(floats, ints, hand.vertices, 5000))
+    origin, spacing = floats[grid:grid + 3], floats[grid + 3]
+    shape = floats[grid + 4:grid + 7].astype(int)
+    finer = np.ceil(np.ptp(hand.vertices, axis=0) * 1.25 / spacing) + 3
+    assert np.prod(shape) <= 5000 < np.prod(finer)
+    assert np.all(origin + spacing * (shape - 1) >= hand.vertices.max(axis=0) + spacing - 1e-12)
+    assert np.all(origin <= hand.vertices.min(axis=0) - spacing + 1e-12)
+    values = floats[grid + bvh.GRID_HEADER:].reshape(shape)
+    rng = np.random.default_rng(16)
+    picked = rng.integers(0, shape, size=(300, 3))
+    truth, _ = mesh_signed_distance(origin + spacing * picked, hand.vertices, hand.faces)
+    np.testing.assert_allclose(values[tuple(picked.T)], truth, rtol=0, atol=1e-14)
+    near, _ = sample_near_surface(hand.vertices, hand.faces, 300, 2 * spacing, rng)
+    low, high = origin - 2 * spacing, origin + spacing * (shape + 1)
+    points = np.concatenate((near, rng.uniform(low, high, size=(300, 3))))
+    truth, _ = mesh_signed_distance(points, hand.vertices, hand.faces)
+    bounds = np.array([bvh.grid_bounds(floats, grid, *p) for p in points])
+    beyond = bounds[:, 0] == np.inf
+    assert 0 < np.count_nonzero(beyond) and np.all(truth[beyond] > 0.0)
+    lower, upper, truth = bounds[~beyond, 0], bounds[~beyond, 1], truth[~beyond]
+    assert np.all(lower <= truth + 1e-14) and np.all(truth <= upper + 1e-14)
+    assert np.all(upper - lower <= spacing * 3 ** 0.5 + 1e-14)
+
+
+def test_a_mesh_packed_without_a_grid_bounds_nothing(hand):
+    floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces)
+    grid = len(floats) - bvh.GRID_HEADER
+    assert bvh.grid_bounds(floats, grid, *hand.vertices[0]) == (-np.inf, np.inf)
+
+
 def reference_triangle_bound2(corners, point) -> float:
     """The larger squared distance from the point to the triangle's plane and to its box."""
     normal = unit(np.cross(corners[1] - corners[0], corners[2] - corners[0]))

@@ -108,7 +108,8 @@ def place_object(floats: np.ndarray, ints: np.ndarray, index: int, shape, pose) 
 
 def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
     if shape.kind == TRIANGLE_MESH:
-        floats, ints = bvh.pack_triangle_mesh(shape.vertices, shape.faces)
+        floats, ints = bvh.pack_triangle_mesh(shape.vertices, shape.faces,
+                                              grid_vertices=bvh.GRID_VERTICES)
         return TRIANGLE_MESH, floats, ints
     return pack_convex(shape)
 

@@ -31,7 +31,7 @@ __all__ = ['BOX_FLOATS', 'DEFAULT_SHELL_SPACING', 'FLOAT_HEADER', 'INT_HEADER',
 
 DEFAULT_SHELL_SPACING = 0.005  # m
 FLOAT_HEADER = 8  # radius, bounding radius, bounding centre (3), spacing, shell at, work at
-INT_HEADER = 3  # kind, shell points, where the shell's orders along the tool's axes start
+INT_HEADER = 2  # kind, shell points
 BOX_FLOATS = 25  # the tool's extents in an object's frame (``tool_mesh._set_tool_box``)
 MEASURED_FLOATS = 8  # a shell point measured: itself, a bound, a surface point, its triangle
 MAX_FACE_POINTS = 32  # as haptic_msgs/CollisionState's contact sequences
@@ -230,9 +230,9 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
     work offset], the shape's float block, the shell (n, 3), then work space: the tool's pose
     in an object's frame (12), its extents there (``BOX_FLOATS``) and the shell points measured
     so far (``MEASURED_FLOATS`` n: each with a lower bound on its signed distance, and the
-    nearest surface point found for it and its triangle).
-    ints = [kind, n, orders offset], the shape's int block, then the shell's indices sorted
-    along the tool's x, y and z axes (3, n), which order the overlap search (``tool_mesh``).
+    nearest surface point found for it and its triangle), then each shell point's lower and
+    upper bound from the mesh's distance grid (2 n).
+    ints = [kind, n], then the shape's int block.
 
     Raises
     ------
@@ -250,11 +250,9 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
     shell_at = FLOAT_HEADER + len(shape_floats)
     work_at = shell_at + shell.size
     header = [radius, bounding, *centre, spacing, shell_at, work_at]
-    work = np.zeros(12 + BOX_FLOATS + MEASURED_FLOATS * len(shell))
+    work = np.zeros(12 + BOX_FLOATS + (MEASURED_FLOATS + 2) * len(shell))
     floats = np.concatenate((header, shape_floats, shell.ravel(), work))
-    orders = np.argsort(shell, axis=0, kind='stable').T.ravel()
-    ints = np.concatenate(([kind, len(shell), INT_HEADER + len(shape_ints)], shape_ints,
-                           orders)).astype(np.int64)
+    ints = np.concatenate(([kind, len(shell)], shape_ints)).astype(np.int64)
     packed = (floats, ints)
     _PACKED[shape] = packed
     return packed

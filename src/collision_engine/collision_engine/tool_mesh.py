@@ -23,20 +23,20 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   outside.
 * Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
   point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). Only a
-  point deeper than the deepest so far matters, and two bounds rule points out unsearched: the
-  signed distance is 1-Lipschitz, so a shell point closer to an already measured one than that
-  one's distance above the deepest so far cannot be deeper (every measured point's distance,
-  outside ones included, serves that test); and it is at least minus the distance to any
-  surface point, so a shell point within the deepest depth of a surface point found is no
-  deeper. For the same reason a search stops at the first triangle within the deepest depth
-  (its distance is then kept as the bound), and it starts from the triangle of the surface
-  point found nearest the shell point. The first point measured is the one deepest along the
-  contact triangle's normal; the others follow from the highest down, along the tool's axis
-  nearest that normal, so that the far points, measured early, rule out many of their
-  neighbours (for the probe near the hand, 19 searches a query where the shell's own order
-  took 25). When no shell point is inside (a feature of the mesh reaches into the tool between
-  shell points), the answer is the contact itself: depth zero at GJK's contact point, with that
-  triangle's normal.
+  point deeper than the deepest so far matters, and bounds rule most points out unsearched:
+  a scene's mesh carries a grid of exact signed distances (``bvh.distance_grid``), and as the
+  signed distance is 1-Lipschitz a point's lies within its distance to the nearest grid vertex
+  of that vertex's value (beyond the grid it is outside); a measured point q bounds p's from
+  below by q's minus |p - q| (every measured point's distance, outside ones included, serves
+  that test); and it is at least minus the distance to any surface point, so a shell point
+  within the deepest depth of a surface point found is no deeper. For the same reason a search
+  stops at the first triangle within the deepest depth (its distance is then kept as the
+  bound), and it starts from the triangle of the surface point found nearest the shell point.
+  The points are taken by least upper bound from the grid, the likely deepest first, among
+  those whose lower bound is below the deepest so far; for the probe near the hand that is 6
+  searches a query, where the tests between shell points alone left 19. When no shell point
+  is inside (a feature of the mesh reaches into the tool between shell points), the answer is
+  the contact itself: depth zero at GJK's contact point, with that triangle's normal.
 """
 
 import math
@@ -270,39 +270,27 @@ def _outside(floats, ints, lay, t, ax, ay, az, vx, vy, vz):
 
 
 @jit
-def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
-    """Return the shell point deepest below the plane through a with normal n.
+def _bound_shell(floats, fo, grid, tool_floats, shell, n_shell, rel, bounds):
+    """Write each shell point's bounds from the mesh's distance grid to tool_floats[bounds:].
 
-    It is measured first: the deepest depth so far widens every later Lipschitz test.
+    Lower and upper, two a point, the lower one lessened by a rounding slack.
     """
-    first, deepest = 0, -math.inf
+    slack = 1e-9 * floats[fo]
     for i in range(n_shell):
         px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
                               tool_floats[shell + 3 * i + 2])
-        depth = nx * (ax - px) + ny * (ay - py) + nz * (az - pz)
-        if depth > deepest:
-            first, deepest = i, depth
-    return first
+        lower, upper = bvh.grid_bounds(floats, grid, px, py, pz)
+        tool_floats[bounds + 2 * i], tool_floats[bounds + 2 * i + 1] = lower - slack, upper
 
 
 @jit
-def _highest_first(tool_ints, n_shell, rel, nx, ny, nz):
-    """Return the shell's order from the highest point down along n, roughly: (start, step).
-
-    It is the order along the tool's axis nearest n (``tool.pack_tool`` sorts the shell along
-    each), read from its end when that axis points up. High points are far from the surface,
-    and each one measured rules out a wide ball of its neighbours.
-    """
-    up = (rel[0] * nx + rel[3] * ny + rel[6] * nz, rel[1] * nx + rel[4] * ny + rel[7] * nz,
-          rel[2] * nx + rel[5] * ny + rel[8] * nz)  # n in the tool's frame: R^T n
-    k = 0
-    for j in (1, 2):
-        if abs(up[j]) > abs(up[k]):
-            k = j
-    order = tool_ints[2] + k * n_shell
-    if up[k] > 0.0:
-        return order + n_shell - 1, -1
-    return order, 1
+def _least_upper(tool_floats, bounds, n_shell, best):
+    """Return the shell point of least upper bound whose lower one is below ``best``, or -1."""
+    chosen, least = -1, math.inf
+    for i in range(n_shell):
+        if tool_floats[bounds + 2 * i] < best and tool_floats[bounds + 2 * i + 1] <= least:
+            chosen, least = i, tool_floats[bounds + 2 * i + 1]
+    return chosen
 
 
 @jit
@@ -331,29 +319,29 @@ def _ruled_out(tool_floats, work, measured, px, py, pz, best, hint):
 
 
 @jit
-def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, nx, ny, nz, ax, ay,
-                         az, hint, stack, stack_d2):
+def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, hint, stack,
+                         stack_d2):
     """Find the shell point of least signed distance, if any is inside (module docstring).
 
-    (nx, ny, nz) is the contact's outward normal and a a point on the surface there, which
-    order the shell. Returns (found, distance, x, y, z, normal x, y, z, leaf triangle,
-    original triangle, triangles tested).
+    Returns (found, distance, x, y, z, normal x, y, z, leaf triangle, original triangle,
+    triangles tested).
     """
     n_shell, shell = tool_ints[1], int(tool_floats[6])
     work = int(tool_floats[7]) + 12 + BOX_FLOATS
-    first = _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az)
-    start, stride = _highest_first(tool_ints, n_shell, rel, nx, ny, nz)
+    bounds = work + MEASURED_FLOATS * n_shell
+    boxes = bvh.layout(floats, fo, ints, io)[5]
+    _bound_shell(floats, fo, boxes + 6 * ints[io + 3], tool_floats, shell, n_shell, rel, bounds)
     best, found, measured, tested = 0.0, False, 0, 0
     x = y = z = mx = my = mz = 0.0
     leaf_t = triangle = -1
-    for step in range(-1, n_shell):
-        i = first if step < 0 else tool_ints[start + stride * step]
-        if step >= 0 and i == first:
-            continue
+    i = _least_upper(tool_floats, bounds, n_shell, best)
+    while i >= 0:
+        tool_floats[bounds + 2 * i] = math.inf
         px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
                               tool_floats[shell + 3 * i + 2])
         ruled_out, hint = _ruled_out(tool_floats, work, measured, px, py, pz, best, hint)
         if ruled_out:
+            i = _least_upper(tool_floats, bounds, n_shell, best)
             continue
         # The search starts from the triangle of the nearest surface point found, and stops at
         # any triangle within the deepest depth so far: p is then no deeper (its signed
@@ -372,6 +360,7 @@ def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, nx, 
         tool_floats[w + 4], tool_floats[w + 5], tool_floats[w + 6] = qx, qy, qz
         tool_floats[w + 7] = t
         measured += 1
+        i = _least_upper(tool_floats, bounds, n_shell, best)
     return found, best, x, y, z, mx, my, mz, leaf_t, triangle, tested
 
 
@@ -407,8 +396,7 @@ def mesh_tool_distance(floats, fo, ints, io, tool_floats, tool_ints, tool_kind, 
     f = face_normals + 3 * t
     fx, fy, fz = floats[f], floats[f + 1], floats[f + 2]
     found, depth, x, y, z, nx, ny, nz, leaf_t, triangle, more = _deepest_shell_point(
-        floats, fo, ints, io, tool_floats, tool_ints, rel, fx, fy, fz, ax, ay, az, t, stack,
-        stack_d2)
+        floats, fo, ints, io, tool_floats, tool_ints, rel, t, stack, stack_d2)
     if not found:
         return (STATUS_OK, -radius, -radius, ax, ay, az, fx, fy, fz, tested + more,
                 ints[original + t], t)
