@@ -101,6 +101,60 @@ def test_points_just_off_vertices_edges_and_faces(hand, offset):
             check(hand, points + sign * offset * direction, closest_too=False)
 
 
+def test_a_search_told_what_is_enough_stops_only_within_it(hand):
+    # The probe's overlap search asks only whether a shell point lies within the deepest depth
+    # so far: a triangle that near answers it (a bound from above, sign unknown); a point with
+    # none that near gets its exact signed distance.
+    floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces)
+    size = search_stack_size(ints)
+    stack, stack_d2 = np.zeros(size, dtype=np.int64), np.zeros(size)
+    points, _ = sample_near_surface(hand.vertices, hand.faces, 600, 0.004,
+                                    np.random.default_rng(15))
+    truth, _ = mesh_signed_distance(points, hand.vertices, hand.faces)
+    enough = 0.002
+    answers = np.array([bvh.mesh_distance(floats, 0, ints, 0, *p, -1, stack, stack_d2,
+                                          enough * enough)[0] for p in points])
+    within = np.abs(truth) <= enough
+    assert 0 < np.count_nonzero(within) < len(points)
+    assert np.all(np.abs(answers[within]) <= enough)
+    assert np.all(np.abs(answers[within]) >= np.abs(truth[within]) - 1e-14)
+    np.testing.assert_allclose(answers[~within], truth[~within], rtol=0, atol=1e-14)
+
+
+def test_the_distance_grid_holds_exact_signed_distances_that_bound_the_field(hand):
+    # The probe's overlap search rules shell points out by the grid's bounds: its values must
+    # be the exact signed distance (brute force), and the bounds must hold around them.
+    floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces, grid_vertices=5000)
+    grid = len(floats) - len(bvh.distance_grid(floats, ints, hand.vertices, 5000))
+    origin, spacing = floats[grid:grid + 3], floats[grid + 3]
+    shape = floats[grid + 4:grid + 7].astype(int)
+    finer = np.ceil(np.ptp(hand.vertices, axis=0) * 1.25 / spacing) + 3
+    assert np.prod(shape) <= 5000 < np.prod(finer)
+    assert np.all(origin + spacing * (shape - 1) >= hand.vertices.max(axis=0) + spacing - 1e-12)
+    assert np.all(origin <= hand.vertices.min(axis=0) - spacing + 1e-12)
+    values = floats[grid + bvh.GRID_HEADER:].reshape(shape)
+    rng = np.random.default_rng(16)
+    picked = rng.integers(0, shape, size=(300, 3))
+    truth, _ = mesh_signed_distance(origin + spacing * picked, hand.vertices, hand.faces)
+    np.testing.assert_allclose(values[tuple(picked.T)], truth, rtol=0, atol=1e-14)
+    near, _ = sample_near_surface(hand.vertices, hand.faces, 300, 2 * spacing, rng)
+    low, high = origin - 2 * spacing, origin + spacing * (shape + 1)
+    points = np.concatenate((near, rng.uniform(low, high, size=(300, 3))))
+    truth, _ = mesh_signed_distance(points, hand.vertices, hand.faces)
+    bounds = np.array([bvh.grid_bounds(floats, grid, *p) for p in points])
+    beyond = bounds[:, 0] == np.inf
+    assert 0 < np.count_nonzero(beyond) and np.all(truth[beyond] > 0.0)
+    lower, upper, truth = bounds[~beyond, 0], bounds[~beyond, 1], truth[~beyond]
+    assert np.all(lower <= truth + 1e-14) and np.all(truth <= upper + 1e-14)
+    assert np.all(upper - lower <= spacing * 3 ** 0.5 + 1e-14)
+
+
+def test_a_mesh_packed_without_a_grid_bounds_nothing(hand):
+    floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces)
+    grid = len(floats) - bvh.GRID_HEADER
+    assert bvh.grid_bounds(floats, grid, *hand.vertices[0]) == (-np.inf, np.inf)
+
+
 def reference_triangle_bound2(corners, point) -> float:
     """The larger squared distance from the point to the triangle's plane and to its box."""
     normal = unit(np.cross(corners[1] - corners[0], corners[2] - corners[0]))

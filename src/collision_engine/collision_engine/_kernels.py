@@ -108,7 +108,8 @@ def place_object(floats: np.ndarray, ints: np.ndarray, index: int, shape, pose) 
 
 def _pack_shape(shape) -> tuple[int, np.ndarray, np.ndarray]:
     if shape.kind == TRIANGLE_MESH:
-        floats, ints = bvh.pack_triangle_mesh(shape.vertices, shape.faces)
+        floats, ints = bvh.pack_triangle_mesh(shape.vertices, shape.faces,
+                                              grid_vertices=bvh.GRID_VERTICES)
         return TRIANGLE_MESH, floats, ints
     return pack_convex(shape)
 
@@ -128,7 +129,7 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2
     triangle = -1
     if kind == TRIANGLE_MESH:
         distance, x, y, z, nx, ny, nz, leaf_t, triangle, iterations = bvh.mesh_distance(
-            floats, fo, ints, io, qx, qy, qz, ints[entry + 4], stack, stack_d2)
+            floats, fo, ints, io, qx, qy, qz, ints[entry + 4], stack, stack_d2, -1.0)
         ints[entry + 4] = leaf_t
         status, lower = STATUS_OK, distance
     else:

@@ -18,7 +18,9 @@ Packed layout (one object's blocks; ``t`` triangles, ``e`` edges, ``n`` vertices
 triangles in tree-leaf order:
 
 * floats: scale (bounding radius, m); corners (t, 9); face normals (t, 3); edge normals (e, 3);
-  vertex normals (n, 3); node boxes (b, 6) as min xyz, max xyz.
+  vertex normals (n, 3); node boxes (b, 6) as min xyz, max xyz; a grid of exact signed
+  distances (``distance_grid``, for the probe's overlap search: ``tool_mesh``): origin (3),
+  spacing (0: no grid), vertices along x, y and z (3), then the values.
 * ints: t, e, n, b, tree depth; faces (t, 3); face edges (t, 3); original face index (t,);
   nodes (b, 3) as first child (-1 for a leaf), first triangle, triangle count.
 
@@ -37,11 +39,14 @@ from collision_engine.norms import norm3, unit3
 from collision_engine.pseudonormals import pseudonormals
 from collision_engine.signed_volumes import closest_point_on_triangle
 
-__all__ = ['FAR', 'LEAF_SIZE', 'box_distance2', 'build_tree', 'layout', 'mesh_distance',
+__all__ = ['FAR', 'GRID_HEADER', 'GRID_VERTICES', 'LEAF_SIZE', 'box_distance2', 'build_tree',
+           'distance_grid', 'grid_bounds', 'layout', 'mesh_distance',
            'nearest_triangle', 'pack_triangle_mesh', 'pseudonormal', 'search_stack_size',
            'tree_depth', 'triangle_bound2', 'triangle_distance2']
 
 LEAF_SIZE = 4
+GRID_HEADER = 7  # a distance grid's origin (3), spacing, vertices along x, y and z
+GRID_VERTICES = 2 ** 17  # the grid of a scene's mesh: 1 MB; for the hand, 2 mm apart
 FAR = 2.0 ** 26  # mesh radii: beyond, a query is answered from a nearer point on its ray
 
 
@@ -130,13 +135,16 @@ def search_stack_size(ints: np.ndarray) -> int:
     return int(ints[4]) + 1
 
 
-def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray, *,
+                       grid_vertices: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Build the tree and pseudonormals of a mesh and pack them in the layout above.
 
     Parameters
     ----------
     vertices : (n, 3) float, m, local frame
     faces : (t, 3) int, closed and consistently wound
+    grid_vertices : int
+        The most vertices of its grid of exact signed distances (``distance_grid``; 0: none).
 
     Returns
     -------
@@ -155,7 +163,74 @@ def pack_triangle_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndar
         [len(faces), len(normals.edge), len(vertices), len(nodes), tree_depth(nodes)],
         faces_sorted.ravel(),
         normals.face_edges[order].ravel(), order, nodes.ravel()))
-    return floats.astype(np.float64), ints.astype(np.int64)
+    floats, ints = floats.astype(np.float64), ints.astype(np.int64)
+    return np.concatenate((floats, distance_grid(floats, ints, vertices, grid_vertices))), ints
+
+
+def distance_grid(floats: np.ndarray, ints: np.ndarray, vertices: np.ndarray,
+                  count: int) -> np.ndarray:
+    """Return the grid block of a packed mesh: exact signed distances at a grid's vertices.
+
+    The grid spans the mesh's box widened by one spacing on every side, its spacing the least
+    that keeps it to ``count`` vertices. Each value bounds the signed distance d near its
+    vertex v, which is 1-Lipschitz: |d(p) - d(v)| <= |p - v|; and a point beyond the grid is
+    outside the mesh. Returns [origin (3), spacing, vertices along x, y, z, values (x-major)],
+    or that header with a zero spacing when ``count`` is 0.
+    """
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    extent = high - low
+    if count <= 0 or extent.max() <= 0.0:
+        return np.zeros(GRID_HEADER)
+
+    def shape(spacing):
+        return np.ceil(extent / spacing).astype(np.int64) + 3
+
+    spacing = extent.max() / 4.0
+    while np.prod(shape(spacing / 1.25)) <= count:
+        spacing /= 1.25
+    origin = low - spacing
+    stack = np.zeros(search_stack_size(ints), dtype=np.int64)
+    values = _grid_values(floats, ints, origin, spacing, shape(spacing), stack,
+                          np.zeros(len(stack)))
+    return np.concatenate((origin, [spacing], shape(spacing), values))
+
+
+@jit
+def _grid_values(floats, ints, origin, spacing, shape, stack, stack_d2):
+    """Exact signed distance at every grid vertex, x-major (each search hinted by the last)."""
+    values = np.empty(shape[0] * shape[1] * shape[2])
+    hint, n = -1, 0
+    for i in range(shape[0]):
+        for j in range(shape[1]):
+            for k in range(shape[2]):
+                d, _, _, _, _, _, _, hint, _, _ = mesh_distance(
+                    floats, 0, ints, 0, origin[0] + i * spacing, origin[1] + j * spacing,
+                    origin[2] + k * spacing, hint, stack, stack_d2, -1.0)
+                values[n] = d
+                n += 1
+    return values
+
+
+@jit
+def grid_bounds(floats, grid, qx, qy, qz):
+    """Bounds (lower, upper) on the signed distance at q from the grid at floats[grid:].
+
+    From the nearest grid vertex; (-inf, inf) without a grid, and (inf, inf) beyond it, where
+    q is outside the mesh.
+    """
+    spacing = floats[grid + 3]
+    if spacing == 0.0:
+        return -np.inf, np.inf
+    i = round((qx - floats[grid]) / spacing)
+    j = round((qy - floats[grid + 1]) / spacing)
+    k = round((qz - floats[grid + 2]) / spacing)
+    nx, ny, nz = floats[grid + 4], floats[grid + 5], floats[grid + 6]
+    if not (0 <= i < nx and 0 <= j < ny and 0 <= k < nz):
+        return np.inf, np.inf
+    value = floats[grid + GRID_HEADER + int((i * ny + j) * nz + k)]
+    reach = norm3(qx - (floats[grid] + i * spacing), qy - (floats[grid + 1] + j * spacing),
+                  qz - (floats[grid + 2] + k * spacing))
+    return value - reach, value + reach
 
 
 @jit
@@ -238,11 +313,13 @@ def triangle_distance2(floats, corners, t, qx, qy, qz):
 
 
 @jit
-def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
+def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2, enough2):
     """Signed distance from q to a packed triangle mesh, local frame.
 
     ``hint`` is a triangle (leaf order) to try first, or -1. ``stack`` (int) and ``stack_d2``
-    (float) are scratch, each at least ``search_stack_size`` long (module docstring).
+    (float) are scratch, each at least ``search_stack_size`` long (module docstring). The search
+    stops at the first triangle whose squared distance is at most ``enough2`` (-1: none), and
+    answers from it: then only the distance's magnitude means anything, as an upper bound.
 
     A point farther than ``FAR`` mesh radii R from the mesh's centre is outside, and is searched
     from the point moved toward the mesh to ``FAR`` radii on the same ray: far off, the rounding
@@ -267,7 +344,7 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
         pull = FAR * scale / reach
         sx, sy, sz = cx + (qx - cx) * pull, cy + (qy - cy) * pull, cz + (qz - cz) * pull
     best_d2, best_t, feature, which, vx, vy, vz, tested = nearest_triangle(
-        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2)
+        floats, corners, boxes, ints, nodes, n_tri, sx, sy, sz, hint, stack, stack_d2, enough2)
     if reach > FAR * scale:
         x, y, z = sx + vx, sy + vy, sz + vz
         nx, ny, nz = unit3(qx - x, qy - y, qz - z)
@@ -289,8 +366,10 @@ def mesh_distance(floats, fo, ints, io, qx, qy, qz, hint, stack, stack_d2):
 
 @jit
 def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hint, stack,
-                     stack_d2):
+                     stack_d2, enough2):
     """Depth-first search of the tree for the triangle nearest q (see ``mesh_distance``).
+
+    It stops early at a triangle within ``enough2`` (squared; -1 for none).
 
     Returns (squared distance, triangle in leaf order, feature, which, vx, vy, vz, triangles
     tested) with v from q to the nearest point and the feature as
@@ -308,7 +387,7 @@ def nearest_triangle(floats, corners, boxes, ints, nodes, n_tri, qx, qy, qz, hin
     stack[0] = 0
     stack_d2[0] = box_distance2(floats, boxes, qx, qy, qz)
     top = 1
-    while top > 0:
+    while top > 0 and best_d2 > enough2:
         top -= 1
         node = stack[top]
         if stack_d2[top] >= best_d2:

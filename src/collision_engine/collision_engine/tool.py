@@ -26,13 +26,14 @@ from collision_engine.support import pack_convex
 from collision_engine.transforms import Pose
 
 __all__ = ['BOX_FLOATS', 'DEFAULT_SHELL_SPACING', 'FLOAT_HEADER', 'INT_HEADER',
-           'MAX_FACE_POINTS', 'MountedTool', 'face_shell', 'load_tool', 'mount_tool', 'pack_tool',
-           'point_shell']
+           'MAX_FACE_POINTS', 'MEASURED_FLOATS', 'MountedTool', 'face_shell', 'load_tool',
+           'mount_tool', 'pack_tool', 'point_shell']
 
 DEFAULT_SHELL_SPACING = 0.005  # m
 FLOAT_HEADER = 8  # radius, bounding radius, bounding centre (3), spacing, shell at, work at
-INT_HEADER = 3  # kind, shell points, where the shell's orders along the tool's axes start
+INT_HEADER = 2  # kind, shell points
 BOX_FLOATS = 25  # the tool's extents in an object's frame (``tool_mesh._set_tool_box``)
+MEASURED_FLOATS = 8  # a shell point measured: itself, a bound, a surface point, its triangle
 MAX_FACE_POINTS = 32  # as haptic_msgs/CollisionState's contact sequences
 _FACE_TOLERANCE = 1e-9  # m: a hull vertex this near the lowest z lies on the face
 _CONVEX = (Box, Sphere, Cylinder, Capsule, ConvexMesh)
@@ -228,9 +229,10 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
     Layout: floats = [radius, bounding radius, bounding centre (3), spacing, shell offset,
     work offset], the shape's float block, the shell (n, 3), then work space: the tool's pose
     in an object's frame (12), its extents there (``BOX_FLOATS``) and the shell points measured
-    so far with bounds on their distances (4 n).
-    ints = [kind, n, orders offset], the shape's int block, then the shell's indices sorted
-    along the tool's x, y and z axes (3, n), which order the overlap search (``tool_mesh``).
+    so far (``MEASURED_FLOATS`` n: each with a lower bound on its signed distance, and the
+    nearest surface point found for it and its triangle), then each shell point's lower and
+    upper bound from the mesh's distance grid (2 n).
+    ints = [kind, n], then the shape's int block.
 
     Raises
     ------
@@ -248,11 +250,9 @@ def pack_tool(shape, *, spacing: float, workspace_size: float) -> tuple[np.ndarr
     shell_at = FLOAT_HEADER + len(shape_floats)
     work_at = shell_at + shell.size
     header = [radius, bounding, *centre, spacing, shell_at, work_at]
-    work = np.zeros(12 + BOX_FLOATS + 4 * len(shell))
+    work = np.zeros(12 + BOX_FLOATS + (MEASURED_FLOATS + 2) * len(shell))
     floats = np.concatenate((header, shape_floats, shell.ravel(), work))
-    orders = np.argsort(shell, axis=0, kind='stable').T.ravel()
-    ints = np.concatenate(([kind, len(shell), INT_HEADER + len(shape_ints)], shape_ints,
-                           orders)).astype(np.int64)
+    ints = np.concatenate(([kind, len(shell)], shape_ints)).astype(np.int64)
     packed = (floats, ints)
     _PACKED[shape] = packed
     return packed

@@ -6,25 +6,37 @@ Sign rule as everywhere: negative in overlap; the normal is outward from the mes
   is the mesh's exact point query at its centre, minus its radius.
 * Separation: the mesh's AABB tree is searched depth-first, nearer child first, skipping every
   node, and every triangle, whose lower bound is not below the nearest triangle so far; each
-  other triangle is measured by GJK against the tool. The bound is the largest of these
-  separating-axis bounds, along the mesh's axes (against the tool's box there, from six support
-  points) and along the tool's own axes (against its extents along them): the distance is at
-  least the root sum of squares of the gaps along any three orthogonal axes; and, once a
-  triangle is measured, the gap along the direction from it to the tool, which prunes the
-  surface that curves away from the nearest point. The nearest triangle's distance is the
-  separation, exact to GJK's tolerance, and its feature's pseudonormal at the tool's witness
-  says whether the tool is outside.
+  other triangle is measured by GJK against the tool, starting toward the tool's centre (so a
+  triangle's answer, to its last bit, does not depend on the order of the search). The bound
+  is the largest of these separating-axis bounds, along the mesh's axes (against the tool's box
+  there, from six support points) and along the tool's own axes (against its extents along
+  them): the distance is at least the root sum of squares of the gaps along any three
+  orthogonal axes; and, once a triangle is measured, the gap along the direction from it to the
+  tool, which prunes the surface that curves away from the nearest point. Of two children as
+  near (both at zero, often, under a tool that reaches into the surface) the one whose box
+  centre is nearer the tool's goes first: there the search meets a triangle in contact sooner.
+  The last query's triangle is measured first when it lies within the tool's diagonal, else in
+  its turn: a stale hint is a GJK call for a bound that prunes nothing. (For the probe near the
+  hand, 3 GJK calls a query in overlap and 10 apart, where the children's own order and every
+  hint took 8 and 16.) The nearest triangle's distance is the separation, exact to GJK's
+  tolerance, and its feature's pseudonormal at the tool's witness says whether the tool is
+  outside.
 * Overlap (a triangle in contact, or the tool wholly inside): the deepest point of the tool's
-  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``, its search
-  starting from the last point's nearest triangle). The signed distance is 1-Lipschitz, so a
-  shell point closer to an already measured one than that one's distance above the deepest so
-  far cannot be deeper, and is skipped; every measured point's exact distance, outside ones
-  included, serves that test. The first point measured is the one deepest along the contact
-  triangle's normal; the others follow from the highest down, along the tool's axis nearest
-  that normal, so that the far points, measured early, rule out many of their neighbours (for
-  the probe near the hand, 19 searches a query where the shell's own order took 25). When no
-  shell point is inside (a feature of the mesh reaches into the tool between shell points), the
-  answer is the contact itself: depth zero at GJK's contact point, with that triangle's normal.
+  point shell (``tool``) by the mesh's exact signed distance (``bvh.mesh_distance``). Only a
+  point deeper than the deepest so far matters, and bounds rule most points out unsearched:
+  a scene's mesh carries a grid of exact signed distances (``bvh.distance_grid``), and as the
+  signed distance is 1-Lipschitz a point's lies within its distance to the nearest grid vertex
+  of that vertex's value (beyond the grid it is outside); a measured point q bounds p's from
+  below by q's minus |p - q| (every measured point's distance, outside ones included, serves
+  that test); and it is at least minus the distance to any surface point, so a shell point
+  within the deepest depth of a surface point found is no deeper. For the same reason a search
+  stops at the first triangle within the deepest depth (its distance is then kept as the
+  bound), and it starts from the triangle of the surface point found nearest the shell point.
+  The points are taken by least upper bound from the grid, the likely deepest first, among
+  those whose lower bound is below the deepest so far; for the probe near the hand that is 6
+  searches a query, where the tests between shell points alone left 19. When no shell point
+  is inside (a feature of the mesh reaches into the tool between shell points), the answer is
+  the contact itself: depth zero at GJK's contact point, with that triangle's normal.
 """
 
 import math
@@ -36,7 +48,7 @@ from collision_engine.narrowphase import core_of
 from collision_engine.norms import norm3, unit3
 from collision_engine.signed_volumes import closest_point_on_triangle
 from collision_engine.support import POINT, support, TRIANGLE
-from collision_engine.tool import BOX_FLOATS, FLOAT_HEADER, INT_HEADER
+from collision_engine.tool import BOX_FLOATS, FLOAT_HEADER, INT_HEADER, MEASURED_FLOATS
 
 __all__ = ['mesh_tool_distance']
 
@@ -144,16 +156,35 @@ def _triangle_bound2(floats, c, box):
 
 
 @jit
+def _diagonal2(box):
+    """Squared diagonal of the tool's box along its own axes."""
+    return ((box[16] - box[15]) ** 2 + (box[18] - box[17]) ** 2 + (box[20] - box[19]) ** 2)
+
+
+@jit
+def _centre_nearer(floats, a, b, centre):
+    """Whether the node box at floats[a:a + 6] has its centre nearer ``centre`` than b's."""
+    cx, cy, cz = centre
+    ax = floats[a] + floats[a + 3] - 2.0 * cx
+    ay = floats[a + 1] + floats[a + 4] - 2.0 * cy
+    az = floats[a + 2] + floats[a + 5] - 2.0 * cz
+    bx = floats[b] + floats[b + 3] - 2.0 * cx
+    by = floats[b + 1] + floats[b + 4] - 2.0 * cy
+    bz = floats[b + 2] + floats[b + 5] - 2.0 * cz
+    return ax * ax + ay * ay + az * az < bx * bx + by * by + bz * bz
+
+
+@jit
 def _nearest_triangle(floats, ints, corners, boxes, nodes, n_tri, core, rel, box, hint, size,
                       rel_tol, abs_tol, max_iter, W, stack, stack_d2):
     """Search the tree for the triangle nearest the core; stop at the first one in contact.
 
-    The hint triangle is measured first. Returns (contact, triangle, distance, a, v, status,
-    lower, iterations) with a on the triangle and v = a - b (module docstring).
+    The hint triangle is measured first if it is near (module docstring). Returns (contact,
+    triangle, distance, a, v, status, lower, iterations) with a on the triangle and v = a - b.
     """
     centre = (0.5 * (box[0] + box[3]), 0.5 * (box[1] + box[4]), 0.5 * (box[2] + box[5]))
     state = (math.inf, -1, STATUS_OK, 0.0, math.inf, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, False)
-    if 0 <= hint < n_tri:
+    if 0 <= hint < n_tri and _triangle_bound2(floats, corners + 9 * hint, box) < _diagonal2(box):
         state = _measure(floats, ints, corners, hint, 1, core, rel, box, centre, size, rel_tol,
                          abs_tol, max_iter, W, state)
     stack[0], stack_d2[0] = 0, _node_bound2(floats, boxes, box)
@@ -173,7 +204,8 @@ def _nearest_triangle(floats, ints, corners, boxes, nodes, n_tri, core, rel, box
         near_d2 = _node_bound2(floats, boxes + 6 * child, box)
         far_d2 = _node_bound2(floats, boxes + 6 * (child + 1), box)
         near, far = child, child + 1
-        if far_d2 < near_d2:
+        if far_d2 < near_d2 or (far_d2 == near_d2 and _centre_nearer(
+                floats, boxes + 6 * far, boxes + 6 * near, centre)):
             near, far, near_d2, far_d2 = far, near, far_d2, near_d2
         if far_d2 < best2:
             stack[top], stack_d2[top] = far, far_d2
@@ -202,11 +234,9 @@ def _measure(floats, ints, corners, first, count, core, rel, box, centre, size, 
         c = corners + 9 * t
         if _triangle_bound2(floats, c, box) >= best * best:
             continue
-        # The search starts along the nearest triangle's direction so far, else toward the
-        # tool's centre.
-        gx, gy, gz = -vx, -vy, -vz
-        if best_t < 0:
-            gx, gy, gz = cx - floats[c], cy - floats[c + 1], cz - floats[c + 2]
+        # The search starts toward the tool's centre, whatever was measured before: a
+        # triangle's answer, to its last bit, is then the same in any order of the search.
+        gx, gy, gz = cx - floats[c], cy - floats[c + 1], cz - floats[c + 2]
         s, touch, _, ux, uy, uz, low, iterations, _, px, py, pz = gjk(
             (TRIANGLE, floats, c, ints, 0), core, rel, gx, gy, gz, size, rel_tol, abs_tol,
             max_iter, W[:12], W[12:24])
@@ -240,95 +270,97 @@ def _outside(floats, ints, lay, t, ax, ay, az, vx, vy, vz):
 
 
 @jit
-def _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az):
-    """Return the shell point deepest below the plane through a with normal n.
+def _bound_shell(floats, fo, grid, tool_floats, shell, n_shell, rel, bounds):
+    """Write each shell point's bounds from the mesh's distance grid to tool_floats[bounds:].
 
-    It is measured first: the deepest depth so far widens every later Lipschitz test.
+    Lower and upper, two a point, the lower one lessened by a rounding slack.
     """
-    first, deepest = 0, -math.inf
+    slack = 1e-9 * floats[fo]
     for i in range(n_shell):
         px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
                               tool_floats[shell + 3 * i + 2])
-        depth = nx * (ax - px) + ny * (ay - py) + nz * (az - pz)
-        if depth > deepest:
-            first, deepest = i, depth
-    return first
+        lower, upper = bvh.grid_bounds(floats, grid, px, py, pz)
+        tool_floats[bounds + 2 * i], tool_floats[bounds + 2 * i + 1] = lower - slack, upper
 
 
 @jit
-def _highest_first(tool_ints, n_shell, rel, nx, ny, nz):
-    """Return the shell's order from the highest point down along n, roughly: (start, step).
-
-    It is the order along the tool's axis nearest n (``tool.pack_tool`` sorts the shell along
-    each), read from its end when that axis points up. High points are far from the surface,
-    and each one measured rules out a wide ball of its neighbours.
-    """
-    up = (rel[0] * nx + rel[3] * ny + rel[6] * nz, rel[1] * nx + rel[4] * ny + rel[7] * nz,
-          rel[2] * nx + rel[5] * ny + rel[8] * nz)  # n in the tool's frame: R^T n
-    k = 0
-    for j in (1, 2):
-        if abs(up[j]) > abs(up[k]):
-            k = j
-    order = tool_ints[2] + k * n_shell
-    if up[k] > 0.0:
-        return order + n_shell - 1, -1
-    return order, 1
+def _least_upper(tool_floats, bounds, n_shell, best):
+    """Return the shell point of least upper bound whose lower one is below ``best``, or -1."""
+    chosen, least = -1, math.inf
+    for i in range(n_shell):
+        if tool_floats[bounds + 2 * i] < best and tool_floats[bounds + 2 * i + 1] <= least:
+            chosen, least = i, tool_floats[bounds + 2 * i + 1]
+    return chosen
 
 
 @jit
-def _ruled_out(tool_floats, work, measured, px, py, pz, best):
-    """Return whether a point measured so far rules p out.
+def _ruled_out(tool_floats, work, measured, px, py, pz, best, hint):
+    """Return whether what the points measured so far found rules p out, and where to search.
 
-    It does when its signed distance minus its distance to p (a lower bound on p's, the signed
-    distance being 1-Lipschitz) is not below ``best``. The latest points, most often p's
-    neighbours in the order of the search, are tried first.
+    A measured point q rules p out when its signed distance minus its distance to p (a lower
+    bound on p's, the signed distance being 1-Lipschitz) is not below ``best``; so does a
+    surface point a found for q when |p - a| <= -best (p's signed distance is at least
+    -|p - a|). Returns (ruled out, the triangle of the surface point nearest p, else ``hint``).
+    The latest points, most often p's neighbours in the order of the search, are tried first.
     """
+    nearest2 = math.inf
     for j in range(measured - 1, -1, -1):
-        w = work + 4 * j
+        w = work + MEASURED_FLOATS * j
         reach = tool_floats[w + 3] - best
         if reach >= 0.0:
             dx, dy, dz = px - tool_floats[w], py - tool_floats[w + 1], pz - tool_floats[w + 2]
             if dx * dx + dy * dy + dz * dz <= reach * reach:
-                return True
-    return False
+                return True, hint
+        dx, dy, dz = px - tool_floats[w + 4], py - tool_floats[w + 5], pz - tool_floats[w + 6]
+        d2 = dx * dx + dy * dy + dz * dz
+        if d2 < nearest2:
+            nearest2, hint = d2, int(tool_floats[w + 7])
+    return nearest2 <= best * best, hint
 
 
 @jit
-def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, nx, ny, nz, ax, ay,
-                         az, hint, stack, stack_d2):
+def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, hint, stack,
+                         stack_d2):
     """Find the shell point of least signed distance, if any is inside (module docstring).
 
-    (nx, ny, nz) is the contact's outward normal and a a point on the surface there, which
-    order the shell. Returns (found, distance, x, y, z, normal x, y, z, leaf triangle,
-    original triangle, triangles tested).
+    Returns (found, distance, x, y, z, normal x, y, z, leaf triangle, original triangle,
+    triangles tested).
     """
     n_shell, shell = tool_ints[1], int(tool_floats[6])
     work = int(tool_floats[7]) + 12 + BOX_FLOATS
-    first = _deepest_first(tool_floats, shell, n_shell, rel, nx, ny, nz, ax, ay, az)
-    start, stride = _highest_first(tool_ints, n_shell, rel, nx, ny, nz)
+    bounds = work + MEASURED_FLOATS * n_shell
+    boxes = bvh.layout(floats, fo, ints, io)[5]
+    _bound_shell(floats, fo, boxes + 6 * ints[io + 3], tool_floats, shell, n_shell, rel, bounds)
     best, found, measured, tested = 0.0, False, 0, 0
     x = y = z = mx = my = mz = 0.0
     leaf_t = triangle = -1
-    for step in range(-1, n_shell):
-        i = first if step < 0 else tool_ints[start + stride * step]
-        if step >= 0 and i == first:
-            continue
+    i = _least_upper(tool_floats, bounds, n_shell, best)
+    while i >= 0:
+        tool_floats[bounds + 2 * i] = math.inf
         px, py, pz = _to_mesh(rel, tool_floats[shell + 3 * i], tool_floats[shell + 3 * i + 1],
                               tool_floats[shell + 3 * i + 2])
-        if _ruled_out(tool_floats, work, measured, px, py, pz, best):
+        ruled_out, hint = _ruled_out(tool_floats, work, measured, px, py, pz, best, hint)
+        if ruled_out:
+            i = _least_upper(tool_floats, bounds, n_shell, best)
             continue
-        # The search starts from the last nearest triangle.
+        # The search starts from the triangle of the nearest surface point found, and stops at
+        # any triangle within the deepest depth so far: p is then no deeper (its signed
+        # distance is at least minus that triangle's distance), and that bound is kept of it.
+        enough2 = best * best
         d, qx, qy, qz, ux, uy, uz, t, original, count = bvh.mesh_distance(
-            floats, fo, ints, io, px, py, pz, hint, stack, stack_d2)
+            floats, fo, ints, io, px, py, pz, hint, stack, stack_d2, enough2)
         tested += count
-        hint = t
-        if d < best:
+        if d * d <= enough2:
+            d = -abs(d)
+        elif d < best:
             best, found = d, True
             x, y, z, mx, my, mz, leaf_t, triangle = qx, qy, qz, ux, uy, uz, t, original
-        w = work + 4 * measured
-        tool_floats[w], tool_floats[w + 1], tool_floats[w + 2], tool_floats[w + 3] = (
-            px, py, pz, d)
+        w = work + MEASURED_FLOATS * measured
+        tool_floats[w], tool_floats[w + 1], tool_floats[w + 2], tool_floats[w + 3] = px, py, pz, d
+        tool_floats[w + 4], tool_floats[w + 5], tool_floats[w + 6] = qx, qy, qz
+        tool_floats[w + 7] = t
         measured += 1
+        i = _least_upper(tool_floats, bounds, n_shell, best)
     return found, best, x, y, z, mx, my, mz, leaf_t, triangle, tested
 
 
@@ -347,7 +379,7 @@ def mesh_tool_distance(floats, fo, ints, io, tool_floats, tool_ints, tool_kind, 
     core = core_of(tool)
     if core[0] == POINT:
         d, x, y, z, nx, ny, nz, t, original, tested = bvh.mesh_distance(
-            floats, fo, ints, io, rel[9], rel[10], rel[11], hint, stack, stack_d2)
+            floats, fo, ints, io, rel[9], rel[10], rel[11], hint, stack, stack_d2, -1.0)
         return STATUS_OK, d - radius, d - radius, x, y, z, nx, ny, nz, tested, original, t
     lay = bvh.layout(floats, fo, ints, io)
     n_tri, corners, face_normals, _, _, boxes, _, _, original, nodes = lay
@@ -364,8 +396,7 @@ def mesh_tool_distance(floats, fo, ints, io, tool_floats, tool_ints, tool_kind, 
     f = face_normals + 3 * t
     fx, fy, fz = floats[f], floats[f + 1], floats[f + 2]
     found, depth, x, y, z, nx, ny, nz, leaf_t, triangle, more = _deepest_shell_point(
-        floats, fo, ints, io, tool_floats, tool_ints, rel, fx, fy, fz, ax, ay, az, t, stack,
-        stack_d2)
+        floats, fo, ints, io, tool_floats, tool_ints, rel, t, stack, stack_d2)
     if not found:
         return (STATUS_OK, -radius, -radius, ax, ay, az, fx, fy, fz, tested + more,
                 ints[original + t], t)
