@@ -11,6 +11,7 @@ What it shows is what the schemes do with a delay, free of a busy machine's timi
 ``tdpa-plain``: TDPA's operator-side controller on the wand itself, without the virtual coupling
 that ``tdpa`` puts between them, the baseline that chatters.
 """
+import argparse
 import math
 import sys
 
@@ -134,7 +135,13 @@ def as_series(run: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    args = teleop_scan.scan_arguments(__doc__, SCHEMES).parse_args(argv)
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--schemes', nargs='+', default=list(SCHEMES), choices=SCHEMES)
+    parser.add_argument('--delays', nargs='+', type=float,
+                        default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
+    parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
+    parser.add_argument('--loss', type=float, default=0.01)
+    args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")} (no ROS: one clock, lockstep)')
     teleop_scan.print_header()
     for delay in args.delays:

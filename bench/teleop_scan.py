@@ -160,19 +160,14 @@ def print_row(r: dict) -> None:
           flush=True)
 
 
-def scan_arguments(doc: str, schemes) -> argparse.ArgumentParser:
-    """Return a parser of what a scan varies: schemes, one-way delays, jitter, loss."""
-    parser = argparse.ArgumentParser(description=doc.split('\n\n')[0])
-    parser.add_argument('--schemes', nargs='+', default=list(schemes), choices=schemes)
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--schemes', nargs='+', default=['direct', 'tdpa', 'model'],
+                        choices=['direct', 'tdpa', 'model'])
     parser.add_argument('--delays', nargs='+', type=float,
                         default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
     parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
     parser.add_argument('--loss', type=float, default=0.01)
-    return parser
-
-
-def main(argv=None) -> int:
-    parser = scan_arguments(__doc__, ('direct', 'tdpa', 'model'))
     parser.add_argument('--site-streams', nargs='+', default=['in-process'],
                         choices=SITE_STREAMS, help="how each site's nodes pass their streams")
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
