@@ -125,7 +125,7 @@ def test_the_distance_grid_holds_exact_signed_distances_that_bound_the_field(han
     # The probe's overlap search rules shell points out by the grid's bounds: its values must
     # be the exact signed distance (brute force), and the bounds must hold around them.
     floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces, grid_vertices=5000)
-    grid = len(floats) - len(bvh.distance_grid(floats, ints, hand.vertices, 5000))
+    grid = bvh.grid_at(floats, 0, ints, 0)
     origin, spacing = floats[grid:grid + 3], floats[grid + 3]
     shape = floats[grid + 4:grid + 7].astype(int)
     finer = np.ceil(np.ptp(hand.vertices, axis=0) * 1.25 / spacing) + 3
@@ -151,7 +151,8 @@ def test_the_distance_grid_holds_exact_signed_distances_that_bound_the_field(han
 
 def test_a_mesh_packed_without_a_grid_bounds_nothing(hand):
     floats, ints = bvh.pack_triangle_mesh(hand.vertices, hand.faces)
-    grid = len(floats) - bvh.GRID_HEADER
+    grid = bvh.grid_at(floats, 0, ints, 0)
+    assert grid == len(floats) - bvh.GRID_HEADER
     assert bvh.grid_bounds(floats, grid, *hand.vertices[0]) == (-np.inf, np.inf)
 
 

@@ -40,7 +40,7 @@ from collision_engine.pseudonormals import pseudonormals
 from collision_engine.signed_volumes import closest_point_on_triangle
 
 __all__ = ['FAR', 'GRID_HEADER', 'GRID_VERTICES', 'LEAF_SIZE', 'box_distance2', 'build_tree',
-           'distance_grid', 'grid_bounds', 'layout', 'mesh_distance',
+           'distance_grid', 'grid_at', 'grid_bounds', 'layout', 'mesh_distance',
            'nearest_triangle', 'pack_triangle_mesh', 'pseudonormal', 'search_stack_size',
            'tree_depth', 'triangle_bound2', 'triangle_distance2']
 
@@ -251,6 +251,12 @@ def layout(floats, fo, ints, io):
     original = face_edges + 3 * n_tri
     return (n_tri, corners, face_normals, edge_normals, vertex_normals, boxes, faces, face_edges,
             original, original + n_tri)
+
+
+@jit
+def grid_at(floats, fo, ints, io):
+    """Offset in ``floats`` of one packed mesh's distance grid: the block after its node boxes."""
+    return layout(floats, fo, ints, io)[5] + 6 * ints[io + 3]
 
 
 @jit

@@ -329,8 +329,8 @@ def _deepest_shell_point(floats, fo, ints, io, tool_floats, tool_ints, rel, hint
     n_shell, shell = tool_ints[1], int(tool_floats[6])
     work = int(tool_floats[7]) + 12 + BOX_FLOATS
     bounds = work + MEASURED_FLOATS * n_shell
-    boxes = bvh.layout(floats, fo, ints, io)[5]
-    _bound_shell(floats, fo, boxes + 6 * ints[io + 3], tool_floats, shell, n_shell, rel, bounds)
+    _bound_shell(floats, fo, bvh.grid_at(floats, fo, ints, io), tool_floats, shell, n_shell,
+                 rel, bounds)
     best, found, measured, tested = 0.0, False, 0, 0
     x = y = z = mx = my = mz = 0.0
     leaf_t = triangle = -1
