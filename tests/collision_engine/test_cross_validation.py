@@ -94,6 +94,7 @@ def test_a_wrong_distance_from_the_engine_is_a_disagreement(checked_scenes, monk
     assert scene.wait_for_cross_validation(timeout=60.0)
     stats = scene.cross_validation_stats
     assert (stats.checks, stats.disagreements) == (2, 1)
+    assert scene.cross_validation_disagreements == 1  # what every collision state carries
     assert stats.max_discrepancy == pytest.approx(1e-3, abs=1e-8)
 
 
@@ -131,6 +132,7 @@ def test_a_wrong_fcl_answer_is_counted_and_changes_nothing(checked_scenes, monke
     assert (stats.checks, stats.disagreements) == (1, 1)
     assert stats.max_discrepancy == pytest.approx(1e-3, abs=1e-8)
     reference = plain.query(point)
+    assert plain.cross_validation_disagreements == 0  # no cross-check, nothing to disagree
     assert result.distance == reference.distance
     np.testing.assert_array_equal(result.point, reference.point)
     np.testing.assert_array_equal(result.normal, reference.normal)

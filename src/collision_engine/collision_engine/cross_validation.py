@@ -298,6 +298,11 @@ class CrossValidationWorker:
         return replace(self._validator.stats, dropped=self._dropped)
 
     @property
+    def disagreements(self) -> int:
+        """FCL disagreements so far: what every answer carries, without building the totals."""
+        return self._validator.stats.disagreements
+
+    @property
     def running(self) -> bool:
         """Whether the worker thread is alive."""
         return self._thread.is_alive()

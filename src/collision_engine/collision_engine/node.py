@@ -68,34 +68,31 @@ class CollisionNode(Node):
 
     def on_pose(self, pose: Sequence) -> None:
         header = (pose[0], pose[1], pose[2])
+        disagreements = self.scene.cross_validation_disagreements
         try:
             tip, orientation = tip_pose(pose, self.scene.frame_id)
         except InvalidPose as error:
             self._refused.add(error.kind, str(error))
-            self._state_pub.publish(invalid_state(header, self._disagreements()))
+            self._state_pub.publish(invalid_state(header, disagreements))
             return
         start = time.perf_counter()
         if self.scene.tool is None:
             result = self.scene.query(tip)
             elapsed = time.perf_counter() - start
-            fields = state(header, result, elapsed, self._disagreements(), orientation)
+            fields = state(header, result, elapsed, disagreements, orientation)
         else:
             probe = query_probe(self.scene, tip, orientation)
             elapsed = time.perf_counter() - start
             result = probe.tool
-            fields = tool_state(header, probe, tip, orientation, elapsed, self._disagreements())
+            fields = tool_state(header, probe, tip, orientation, elapsed, disagreements)
         self._last_result = result
         self._state_pub.publish(fields)
         self._answered += 1
         if self._nearby_pub is not None:
             self.publish_nearby(header, tip)
 
-    def _disagreements(self) -> int:
-        stats = self.scene.cross_validation_stats
-        return 0 if stats is None else stats.disagreements
-
     def publish_nearby(self, header: tuple, tip) -> None:
-        disagreements = self._disagreements()
+        disagreements = self.scene.cross_validation_disagreements
         nearby = CollisionStateArray(radius=self.params.report_radius)
         nearby.header.stamp.sec, nearby.header.stamp.nanosec, nearby.header.frame_id = header
         nearby.states = [STATE.to_message(state(header, result, 0.0, disagreements))

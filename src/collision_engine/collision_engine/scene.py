@@ -152,6 +152,11 @@ class Scene:
         """
         return None if self._validator is None else self._validator.stats
 
+    @property
+    def cross_validation_disagreements(self) -> int:
+        """FCL disagreements so far (0 when off): cheap enough for every answer."""
+        return 0 if self._validator is None else self._validator.disagreements
+
     def wait_for_cross_validation(self, timeout: float | None = None) -> bool:
         """Wait until every sampled query so far is checked; false on timeout (true when off)."""
         return True if self._validator is None else self._validator.drain(timeout)

@@ -93,6 +93,22 @@ class Contact:
         for name in ('point', 'normal', 'tip'):
             object.__setattr__(self, name, vector3(getattr(self, name), f'Contact.{name}'))
 
+    @classmethod
+    def from_floats(cls, distance: float, point: tuple, normal: tuple, tip: tuple, name: str,
+                    stamp: float, status: int, face: FaceContact | None) -> 'Contact':
+        """Build from a CollisionState's leaves: floats, 3-tuples of floats and an int.
+
+        The renderer's per-answer constructor: its three vectors share one array, and it skips
+        the checks of values a decoded message already has the types of.
+        """
+        vectors = np.array((*point, *normal, *tip))
+        vectors.flags.writeable = False
+        contact = object.__new__(cls)
+        contact.__dict__.update(distance=distance, point=vectors[0:3], normal=vectors[3:6],
+                                tip=vectors[6:9], object=name, stamp=stamp, status=status,
+                                face=face)
+        return contact
+
     @property
     def in_contact(self) -> bool:
         """True when the tip is strictly inside the object (touching the surface is no contact)."""

@@ -139,8 +139,8 @@ class ForceNode(Node):
          tx, ty, tz) = fields[:19]
         stamp_ns = sec * 1_000_000_000 + nanosec
         self._approximate += status == CollisionState.STATUS_NOT_CONVERGED
-        self._contact = Contact(distance, (px, py, pz), (nx, ny, nz), (tx, ty, tz), name,
-                                stamp_ns * 1e-9, status, _face(fields))
+        self._contact = Contact.from_floats(distance, (px, py, pz), (nx, ny, nz), (tx, ty, tz),
+                                            name, stamp_ns * 1e-9, status, _face(fields))
         self._header = (sec, nanosec, frame)
         self.render(self._velocity(stamp_ns))
 

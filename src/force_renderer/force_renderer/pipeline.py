@@ -124,8 +124,9 @@ class ForcePipeline:
         else:
             twist = None
         if reason is Reason.OK:
-            estimate = self.velocity_estimator.update_components(contact.stamp, position)
-            twist = estimate if twist is None else twist
+            self.velocity_estimator.add(contact.stamp, position)
+            if twist is None:
+                twist = self.velocity_estimator.velocity_components()
             raw = floats3(self.law.force(contact, twist))
             force = saturate_components(*raw, limit)
             axis = self.law.axis(contact)

@@ -32,7 +32,7 @@ class VelocityEstimator:
     def __init__(self, window: float = 0.005) -> None:
         self.window = positive(window, 'window')
         self._samples: deque[tuple[float, float, float, float]] = deque()
-        self._velocity = (0.0, 0.0, 0.0)
+        self._velocity = (0.0, 0.0, 0.0)  # None: samples came since it was last worked out
 
     def reset(self) -> None:
         """Forget every sample; the estimate is zero until two new ones arrive."""
@@ -42,7 +42,17 @@ class VelocityEstimator:
     @property
     def velocity(self) -> np.ndarray:
         """(3,) float, m/s: the estimate; zero before the second sample."""
-        return np.array(self._velocity)
+        return np.array(self.velocity_components())
+
+    def velocity_components(self) -> tuple[float, float, float]:
+        """Return the estimate as floats, worked out only when asked.
+
+        A loop fed the driver's twist adds a sample every tick and never asks.
+        """
+        if self._velocity is None:
+            samples = self._samples
+            self._velocity = _slope(samples) if len(samples) > 1 else (0.0, 0.0, 0.0)
+        return self._velocity
 
     def update(self, stamp: float, position) -> np.ndarray:
         """Add one sample and return the new estimate.
@@ -63,17 +73,21 @@ class VelocityEstimator:
 
     def update_components(self, stamp: float,
                           position: tuple[float, float, float]) -> tuple[float, float, float]:
-        """Float-level `update` for the 1 kHz loop."""
+        """Float-level `update`."""
+        self.add(stamp, position)
+        return self.velocity_components()
+
+    def add(self, stamp: float, position: tuple[float, float, float]) -> None:
+        """Add one sample (m, floats), unless its stamp or a coordinate is unusable."""
         x, y, z = position
         samples = self._samples
         usable = math.isfinite(stamp) and math.isfinite(x + y + z)
         if not usable or (samples and stamp <= samples[-1][0]):
-            return self._velocity
+            return
         samples.append((stamp, x, y, z))
         while len(samples) > 2 and stamp - samples[0][0] > self.window:
             samples.popleft()
-        self._velocity = _slope(samples) if len(samples) > 1 else (0.0, 0.0, 0.0)
-        return self._velocity
+        self._velocity = None
 
 
 def _slope(samples) -> tuple[float, float, float]:

@@ -15,7 +15,7 @@ figures on the cylinder and the hand).
 from dataclasses import dataclass
 import enum
 import math
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 from force_renderer.spring_damper import unilateral_spring_damper
 from haptic_wand_driver.orientation import rotate
@@ -37,7 +37,7 @@ class Kind(enum.IntEnum):
     UNAVAILABLE = 2
 
 
-_KINDS = frozenset(int(kind) for kind in Kind)
+_KINDS = {int(kind): kind for kind in Kind}  # a message's kind -> Kind, without Kind()'s cost
 
 
 class ModelRefused(ValueError):
@@ -48,9 +48,12 @@ class ModelRefused(ValueError):
         self.field = field
 
 
-@dataclass(frozen=True)
-class Plane:
-    """One plane of a model: see ``ContactPlane.msg``. Vectors (3,) float, SI units."""
+class Plane(NamedTuple):
+    """One plane of a model: see ``ContactPlane.msg``. Vectors (3,) float, SI units.
+
+    A named tuple: one is built for every plane of every answer, at a third of a frozen
+    dataclass's cost.
+    """
 
     point: Vector3
     normal: Vector3
@@ -109,9 +112,13 @@ class ContactModel:
                 and min(force_limit, valid_for, valid_radius) >= 0.0):
             _refuse(fields, count)
         planes = tuple(_plane(k, fields[6 + 15 * k:21 + 15 * k]) for k in range(count))
-        return cls(sec + nanosec * 1e-9, Kind(kind), planes if kind == Kind.PLANES else (),
-                   force_limit, valid_for, valid_radius, tuple(fields[54:57]),
-                   tuple(fields[57:63]))
+        model = object.__new__(cls)  # checked above: the dataclass's frozen __init__ costs more
+        model.__dict__.update(
+            stamp=sec + nanosec * 1e-9, kind=_KINDS[kind],
+            planes=planes if kind == Kind.PLANES else (), force_limit=force_limit,
+            valid_for=valid_for, valid_radius=valid_radius, tip=tuple(fields[54:57]),
+            held_wrench=tuple(fields[57:63]))
+        return model
 
     def valid(self, position: Sequence[float]) -> bool:
         """Whether ``position`` (3,) m is within ``valid_radius`` of the model's tip."""
@@ -179,14 +186,17 @@ def _refuse(fields: Sequence, count: int) -> None:
 
 def _plane(k: int, values: Sequence[float]) -> Plane:
     """Return plane k of a model whose numbers are finite, its gains and normal checked."""
-    vectors = [tuple(values[i:i + 3]) for i in range(0, 15, 3)]
-    for label, vector in zip(('stiffness', 'damping'), vectors[2:4]):
-        if min(vector) < 0.0:
-            raise ModelRefused(f'planes[{k}].{label}', f'is negative: {list(vector)}')
-    norm = math.sqrt(sum(c * c for c in vectors[1]))
+    if min(values[6:12]) < 0.0:
+        for label, at in (('stiffness', 6), ('damping', 9)):
+            if min(values[at:at + 3]) < 0.0:
+                raise ModelRefused(f'planes[{k}].{label}',
+                                   f'is negative: {list(values[at:at + 3])}')
+    nx, ny, nz = values[3:6]
+    norm = math.sqrt(0.0 + nx * nx + ny * ny + nz * nz)  # the order sum() adds them in
     if abs(norm - 1.0) > UNIT_TOLERANCE:
         raise ModelRefused(f'planes[{k}].normal', f'is not unit (|n| = {norm:.9g})')
-    return Plane(*vectors)
+    return Plane(tuple(values[0:3]), (nx, ny, nz), tuple(values[6:9]), tuple(values[9:12]),
+                 tuple(values[12:15]))
 
 
 def _finite(name: str, vector: Sequence[float]) -> None:

@@ -80,9 +80,7 @@ class LocalRenderer:
         """Render ``model`` from now until ``deadline`` (s, the device's clock)."""
         self._held = (model, None, deadline)
         mode = MODE_PLANES if model.kind == Kind.PLANES else MODE_NONE
-        planes = [value for plane in model.planes for vector in (
-            plane.point, plane.normal, plane.stiffness, plane.damping, plane.tool_point)
-            for value in vector]
+        planes = [value for plane in model.planes for vector in plane for value in vector]
         self._pack(mode, deadline, model.force_limit, model.valid_radius, model.tip, _ZERO * 2,
                    len(model.planes), planes)
 
