@@ -131,10 +131,11 @@ class ImpedanceRobot:
     def __init__(self, config: ImpedanceRobotConfig = ImpedanceRobotConfig(), *,
                  environment: Environment | None = None):
         self._config = config
-        self._environment = environment
+        self._force_at = _float_environment(environment)
+        self._decay = 1.0 + config.step * config.damping / config.mass  # the implicit damping
         self._position = tuple(config.initial_position.tolist())
         self._velocity = (0.0, 0.0, 0.0)
-        self._external_force = self._environment_force()
+        self._external_force = self._force_at(self._position, self._velocity)
         self._target = self._position
         self._start: float | None = None
         self._steps_done = 0
@@ -172,9 +173,9 @@ class ImpedanceRobot:
             raise ValueError(f'ImpedanceRobot.read: now {now!r} s is before the last state '
                              f'({self._time()!r} s); the clock must not go back')
         target_steps = math.floor((now - self._start) / self._config.step + 1e-9)
-        for _ in range(self._steps_done, target_steps):
-            self._substep()
-        self._steps_done = max(self._steps_done, target_steps)
+        if target_steps > self._steps_done:
+            self._advance(target_steps - self._steps_done)
+            self._steps_done = target_steps
         return self.state()
 
     def state(self) -> RobotState:
@@ -185,29 +186,57 @@ class ImpedanceRobot:
     def _time(self) -> float:
         return (self._start or 0.0) + self._steps_done * self._config.step
 
-    def _substep(self) -> None:
-        """One semi-implicit Euler step: speed limited, then the workspace walls stop the TCP."""
+    def _advance(self, steps: int) -> None:
+        """Run ``steps`` semi-implicit Euler steps: speed limited, then the walls stop the TCP.
+
+        The state stays in local floats from one substep to the next: attribute lookups and
+        3-vector arrays would cost more than the arithmetic.
+        """
         config = self._config
         step, mass, stiffness = config.step, config.mass, config.stiffness
-        decay = 1.0 + step * config.damping / mass
-        velocity = [(v + step * (stiffness * (t - p) + f) / mass) / decay for p, v, t, f in zip(
-            self._position, self._velocity, self._target, self._external_force)]
-        speed = math.sqrt(velocity[0] ** 2 + velocity[1] ** 2 + velocity[2] ** 2)
-        if speed > config.max_speed:
-            scale = config.max_speed / speed
-            velocity = [v * scale for v in velocity]
-        position = []
-        for k, (p, (lower, upper)) in enumerate(zip(self._position, self._limits)):
-            p += step * velocity[k]
-            if p <= lower and velocity[k] < 0.0 or p >= upper and velocity[k] > 0.0:
-                velocity[k] = 0.0
-            position.append(min(max(p, lower), upper))
-        self._position, self._velocity = tuple(position), tuple(velocity)
-        self._external_force = self._environment_force()
+        max_speed, decay, force_at = config.max_speed, self._decay, self._force_at
+        (x_lower, x_upper), (y_lower, y_upper), (z_lower, z_upper) = self._limits
+        target_x, target_y, target_z = self._target
+        x, y, z = self._position
+        vx, vy, vz = self._velocity
+        fx, fy, fz = self._external_force
+        for _ in range(steps):
+            vx = (vx + step * (stiffness * (target_x - x) + fx) / mass) / decay
+            vy = (vy + step * (stiffness * (target_y - y) + fy) / mass) / decay
+            vz = (vz + step * (stiffness * (target_z - z) + fz) / mass) / decay
+            speed = math.sqrt(vx ** 2 + vy ** 2 + vz ** 2)
+            if speed > max_speed:
+                scale = max_speed / speed
+                vx, vy, vz = vx * scale, vy * scale, vz * scale
+            x, y, z = x + step * vx, y + step * vy, z + step * vz
+            if not (x_lower < x < x_upper and y_lower < y < y_upper and z_lower < z < z_upper):
+                x, vx = _stop_at_walls(x, vx, x_lower, x_upper)
+                y, vy = _stop_at_walls(y, vy, y_lower, y_upper)
+                z, vz = _stop_at_walls(z, vz, z_lower, z_upper)
+            fx, fy, fz = force_at((x, y, z), (vx, vy, vz))
+        self._position, self._velocity = (x, y, z), (vx, vy, vz)
+        self._external_force = (fx, fy, fz)
 
-    def _environment_force(self) -> tuple:
-        """Return the environment's force at the current state (and for the next substep)."""
-        if self._environment is None:
-            return (0.0, 0.0, 0.0)
-        force = self._environment(np.array(self._position), np.array(self._velocity))
+
+def _stop_at_walls(position: float, velocity: float, lower: float, upper: float) -> tuple:
+    """Return ``position`` clamped to [lower, upper] and ``velocity`` along it, zeroed outward."""
+    if position <= lower and velocity < 0.0 or position >= upper and velocity > 0.0:
+        velocity = 0.0
+    return min(max(position, lower), upper), velocity
+
+
+def _no_force(position: tuple, velocity: tuple) -> tuple:
+    """Return free space's force: none."""
+    return (0.0, 0.0, 0.0)
+
+
+def _float_environment(environment: Environment | None) -> Callable[[tuple, tuple], tuple]:
+    """Return ``environment`` as a function of float tuples giving a checked float tuple."""
+    if environment is None:
+        return _no_force
+
+    def array_force_at(position: tuple, velocity: tuple) -> tuple:
+        """Call the environment on arrays; check its force and return it as floats."""
+        force = environment(np.array(position), np.array(velocity))
         return tuple(finite_vector(force, 3, 'environment force').tolist())
+    return array_force_at
