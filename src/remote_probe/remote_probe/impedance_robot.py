@@ -20,6 +20,7 @@ so the state is plain floats: numpy's cost per call on a 3-vector is larger than
 
 from dataclasses import dataclass, field
 import math
+from math import isfinite
 from typing import Callable
 
 import numpy as np
@@ -29,7 +30,11 @@ from remote_probe._checks import finite_number, finite_vector, unit_vector
 __all__ = ['Environment', 'ImpedanceRobot', 'ImpedanceRobotConfig', 'RobotState']
 
 Environment = Callable[[np.ndarray, np.ndarray], np.ndarray]
-"""The force (3,) N on the TCP from what it touches, given its position (m) and velocity (m/s)."""
+"""The force (3,) N on the TCP from what it touches, given its position (m) and velocity (m/s).
+
+An environment may also offer ``force_floats(position, velocity)``: the same force from and as
+three floats (``tissue.Tissue`` does). The substeps then call that, with no arrays.
+"""
 
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
@@ -131,11 +136,11 @@ class ImpedanceRobot:
     def __init__(self, config: ImpedanceRobotConfig = ImpedanceRobotConfig(), *,
                  environment: Environment | None = None):
         self._config = config
-        self._force_at = _float_environment(environment)
+        self._force_floats = _float_environment(environment)
         self._decay = 1.0 + config.step * config.damping / config.mass  # the implicit damping
         self._position = tuple(config.initial_position.tolist())
         self._velocity = (0.0, 0.0, 0.0)
-        self._external_force = self._force_at(self._position, self._velocity)
+        self._external_force = self._force_floats(self._position, self._velocity)
         self._target = self._position
         self._start: float | None = None
         self._steps_done = 0
@@ -194,7 +199,7 @@ class ImpedanceRobot:
         """
         config = self._config
         step, mass, stiffness = config.step, config.mass, config.stiffness
-        max_speed, decay, force_at = config.max_speed, self._decay, self._force_at
+        max_speed, decay, force_floats = config.max_speed, self._decay, self._force_floats
         (x_lower, x_upper), (y_lower, y_upper), (z_lower, z_upper) = self._limits
         target_x, target_y, target_z = self._target
         x, y, z = self._position
@@ -213,7 +218,7 @@ class ImpedanceRobot:
                 x, vx = _stop_at_walls(x, vx, x_lower, x_upper)
                 y, vy = _stop_at_walls(y, vy, y_lower, y_upper)
                 z, vz = _stop_at_walls(z, vz, z_lower, z_upper)
-            fx, fy, fz = force_at((x, y, z), (vx, vy, vz))
+            fx, fy, fz = force_floats((x, y, z), (vx, vy, vz))
         self._position, self._velocity = (x, y, z), (vx, vy, vz)
         self._external_force = (fx, fy, fz)
 
@@ -231,12 +236,26 @@ def _no_force(position: tuple, velocity: tuple) -> tuple:
 
 
 def _float_environment(environment: Environment | None) -> Callable[[tuple, tuple], tuple]:
-    """Return ``environment`` as a function of float tuples giving a checked float tuple."""
+    """Return ``environment`` as a function of float tuples giving a checked float tuple.
+
+    The substeps call it: an environment with ``force_floats`` (as ``tissue.Tissue``) is called
+    on floats, any other with (3,) arrays, as the ``Environment`` type says.
+    """
     if environment is None:
         return _no_force
+    force_floats = getattr(environment, 'force_floats', None)
+    if force_floats is None:
+        def array_force_floats(position: tuple, velocity: tuple) -> tuple:
+            """Call the environment on arrays; check its force and return it as floats."""
+            force = environment(np.array(position), np.array(velocity))
+            return tuple(finite_vector(force, 3, 'environment force').tolist())
+        return array_force_floats
 
-    def array_force_at(position: tuple, velocity: tuple) -> tuple:
-        """Call the environment on arrays; check its force and return it as floats."""
-        force = environment(np.array(position), np.array(velocity))
-        return tuple(finite_vector(force, 3, 'environment force').tolist())
-    return array_force_at
+    def checked_force_floats(position: tuple, velocity: tuple) -> tuple:
+        """Call the environment on floats; check its force, as an array environment's."""
+        force = force_floats(position, velocity)
+        fx, fy, fz = force
+        if isfinite(fx) and isfinite(fy) and isfinite(fz):
+            return force
+        raise ValueError(f'environment force must be 3 finite numbers, got {force!r}')
+    return checked_force_floats
