@@ -180,5 +180,7 @@ class Tissue:
         depth, (nx, ny, nz) = self._penetration_floats(position)
         if depth <= 0.0:
             return _NO_FORCE
-        magnitude = self._law.normal_force(depth, -float(np.dot(velocity, (nx, ny, nz))))
+        vx, vy, vz = velocity
+        # Summed in order: np.dot (OpenBLAS) fuses the multiply-adds, so the last bit may differ.
+        magnitude = self._law.normal_force(depth, -(vx * nx + vy * ny + vz * nz))
         return magnitude * nx, magnitude * ny, magnitude * nz
