@@ -171,17 +171,25 @@ class ImpedanceRobot:
 
         The first call starts the clock at ``now``; the clock must not go back.
         """
-        now = finite_number(now, 'ImpedanceRobot.read now')
+        self.advance(now)
+        return self.state()
+
+    def advance(self, now: float) -> None:
+        """Advance to the last substep at or before ``now`` (s) as ``read`` does; return nothing.
+
+        For a caller about to give a new command, which needs the old target applied up to now
+        but not the state, whose arrays cost more than a tick's two substeps.
+        """
+        now = finite_number(now, 'ImpedanceRobot now')
         if self._start is None:
             self._start = now
         elif now < self._time():
-            raise ValueError(f'ImpedanceRobot.read: now {now!r} s is before the last state '
+            raise ValueError(f'ImpedanceRobot: now {now!r} s is before the last state '
                              f'({self._time()!r} s); the clock must not go back')
         target_steps = math.floor((now - self._start) / self._config.step + 1e-9)
         if target_steps > self._steps_done:
-            self._advance(target_steps - self._steps_done)
+            self._run_substeps(target_steps - self._steps_done)
             self._steps_done = target_steps
-        return self.state()
 
     def state(self) -> RobotState:
         """Return the state at the last substep, without advancing."""
@@ -191,7 +199,7 @@ class ImpedanceRobot:
     def _time(self) -> float:
         return (self._start or 0.0) + self._steps_done * self._config.step
 
-    def _advance(self, steps: int) -> None:
+    def _run_substeps(self, steps: int) -> None:
         """Run ``steps`` semi-implicit Euler steps: speed limited, then the walls stop the TCP.
 
         The state stays in local floats from one substep to the next: attribute lookups and
