@@ -25,7 +25,8 @@ from typing import Callable
 
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector, unit_vector
+from remote_probe._checks import (finite_floats, finite_number, finite_vector, nonzero_floats,
+                                  unit_vector)
 
 __all__ = ['Environment', 'ImpedanceRobot', 'ImpedanceRobotConfig', 'RobotState']
 
@@ -162,9 +163,9 @@ class ImpedanceRobot:
         ``orientation`` (4,) x, y, z, w must be a non-zero quaternion; it is not tracked yet
         (the orientation stays at ``config.initial_orientation``).
         """
-        position = finite_vector(position, 3, 'ImpedanceRobot.command position')
-        unit_vector(orientation, 4, 'ImpedanceRobot.command orientation')
-        self._target = tuple(position.tolist())
+        target = finite_floats(position, 3, 'ImpedanceRobot.command position')
+        nonzero_floats(orientation, 4, 'ImpedanceRobot.command orientation')
+        self._target = target
 
     def read(self, now: float) -> RobotState:
         """Advance to the last substep at or before ``now`` (s) and return the state there.
