@@ -181,6 +181,6 @@ class Tissue:
         if depth <= 0.0:
             return _NO_FORCE
         vx, vy, vz = velocity
-        # Summed in order: np.dot (OpenBLAS) fuses the multiply-adds, so the last bit may differ.
+        # A plain sum: np.dot (OpenBLAS) fuses the multiply-adds, so it may differ in the last bit.
         magnitude = self._law.normal_force(depth, -(vx * nx + vy * ny + vz * nz))
         return magnitude * nx, magnitude * ny, magnitude * nz
