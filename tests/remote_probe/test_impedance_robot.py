@@ -83,6 +83,25 @@ def test_states_do_not_depend_on_when_read_is_called():
     assert regular.time == jittery.time == pytest.approx(1.0)
 
 
+def test_advance_moves_the_robot_as_read_does():
+    def run(catch_up):
+        robot = ImpedanceRobot(environment=lambda p, v: -300.0 * p - 2.0 * v)
+        robot.read(0.0)
+        for now in np.arange(1, 301) * 1e-3:
+            catch_up(robot, now)
+            robot.command([0.02 * math.sin(now * 20.0), -0.01, 0.03])
+        return robot.read(0.3005)
+
+    advanced = run(ImpedanceRobot.advance)
+    read = run(ImpedanceRobot.read)
+    for name in ('time', 'position', 'velocity', 'external_force'):
+        np.testing.assert_array_equal(getattr(advanced, name), getattr(read, name))
+    robot = ImpedanceRobot()
+    robot.advance(1.0)
+    with pytest.raises(ValueError, match='must not go back'):
+        robot.advance(0.5)
+
+
 def test_orientation_is_held_and_the_pose_api_checks_the_quaternion():
     robot = ImpedanceRobot(ImpedanceRobotConfig(initial_orientation=[0, 0, 2.0, 0]))
     robot.command([0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0])

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-__all__ = ['finite_number', 'finite_vector', 'unit_vector']
+__all__ = ['finite_floats', 'finite_number', 'finite_vector', 'nonzero_floats', 'unit_vector']
 
 
 def finite_number(value, name: str, *, minimum: float | None = None,
@@ -32,6 +32,39 @@ def finite_vector(value, size: int, name: str, *, minimum: float | None = None) 
 
     With ``minimum``, every component must also be at least that. Raises ValueError otherwise.
     """
+    vector, _ = _finite_array(value, size, name, minimum)
+    vector.flags.writeable = False
+    return vector
+
+
+def finite_floats(value, size: int, name: str) -> tuple:
+    """Return ``value`` as a tuple of ``size`` floats, checked as ``finite_vector`` checks it.
+
+    For a caller that keeps floats (a command every tick): no read-only array is made.
+    """
+    return tuple(_finite_array(value, size, name, None)[1])
+
+
+def nonzero_floats(value, size: int, name: str) -> tuple:
+    """Return ``value`` as a tuple of ``size`` floats, checked as ``unit_vector`` checks it.
+
+    For a caller that only refuses a zero vector: not scaled, no read-only array made.
+    """
+    vector, components = _finite_array(value, size, name, None)
+    _nonzero_length(vector, value, name)
+    return tuple(components)
+
+
+def unit_vector(value, size: int, name: str) -> np.ndarray:
+    """Return ``value`` (``size`` finite numbers, not zero) scaled to unit length, read-only."""
+    vector, _ = _finite_array(value, size, name, None)
+    unit = vector / _nonzero_length(vector, value, name)
+    unit.flags.writeable = False
+    return unit
+
+
+def _finite_array(value, size: int, name: str, minimum: float | None) -> tuple[np.ndarray, list]:
+    """Return ``value`` as a float64 array and a list of its floats; raise unless all finite."""
     try:
         vector = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -43,16 +76,12 @@ def finite_vector(value, size: int, name: str, *, minimum: float | None = None) 
             minimum is not None and min(components) < minimum):
         bound = '' if minimum is None else f' >= {minimum:g}'
         raise ValueError(f'{name} must be {size} finite numbers{bound}, got {value!r}')
-    vector.flags.writeable = False
-    return vector
+    return vector, components
 
 
-def unit_vector(value, size: int, name: str) -> np.ndarray:
-    """Return ``value`` (``size`` finite numbers, not zero) scaled to unit length, read-only."""
-    vector = finite_vector(value, size, name)
-    length = float(np.linalg.norm(vector))
+def _nonzero_length(vector: np.ndarray, value, name: str) -> float:
+    """Return the length of ``vector`` (``value`` checked finite); raise if it is zero."""
+    length = math.sqrt(vector.dot(vector))  # np.linalg.norm's own sum, without its dispatch
     if length < 1e-9:
         raise ValueError(f'{name} must not be zero, got {value!r}')
-    unit = vector / length
-    unit.flags.writeable = False
-    return unit
+    return length

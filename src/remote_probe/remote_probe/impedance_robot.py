@@ -20,16 +20,22 @@ so the state is plain floats: numpy's cost per call on a 3-vector is larger than
 
 from dataclasses import dataclass, field
 import math
+from math import isfinite
 from typing import Callable
 
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector, unit_vector
+from remote_probe._checks import (finite_floats, finite_number, finite_vector, nonzero_floats,
+                                  unit_vector)
 
 __all__ = ['Environment', 'ImpedanceRobot', 'ImpedanceRobotConfig', 'RobotState']
 
 Environment = Callable[[np.ndarray, np.ndarray], np.ndarray]
-"""The force (3,) N on the TCP from what it touches, given its position (m) and velocity (m/s)."""
+"""The force (3,) N on the TCP from what it touches, given its position (m) and velocity (m/s).
+
+An environment may also offer ``force_floats(position, velocity)``: the same force from and as
+three floats (``tissue.Tissue`` does). The substeps then call that, with no arrays.
+"""
 
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
@@ -131,10 +137,11 @@ class ImpedanceRobot:
     def __init__(self, config: ImpedanceRobotConfig = ImpedanceRobotConfig(), *,
                  environment: Environment | None = None):
         self._config = config
-        self._environment = environment
+        self._force_floats = _float_environment(environment)
+        self._decay = 1.0 + config.step * config.damping / config.mass  # the implicit damping
         self._position = tuple(config.initial_position.tolist())
         self._velocity = (0.0, 0.0, 0.0)
-        self._external_force = self._environment_force()
+        self._external_force = self._force_floats(self._position, self._velocity)
         self._target = self._position
         self._start: float | None = None
         self._steps_done = 0
@@ -156,26 +163,34 @@ class ImpedanceRobot:
         ``orientation`` (4,) x, y, z, w must be a non-zero quaternion; it is not tracked yet
         (the orientation stays at ``config.initial_orientation``).
         """
-        position = finite_vector(position, 3, 'ImpedanceRobot.command position')
-        unit_vector(orientation, 4, 'ImpedanceRobot.command orientation')
-        self._target = tuple(position.tolist())
+        target = finite_floats(position, 3, 'ImpedanceRobot.command position')
+        nonzero_floats(orientation, 4, 'ImpedanceRobot.command orientation')
+        self._target = target
 
     def read(self, now: float) -> RobotState:
         """Advance to the last substep at or before ``now`` (s) and return the state there.
 
         The first call starts the clock at ``now``; the clock must not go back.
         """
-        now = finite_number(now, 'ImpedanceRobot.read now')
+        self.advance(now)
+        return self.state()
+
+    def advance(self, now: float) -> None:
+        """Advance to the last substep at or before ``now`` (s) as ``read`` does; return nothing.
+
+        For a caller about to give a new command, which needs the old target applied up to now
+        but not the state, whose arrays cost more than a tick's two substeps.
+        """
+        now = finite_number(now, 'ImpedanceRobot now')
         if self._start is None:
             self._start = now
         elif now < self._time():
-            raise ValueError(f'ImpedanceRobot.read: now {now!r} s is before the last state '
+            raise ValueError(f'ImpedanceRobot: now {now!r} s is before the last state '
                              f'({self._time()!r} s); the clock must not go back')
         target_steps = math.floor((now - self._start) / self._config.step + 1e-9)
-        for _ in range(self._steps_done, target_steps):
-            self._substep()
-        self._steps_done = max(self._steps_done, target_steps)
-        return self.state()
+        if target_steps > self._steps_done:
+            self._run_substeps(target_steps - self._steps_done)
+            self._steps_done = target_steps
 
     def state(self) -> RobotState:
         """Return the state at the last substep, without advancing."""
@@ -185,29 +200,71 @@ class ImpedanceRobot:
     def _time(self) -> float:
         return (self._start or 0.0) + self._steps_done * self._config.step
 
-    def _substep(self) -> None:
-        """One semi-implicit Euler step: speed limited, then the workspace walls stop the TCP."""
+    def _run_substeps(self, steps: int) -> None:
+        """Run ``steps`` semi-implicit Euler steps: speed limited, then the walls stop the TCP.
+
+        The state stays in local floats from one substep to the next: attribute lookups and
+        3-vector arrays would cost more than the arithmetic.
+        """
         config = self._config
         step, mass, stiffness = config.step, config.mass, config.stiffness
-        decay = 1.0 + step * config.damping / mass
-        velocity = [(v + step * (stiffness * (t - p) + f) / mass) / decay for p, v, t, f in zip(
-            self._position, self._velocity, self._target, self._external_force)]
-        speed = math.sqrt(velocity[0] ** 2 + velocity[1] ** 2 + velocity[2] ** 2)
-        if speed > config.max_speed:
-            scale = config.max_speed / speed
-            velocity = [v * scale for v in velocity]
-        position = []
-        for k, (p, (lower, upper)) in enumerate(zip(self._position, self._limits)):
-            p += step * velocity[k]
-            if p <= lower and velocity[k] < 0.0 or p >= upper and velocity[k] > 0.0:
-                velocity[k] = 0.0
-            position.append(min(max(p, lower), upper))
-        self._position, self._velocity = tuple(position), tuple(velocity)
-        self._external_force = self._environment_force()
+        max_speed, decay, force_floats = config.max_speed, self._decay, self._force_floats
+        (x_lower, x_upper), (y_lower, y_upper), (z_lower, z_upper) = self._limits
+        target_x, target_y, target_z = self._target
+        x, y, z = self._position
+        vx, vy, vz = self._velocity
+        fx, fy, fz = self._external_force
+        for _ in range(steps):
+            vx = (vx + step * (stiffness * (target_x - x) + fx) / mass) / decay
+            vy = (vy + step * (stiffness * (target_y - y) + fy) / mass) / decay
+            vz = (vz + step * (stiffness * (target_z - z) + fz) / mass) / decay
+            speed = math.sqrt(vx ** 2 + vy ** 2 + vz ** 2)
+            if speed > max_speed:
+                scale = max_speed / speed
+                vx, vy, vz = vx * scale, vy * scale, vz * scale
+            x, y, z = x + step * vx, y + step * vy, z + step * vz
+            if not (x_lower < x < x_upper and y_lower < y < y_upper and z_lower < z < z_upper):
+                x, vx = _stop_at_walls(x, vx, x_lower, x_upper)
+                y, vy = _stop_at_walls(y, vy, y_lower, y_upper)
+                z, vz = _stop_at_walls(z, vz, z_lower, z_upper)
+            fx, fy, fz = force_floats((x, y, z), (vx, vy, vz))
+        self._position, self._velocity = (x, y, z), (vx, vy, vz)
+        self._external_force = (fx, fy, fz)
 
-    def _environment_force(self) -> tuple:
-        """Return the environment's force at the current state (and for the next substep)."""
-        if self._environment is None:
-            return (0.0, 0.0, 0.0)
-        force = self._environment(np.array(self._position), np.array(self._velocity))
-        return tuple(finite_vector(force, 3, 'environment force').tolist())
+
+def _stop_at_walls(position: float, velocity: float, lower: float, upper: float) -> tuple:
+    """Return ``position`` clamped to [lower, upper] and ``velocity`` along it, zeroed outward."""
+    if position <= lower and velocity < 0.0 or position >= upper and velocity > 0.0:
+        velocity = 0.0
+    return min(max(position, lower), upper), velocity
+
+
+def _no_force(position: tuple, velocity: tuple) -> tuple:
+    """Return free space's force: none."""
+    return (0.0, 0.0, 0.0)
+
+
+def _float_environment(environment: Environment | None) -> Callable[[tuple, tuple], tuple]:
+    """Return ``environment`` as a function of float tuples giving a checked float tuple.
+
+    The substeps call it: an environment with ``force_floats`` (as ``tissue.Tissue``) is called
+    on floats, any other with (3,) arrays, as the ``Environment`` type says.
+    """
+    if environment is None:
+        return _no_force
+    force_floats = getattr(environment, 'force_floats', None)
+    if force_floats is None:
+        def array_force_floats(position: tuple, velocity: tuple) -> tuple:
+            """Call the environment on arrays; check its force and return it as floats."""
+            force = environment(np.array(position), np.array(velocity))
+            return tuple(finite_vector(force, 3, 'environment force').tolist())
+        return array_force_floats
+
+    def checked_force_floats(position: tuple, velocity: tuple) -> tuple:
+        """Call the environment on floats; check its force, as an array environment's."""
+        force = force_floats(position, velocity)
+        fx, fy, fz = force
+        if isfinite(fx) and isfinite(fy) and isfinite(fz):
+            return force
+        raise ValueError(f'environment force must be 3 finite numbers, got {force!r}')
+    return checked_force_floats

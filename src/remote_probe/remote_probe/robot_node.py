@@ -75,7 +75,7 @@ class SimulatedRobotNode(Node):
             self._refused.add(f'target in frame {fields[2]!r}')
             return
         try:
-            self.robot.read(self._now())  # the old target up to now
+            self.robot.advance(self._now())  # the old target up to now
             self.robot.command(fields[3:6], fields[6:10])
         except ValueError as error:  # NaN, a zero quaternion
             self._refused.add('target not finite', str(error))

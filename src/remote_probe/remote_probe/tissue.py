@@ -86,7 +86,12 @@ ABDOMEN = HuntCrossley(stiffness=2000.0, exponent=1.3, damping=1500.0)
 
 
 class Surface(Protocol):
-    """Where a point is against the patient's skin."""
+    """Where a point is against the patient's skin.
+
+    A surface may also offer ``penetration_floats(position)``: the same from a sequence of three
+    floats, with the normal as a tuple of floats (both surfaces here do). ``Tissue.force_floats``
+    calls that, with no arrays.
+    """
 
     def penetration(self, position: np.ndarray) -> tuple[float, np.ndarray]:
         """Return the depth (m, > 0 inside) of ``position`` (3,) and the unit outward normal."""
@@ -98,10 +103,15 @@ class PlaneSurface:
     def __init__(self, point, normal) -> None:
         self.point = finite_vector(point, 3, 'PlaneSurface.point')
         self.normal = unit_vector(normal, 3, 'PlaneSurface.normal')
+        self._normal_floats = tuple(self.normal.tolist())
 
     def penetration(self, position: np.ndarray) -> tuple[float, np.ndarray]:
         """Return the depth below the plane (m) and its normal."""
         return float(np.dot(self.point - position, self.normal)), self.normal
+
+    def penetration_floats(self, position) -> tuple[float, tuple]:
+        """Return the depth below the plane (m) and its normal as floats."""
+        return self.penetration(position)[0], self._normal_floats
 
 
 class SceneSurface:
@@ -111,31 +121,66 @@ class SceneSurface:
     ----------
     scene : collision_engine.Scene
         Any object whose ``query(point)`` returns a signed ``distance`` (negative inside) and a
-        unit outward ``normal``.
+        unit outward ``normal``, both also in its packed ``row`` (distance at 0, normal at 4:7).
     """
 
     def __init__(self, scene) -> None:
         self._scene = scene
+        self._query = scene.query
 
     def penetration(self, position: np.ndarray) -> tuple[float, np.ndarray]:
         """Return the depth inside the nearest object (m) and its outward normal there."""
-        result = self._scene.query(position)
-        return -float(result.distance), np.asarray(result.normal, dtype=np.float64)
+        depth, normal = self.penetration_floats(position)
+        return depth, np.array(normal)
+
+    def penetration_floats(self, position) -> tuple[float, tuple]:
+        """Return the depth inside the nearest object (m) and its outward normal, as floats.
+
+        From the query's packed row: its ``normal`` would be an array made for three floats.
+        """
+        row = self._query(position).row
+        return -row[0], (row[4], row[5], row[6])
+
+
+_NO_FORCE = (0.0, 0.0, 0.0)
 
 
 class Tissue:
     """The force of the patient on the probe's tip: ``law`` along the ``surface``'s normal.
 
-    An ``impedance_robot.Environment``: call it with the tip's position (m) and velocity (m/s).
+    An ``impedance_robot.Environment``: call it with the tip's position (m) and velocity (m/s),
+    or ``force_floats`` with floats. ``law`` and ``surface`` are fixed at construction.
     """
 
     def __init__(self, law: HuntCrossley = ABDOMEN, surface: Surface | None = None) -> None:
-        self.law = law
-        self.surface = surface if surface is not None else PlaneSurface(np.zeros(3), [0, 0, 1])
+        self._law = law
+        self._surface = surface if surface is not None else PlaneSurface(np.zeros(3), [0, 0, 1])
+        self._penetration_floats = getattr(self._surface, 'penetration_floats',
+                                           self._surface.penetration)
+
+    @property
+    def law(self) -> HuntCrossley:
+        """The tissue's force law."""
+        return self._law
+
+    @property
+    def surface(self) -> Surface:
+        """The patient's skin."""
+        return self._surface
 
     def __call__(self, position: np.ndarray, velocity: np.ndarray) -> np.ndarray:
         """Return the force (3,) N on the tip, along the outward normal, zero outside."""
-        depth, normal = self.surface.penetration(position)
+        return np.array(self.force_floats(position, velocity))
+
+    def force_floats(self, position, velocity) -> tuple:
+        """Return the force (N) on the tip as three floats, from three floats of each argument.
+
+        The robot calls this twice a 1 kHz tick: numpy costs more than three floats' arithmetic.
+        """
+        depth, (nx, ny, nz) = self._penetration_floats(position)
         if depth <= 0.0:
-            return np.zeros(3)
-        return self.law.normal_force(depth, -float(np.dot(velocity, normal))) * normal
+            return _NO_FORCE
+        vx, vy, vz = velocity
+        # A plain sum: np.dot (OpenBLAS) fuses the multiply-adds, so it may differ in the last bit.
+        magnitude = self._law.normal_force(depth, -(vx * nx + vy * ny + vz * nz))
+        return magnitude * nx, magnitude * ny, magnitude * nz
