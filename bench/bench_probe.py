@@ -69,8 +69,9 @@ def run(poses: int = 2000) -> list[dict]:
 
         def force(data):
             fields = STATE.decode(data)
-            contact = Contact(fields[5], fields[7:10], fields[10:13], fields[16:19],
-                              fields[3], 0.0, fields[4], _face(fields))
+            contact = Contact.from_floats(fields[5], tuple(fields[7:10]), tuple(fields[10:13]),
+                                          tuple(fields[16:19]), fields[3], 0.0, fields[4],
+                                          _face(fields))
             law.force(contact, (0.0, 0.0, 0.0))
             law.torque(contact)
             law.planes(contact)

@@ -30,6 +30,20 @@ def test_fields_are_read_only_float_arrays():
         contact.distance = 1.0
 
 
+def test_from_floats_is_the_contact_the_constructor_builds():
+    values = (-0.002, (0.1, 0.2, 0.05), (0.0, 0.6, 0.8), (0.1, 0.2, 0.048), 'box', 3.5, 1, None)
+    fast, checked = Contact.from_floats(*values), Contact(*values)
+    for name in ('distance', 'object', 'stamp', 'status', 'face'):
+        assert getattr(fast, name) == getattr(checked, name)
+    for name in ('point', 'normal', 'tip'):
+        vector = getattr(fast, name)
+        np.testing.assert_array_equal(vector, getattr(checked, name))
+        assert vector.dtype == np.float64 and not vector.flags.writeable
+    np.testing.assert_array_equal(fast.penetration, checked.penetration)
+    with pytest.raises(AttributeError):
+        fast.distance = 1.0
+
+
 def test_nan_is_carried_not_rejected():
     contact = Contact(float('nan'), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, np.nan, 0.0))
     assert np.isnan(contact.distance) and np.isnan(contact.tip[1])

@@ -67,3 +67,18 @@ def test_zero_until_two_samples_and_after_reset():
 def test_bad_window_is_rejected(window):
     with pytest.raises(ForceRendererError, match='window'):
         VelocityEstimator(window)
+
+
+def test_samples_added_unread_give_the_estimate_read_at_each_sample():
+    # The loop adds a sample every tick and asks only when no twist came.
+    every, lazy = VelocityEstimator(0.003), VelocityEstimator(0.003)
+    rng = np.random.default_rng(7)
+    stamp = 0.0
+    for k in range(40):
+        stamp += rng.uniform(0.0005, 0.0015)
+        position = tuple(rng.normal(size=3).tolist())
+        expected = every.update_components(stamp, position)
+        lazy.add(stamp, position)
+        if k % 7 == 0:
+            assert lazy.velocity_components() == expected
+    assert lazy.velocity_components() == expected
