@@ -86,15 +86,13 @@ ABDOMEN = HuntCrossley(stiffness=2000.0, exponent=1.3, damping=1500.0)
 
 
 class Surface(Protocol):
-    """Where a point is against the patient's skin.
-
-    A surface may also offer ``penetration_floats(position)``: the same from a sequence of three
-    floats, with the normal as a tuple of floats (both surfaces here do). ``Tissue.force_floats``
-    calls that, with no arrays.
-    """
+    """Where a point is against the patient's skin."""
 
     def penetration(self, position: np.ndarray) -> tuple[float, np.ndarray]:
         """Return the depth (m, > 0 inside) of ``position`` (3,) and the unit outward normal."""
+
+    def penetration_floats(self, position) -> tuple[float, tuple]:
+        """Return ``penetration`` from three floats, the normal as floats: the robot's substeps."""
 
 
 class PlaneSurface:
@@ -149,24 +147,12 @@ class Tissue:
     """The force of the patient on the probe's tip: ``law`` along the ``surface``'s normal.
 
     An ``impedance_robot.Environment``: call it with the tip's position (m) and velocity (m/s),
-    or ``force_floats`` with floats. ``law`` and ``surface`` are fixed at construction.
+    or ``force_floats`` with floats.
     """
 
     def __init__(self, law: HuntCrossley = ABDOMEN, surface: Surface | None = None) -> None:
-        self._law = law
-        self._surface = surface if surface is not None else PlaneSurface(np.zeros(3), [0, 0, 1])
-        self._penetration_floats = getattr(self._surface, 'penetration_floats',
-                                           self._surface.penetration)
-
-    @property
-    def law(self) -> HuntCrossley:
-        """The tissue's force law."""
-        return self._law
-
-    @property
-    def surface(self) -> Surface:
-        """The patient's skin."""
-        return self._surface
+        self.law = law
+        self.surface = surface if surface is not None else PlaneSurface(np.zeros(3), [0, 0, 1])
 
     def __call__(self, position: np.ndarray, velocity: np.ndarray) -> np.ndarray:
         """Return the force (3,) N on the tip, along the outward normal, zero outside."""
@@ -177,10 +163,10 @@ class Tissue:
 
         The robot calls this twice a 1 kHz tick: numpy costs more than three floats' arithmetic.
         """
-        depth, (nx, ny, nz) = self._penetration_floats(position)
+        depth, (nx, ny, nz) = self.surface.penetration_floats(position)
         if depth <= 0.0:
             return _NO_FORCE
         vx, vy, vz = velocity
         # A plain sum: np.dot (OpenBLAS) fuses the multiply-adds, so it may differ in the last bit.
-        magnitude = self._law.normal_force(depth, -(vx * nx + vy * ny + vz * nz))
+        magnitude = self.law.normal_force(depth, -(vx * nx + vy * ny + vz * nz))
         return magnitude * nx, magnitude * ny, magnitude * nz
