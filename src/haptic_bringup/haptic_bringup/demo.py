@@ -1,11 +1,12 @@
 """The main job: the simulated wand taps the paper's objects over ROS 2, recorded and summarised.
 
     demo [--experiments cuboid cylinder hand cuboid-no-force probe-flat probe-phantom teleop]
-         [--composed] [--out build/demo]
+         [--separate] [--out build/demo]
 
-For each experiment it launches the loop (driver, collision engine, force renderer and a
-recorder), lets the scripted operator tap for 10 s, stops, reads the bag back and prints one
-line per contact: depth, mean force per axis, and how far the force pointed from the normal.
+For each experiment it launches the loop (driver, collision engine and force renderer in one
+process, as ``haptic_loop`` does; in three with ``--separate``) and a recorder, lets the scripted
+operator tap for 10 s, stops, reads the bag back and prints one line per contact: depth, mean force
+per axis, and how far the force pointed from the normal.
 ``cuboid-no-force`` is the control: the same taps with the force held at zero, to show how deep
 the operator's hand would go if nothing pushed back. ``probe-flat`` and ``probe-phantom`` sweep
 a linear probe (a 10 x 40 mm face) rolled and yawed +-20 degrees on a flat slab and on the
@@ -49,7 +50,7 @@ TELEOP_SCHEME = 'model'
 FORCE_SCALE = 0.3  # the leader's default
 
 
-def run_experiment(name: str, out: pathlib.Path, *, composed: bool = False,
+def run_experiment(name: str, out: pathlib.Path, *, composed: bool = True,
                    duration: float = DURATION, domain_id: int = 42) -> dict:
     """Run one experiment over ROS 2 and return where its bag and loop statistics are."""
     run = out / name
@@ -126,7 +127,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog='demo', description=__doc__.split('\n\n')[0])
     parser.add_argument('--experiments', nargs='+', choices=[*EXPERIMENTS, TELEOP],
                         default=[*EXPERIMENTS, TELEOP])
-    parser.add_argument('--composed', action='store_true', help='one process for the loop')
+    parser.add_argument('--separate', action='store_true',
+                        help='three processes for the loop (default: one, as haptic_loop)')
     parser.add_argument('--out', default='build/demo', type=pathlib.Path)
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
@@ -142,7 +144,7 @@ def main(argv=None) -> int:
                       flush=True)
                 continue
             print(f'[demo] {name}: tapping for {DURATION:g} s over ROS 2 ...', flush=True)
-            files = run_experiment(name, args.out, composed=args.composed,
+            files = run_experiment(name, args.out, composed=not args.separate,
                                    domain_id=args.domain_id)
         except RuntimeError as error:
             print(f'[demo] {error}', file=sys.stderr)

@@ -1,13 +1,17 @@
 """The local launcher: the haptic loop without ros2cli or launch (PyPI installs).
 
-    haptic_loop [--composed] [--scene SCENE] [--experiment NAME] [--duration S] [--record DIR]
+    haptic_loop [--separate] [--scene SCENE] [--experiment NAME] [--duration S] [--record DIR]
     haptic_loop --teleop SCHEME [--delay S] [--jitter S] [--loss P] [--record DIR]
 
-starts the wand driver, the collision engine and the force renderer as three processes (or, with
-``--composed``, as one process on one executor), with local-only DDS discovery, a domain id, and
-ROS logs under ``build/``. It waits for the loop's topics to be discovered, runs until the
-driver's experiment ends, ``--duration`` passes or Ctrl-C, then stops every process (the
-recorder last) and removes stale shared memory. On a full ROS 2 install,
+starts the wand driver, the collision engine and the force renderer in one process on one
+executor, their 1 kHz streams handed over in the process (``haptic_bringup.composed``): on two
+cores, the layout that holds the loop's CPU budget with a recorder and an outside client, as
+Nav2's bring-up composes its nodes by default. ``--separate`` starts them as three processes, as
+``ros2 run`` would: to watch one node's CPU, or to run one elsewhere, at a cost in CPU that
+``docs/cpu_budget.md`` gives. It sets local-only DDS discovery, a domain id, and ROS logs under
+``build/``. It waits for the loop's topics to be discovered, runs until the driver's experiment
+ends, ``--duration`` passes or Ctrl-C, then stops every process (the recorder last) and removes
+stale shared memory. On a full ROS 2 install,
 ``ros2 launch haptic_bringup haptic_loop.launch.py`` does the same.
 
 With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
@@ -72,7 +76,7 @@ class LoopConfig:
     """What to run. ``nodes`` may leave some out (a test may stand in for the driver)."""
 
     nodes: tuple = tuple(NODES)
-    composed: bool = False
+    composed: bool = False  # haptic_loop's default is True; tests run each node on its own
     intra_process: bool = True  # composed: the nodes' streams handed over in the process
     scene: Optional[str] = None
     experiment: Optional[str] = None
@@ -370,8 +374,8 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
         prog='haptic_loop', description=__doc__.split('\n\n')[0],
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('--composed', action='store_true',
-                        help='run the three nodes in one process on one executor')
+    parser.add_argument('--separate', action='store_true',
+                        help='run the three nodes as three processes (default: one process)')
     parser.add_argument('--scene', help='scene YAML (path or package://pkg/path)')
     parser.add_argument('--experiment', help='simulated operator script: cuboid, cylinder, '
                         'hand, hold, or a waypoint file')
@@ -409,7 +413,7 @@ def link_parameters(args: argparse.Namespace) -> dict:
 
 def main(argv=None) -> int:
     args = parse_args(argv)
-    config = LoopConfig(composed=args.composed, scene=args.scene, experiment=args.experiment,
+    config = LoopConfig(composed=not args.separate, scene=args.scene, experiment=args.experiment,
                         duration=args.duration, record=args.record, domain_id=args.domain_id,
                         params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
                         teleop=args.teleop, link=link_parameters(args),

@@ -3,9 +3,10 @@
     ros2 launch haptic_bringup haptic_loop.launch.py [scene:=...] [experiment:=...]
 
 Arguments: ``scene:=<path or package://...>``, ``experiment:=cuboid|cylinder|hand|hold|<file>``,
-``composed:=true`` (one process), ``record:=<bag dir>`` (rosbag2 mcap via ``ros2 bag record``),
-``params_file:=<yaml>`` (overrides on top of each package's config/). The local launcher
-(``haptic_loop``) does the same where launch and ros2cli are not installed.
+``composed:=false`` (three processes; by default one, whose nodes hand their streams to each
+other in it: the layout that fits two cores), ``record:=<bag dir>`` (rosbag2 mcap via
+``ros2 bag record``), ``params_file:=<yaml>`` (overrides on top of each package's config/). The
+local launcher (``haptic_loop``) does the same where launch and ros2cli are not installed.
 
 DDS discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``) unless the user
 exported another range. The loop is all or nothing: when one of its nodes exits, the launch
@@ -85,8 +86,8 @@ def generate_launch_description() -> LaunchDescription:
                               description='scene YAML (default: each package config)'),
         DeclareLaunchArgument('experiment', default_value='',
                               description='cuboid | cylinder | hand | hold | waypoint file'),
-        DeclareLaunchArgument('composed', default_value='false',
-                              description='run the three nodes in one process'),
+        DeclareLaunchArgument('composed', default_value='true',
+                              description='run the three nodes in one process (false: three)'),
         DeclareLaunchArgument('record', default_value='',
                               description='record the loop to this rosbag2 directory'),
         DeclareLaunchArgument('params_file', default_value='',
