@@ -60,15 +60,15 @@ def _random_plane(rng, tip):
     return tuple(map(tuple, (point, normal, stiffness, damping, tool_point)))
 
 
-def _give(law: LocalRenderer, rng, tip, now: float) -> None:
-    """Hand the law what the loop might: a model, a held wrench, or nothing."""
+def _give(law: LocalRenderer, rng, tip, now: float, since: float = -math.inf) -> None:
+    """Hand the law what the loop might, from ``since``: a model, a held wrench, or nothing."""
     choice = rng.random()
     deadline = now + rng.choice([0.0004, 0.0011, 0.003, math.inf])
     if choice < 0.1:
-        law.clear()
+        law.clear(since)
     elif choice < 0.25:
         law.take_wrench(rng.uniform(-12.0, 12.0, size=3), rng.uniform(-0.5, 0.5, size=3),
-                        deadline)
+                        deadline, since)
     else:
         count = int(rng.integers(0, 4))
         kind = Kind.PLANES if count else Kind.FREE
@@ -76,18 +76,25 @@ def _give(law: LocalRenderer, rng, tip, now: float) -> None:
         model = ContactModel.from_fields(
             fields(planes, kind=kind, limit=float(rng.uniform(3.0, 12.0)),
                    radius=float(rng.choice([0.0005, 0.002, 0.05])), tip=tuple(tip)), 'world')
-        law.take(model, deadline)
+        law.take(model, deadline, since)
+
+
+def _wand(law, hand: bool = True) -> SimulatedWand:
+    config = SimulatedWandConfig(initial_position=np.array([0.0, 0.0, 0.004]), initial_roll=0.1)
+    wand = SimulatedWand(config, operator=OperatorHand(_Sweep()) if hand else None)
+    wand.render_locally(law)
+    return wand
+
+
+def _row(wand: SimulatedWand, state, law: LocalRenderer) -> tuple:
+    force, torque = wand.applied()
+    return (*state.position, state.roll, state.yaw, *state.linear_velocity, state.roll_rate,
+            state.yaw_rate, *force, *torque, law.passivity.energy, law.passivity.net_work)
 
 
 def _run(seed: int, ratio: float, hand: bool):
-    config = SimulatedWandConfig(initial_position=np.array([0.0, 0.0, 0.004]), initial_roll=0.1)
-    wands, laws = [], []
-    for wrap in (False, True):
-        law = _renderer(ratio)
-        wand = SimulatedWand(config, operator=OperatorHand(_Sweep()) if hand else None)
-        wand.render_locally(_Python(law) if wrap else law)
-        wands.append(wand)
-        laws.append(law)
+    laws = [_renderer(ratio), _renderer(ratio)]
+    wands = [_wand(laws[0], hand), _wand(_Python(laws[1]), hand)]
     assert wands[0]._compiled is not None and wands[1]._compiled is None  # the two paths
     rng = np.random.default_rng(seed)
     rows = [[], []]
@@ -95,14 +102,13 @@ def _run(seed: int, ratio: float, hand: bool):
         now = tick * TICK + rng.uniform(0.0, 0.0006)  # reads at jittered instants
         states = [wand.read(now) for wand in wands]
         tip = states[0].position.tolist()
+        # From the next period, or from one up to 0.3 ms later (before the next read).
+        since = -math.inf if rng.random() < 0.5 else now + rng.uniform(0.0, 0.0003)
         draw = rng.bit_generator.state
         for law, row, wand, state in zip(laws, rows, wands, states):
             rng.bit_generator.state = draw  # the same model for both
-            _give(law, rng, tip, now)
-            force, torque = wand.applied()
-            row.append((*state.position, state.roll, state.yaw, *state.linear_velocity,
-                        state.roll_rate, state.yaw_rate, *force, *torque,
-                        law.passivity.energy, law.passivity.net_work))
+            _give(law, rng, tip, now, since)
+            row.append(_row(wand, state, law))
     return np.array(rows), [wand.force_edges for wand in wands]
 
 
@@ -123,3 +129,31 @@ def test_the_runs_compared_press_rotate_saturate_and_wake_the_passivity():
     assert np.linalg.norm(torque, axis=1).max() > 0.0
     assert np.linalg.norm(force, axis=1).max() > 7.9  # at the renderer's limits
     assert np.abs(compiled[:, 16]).max() > 0.0  # the passivity's books moved
+
+
+@pytest.mark.parametrize('seed', range(3))
+def test_a_law_taken_at_an_instant_switches_where_advancing_the_wand_to_it_first_would(seed):
+    """What the driver does instead of reading the wand at every answer: the same floats.
+
+    A third wand takes each law at once, with no instant and no read: it renders it from its
+    last read on, too early, and must differ.
+    """
+    laws = [_renderer(1.0) for _ in range(3)]
+    wands = [_wand(law) for law in laws]
+    rng = np.random.default_rng(seed)
+    rows = [[], [], []]
+    for tick in range(TICKS):
+        now = tick * TICK
+        states = [wand.read(now) for wand in wands]
+        for row, wand, state, law in zip(rows, wands, states, laws):
+            row.append(_row(wand, state, law))
+        arrival = now + rng.uniform(0.0, 0.00095)
+        wands[0].read(arrival)  # up to the arrival with the law it held
+        draw = rng.bit_generator.state
+        for law, since in zip(laws, (-math.inf, arrival, -math.inf)):
+            rng.bit_generator.state = draw  # the same law for all three
+            _give(law, rng, states[0].position.tolist(), arrival, since)
+    advanced, taken_at, early = map(np.array, rows)
+    assert np.array_equal(taken_at, advanced)
+    assert wands[1].force_edges == wands[0].force_edges
+    assert not np.array_equal(early, advanced)

@@ -19,16 +19,23 @@ pushes, it adds ``contact_damping_ratio`` × 2 sqrt(K_n m_n) (1: critical), capp
 rigid surface, and energy only ever taken out. It is taken off the plane's force already saturated
 to the limit, so a wall pressed past its force limit still takes energy out on the way back.
 
+A model renders from the servo period that holds its ``since`` (the device's clock when it
+arrived), and what was held before renders the periods until then: so a device that runs its
+periods after the fact (the simulated wand, on each read) switches where a real one would,
+without being advanced at every arrival. One ``take`` at a time: a device must have run the
+period of the last ``since`` before the next ``take``, or that model is never rendered.
+
 Thread safety: ``take`` swaps one tuple, which a servo thread reads whole; the passivity books are
 the servo thread's alone.
 
-``packed`` is the same law as floats for the simulated wand's compiled servo loop
-(``servo_loop``, run in the thread that calls ``take``: the packing is not atomic), rewritten by
-every ``take``, ``take_wrench`` or ``clear``: the force and torque limits, the contact damping
-ratio, the mass (3); the mode (``MODE_*``), the deadline, the model's force limit, valid radius
-and tip (3), the held wrench (6), the plane count, the damping cap per mass and period
-(``MAX_DAMPING_PER_MASS``); from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point,
-normal, stiffness, damping, tool point).
+``packed`` is the same as floats for the simulated wand's compiled servo loop (``servo_loop``,
+run in the thread that calls ``take``: the packing is not atomic), rewritten by every ``take``,
+``take_wrench`` or ``clear``: row 0 the law from its ``since`` on, row 1 the one before. A row:
+the force and torque limits, the contact damping ratio, the mass (3); the mode (``MODE_*``), the
+deadline, the model's force limit, valid radius and tip (3), the held wrench (6), the plane
+count, the damping cap per mass and period (``MAX_DAMPING_PER_MASS``), ``since``; from
+``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point, normal, stiffness, damping, tool
+point).
 """
 import math
 from typing import Sequence
@@ -41,13 +48,14 @@ from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.wrench_input import saturate_components
 
 __all__ = ['LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE', 'MODE_PLANES',
-           'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT']
+           'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SINCE']
 
 _ZERO = (0.0, 0.0, 0.0)
 MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
 MODE_NONE, MODE_WRENCH, MODE_PLANES = 0.0, 1.0, 2.0  # what ``packed`` holds
-PLANES_AT, PLANE_SIZE = 21, 15
+SINCE, PLANES_AT, PLANE_SIZE = 21, 22, 15
 LAW_SIZE = PLANES_AT + MAX_PLANES * PLANE_SIZE
+_NOTHING = (None, None, -math.inf)  # (model, wrench, deadline) held
 
 
 class LocalRenderer:
@@ -73,33 +81,38 @@ class LocalRenderer:
         self.passivity = passivity
         self.mass = tuple(mass)
         self.contact_damping_ratio = contact_damping_ratio
-        self.packed = np.zeros(LAW_SIZE)  # (servo_loop's layout)
+        self.packed = np.zeros((2, LAW_SIZE))  # (servo_loop's layout)
+        self._held = (_NOTHING, _NOTHING, -math.inf)  # before since, from since, since
         self.clear()
 
-    def take(self, model: ContactModel, deadline: float) -> None:
-        """Render ``model`` from now until ``deadline`` (s, the device's clock)."""
-        self._held = (model, None, deadline)
+    def take(self, model: ContactModel, deadline: float, since: float = -math.inf) -> None:
+        """Render ``model`` until ``deadline``, from the servo period holding ``since``.
+
+        Both are the device's clock (s); ``since`` defaults to the next period.
+        """
         mode = MODE_PLANES if model.kind == Kind.PLANES else MODE_NONE
         planes = [value for plane in model.planes for vector in plane for value in vector]
-        self._pack(mode, deadline, model.force_limit, model.valid_radius, model.tip, _ZERO * 2,
-                   len(model.planes), planes)
+        self._hold((model, None, deadline), since, mode, model.force_limit, model.valid_radius,
+                   model.tip, _ZERO * 2, len(model.planes), planes)
 
-    def take_wrench(self, force, torque, deadline: float) -> None:
-        """Render a fixed wrench until ``deadline``: for a law that has no model to send."""
-        self._held = (None, (tuple(force), tuple(torque)), deadline)
-        self._pack(MODE_WRENCH, deadline, 0.0, 0.0, _ZERO, (*force, *torque), 0, [])
+    def take_wrench(self, force, torque, deadline: float, since: float = -math.inf) -> None:
+        """Render a fixed wrench as ``take`` a model: for a law that has no model to send."""
+        self._hold((None, (tuple(force), tuple(torque)), deadline), since, MODE_WRENCH, 0.0, 0.0,
+                   _ZERO, (*force, *torque), 0, [])
 
-    def clear(self) -> None:
-        """Drop what is held: zero force until the next model or wrench."""
-        self._held = (None, None, -math.inf)
-        self._pack(MODE_NONE, -math.inf, 0.0, 0.0, _ZERO, _ZERO * 2, 0, [])
+    def clear(self, since: float = -math.inf) -> None:
+        """Drop what is held, as ``take``: zero force until the next model or wrench."""
+        self._hold(_NOTHING, since, MODE_NONE, 0.0, 0.0, _ZERO, _ZERO * 2, 0, [])
 
-    def _pack(self, mode, deadline, force_limit, valid_radius, tip, wrench, count,
-              planes) -> None:
-        self.packed[:PLANES_AT + len(planes)] = (
+    def _hold(self, held: tuple, since: float, mode, force_limit, valid_radius, tip, wrench,
+              count, planes) -> None:
+        """Hold ``held`` from ``since`` on, and what was held before until then."""
+        self.packed[1] = self.packed[0]
+        self.packed[0, :PLANES_AT + len(planes)] = (
             self.force_limit, self.torque_limit, self.contact_damping_ratio, *self.mass, mode,
-            deadline, force_limit, valid_radius, *tip, *wrench, count, MAX_DAMPING_PER_MASS,
-            *planes)
+            held[2], force_limit, valid_radius, *tip, *wrench, count, MAX_DAMPING_PER_MASS,
+            since, *planes)
+        self._held = (self._held[1], held, since)
 
     def wrench(self, time: float, coordinates: Sequence[float], rates: Sequence[float],
                period: float) -> tuple[tuple, tuple]:
@@ -108,7 +121,8 @@ class LocalRenderer:
         ``time`` is the device's clock (s); ``coordinates`` and ``rates`` the joints (x, y, z,
         roll, yaw) and their rates; ``period`` the servo period (s).
         """
-        model, wrench, deadline = self._held
+        before, held, since = self._held
+        model, wrench, deadline = held if time + period > since else before
         position, velocity = coordinates[:3], rates[:3]
         force, torque = _ZERO, _ZERO
         limit = self.force_limit

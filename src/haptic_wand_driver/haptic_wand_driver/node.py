@@ -81,6 +81,7 @@ class WandDriverNode(Node):
         self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
         self.renderer = self._local_renderer() if params.rendering == 'local' else None
         self._model_stamp = -math.inf  # of the newest model taken
+        self._since = -math.inf  # the device's clock when the renderer last switched
         self._period = 1.0 / params.rate
         self._phase = Phase.WAITING
         self._state = None
@@ -258,18 +259,32 @@ class WandDriverNode(Node):
             model = ContactModel.from_fields(fields, self.params.frame_id)
         except ModelRefused as refusal:
             self._refused.add(f'model: {refusal.field}', refusal)
-            self.renderer.clear()
+            self.renderer.clear(self._arrival())
             return
         if model.stamp < self._model_stamp:
             self._refused.add('model older than the held one')
             return
         self._model_stamp = model.stamp
-        self._state = self.device.read(self._device_time())  # up to now: the old model
+        since = self._arrival()
         deadline = model.stamp + model.valid_for - self._ros_minus_device()
         if model.kind == Kind.UNAVAILABLE:
-            self.renderer.take_wrench(model.held_wrench[:3], model.held_wrench[3:], deadline)
+            self.renderer.take_wrench(model.held_wrench[:3], model.held_wrench[3:], deadline,
+                                      since)
         else:
-            self.renderer.take(model, deadline)
+            self.renderer.take(model, deadline, since)
+
+    def _arrival(self) -> float:
+        """Return the device's clock now, for the renderer to switch at.
+
+        The renderer holds one switch at a time, so a device yet to run the period of the last
+        one (the simulated wand runs its periods on each read) is advanced to now first: only
+        when two answers arrive between ticks, no longer at every arrival.
+        """
+        now = self._device_time()
+        if self._since >= self._state.time:
+            self._state = self.device.read(now)
+        self._since = now
+        return now
 
     def _answered(self, stamp_ns: int, now_ns: int) -> bool:
         """Count an answer to the pose stamped ``stamp_ns``; return whether the device uses it.

@@ -10,8 +10,8 @@ The module is self-contained (numba caches a kernel by its own file, so a kernel
 call one elsewhere), and imported only by a wand given such a law, which calls ``compile_now``
 before its loop starts. Its inputs, float64 arrays:
 
-* ``law``: the renderer's settings and what it holds (``LocalRenderer.packed``, whose layout
-  ``local_rendering`` defines);
+* ``packed`` (2, n): the renderer's settings and what it holds, from a period on and before it
+  (``LocalRenderer.packed``, whose layout ``local_rendering`` defines);
 * ``books``: the port's passivity (``PortPassivity.books``);
 * ``joints`` (5, 6): per joint, the hand's stiffness and damping, the inverse inertia, the
   damping decay per period and the workspace stops (lower, upper);
@@ -23,7 +23,7 @@ from numba import njit
 import numpy as np
 
 from haptic_wand_driver.local_rendering import (LAW_SIZE, MODE_PLANES, MODE_WRENCH, PLANE_SIZE,
-                                                PLANES_AT)
+                                                PLANES_AT, SINCE)
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
 
 __all__ = ['advance', 'compile_now']
@@ -132,8 +132,9 @@ def _passive(books, fx, fy, fz, coordinates, rates, period):
 
 
 @njit(cache=True, nogil=True)
-def _law_wrench(law, books, time, coordinates, rates, period):
+def _law_wrench(packed, books, time, coordinates, rates, period):
     """Return what ``LocalRenderer.wrench`` renders this period: force and torque, saturated."""
+    law = packed[0] if time + period > packed[0, SINCE] else packed[1]
     fx = fy = fz = tx = ty = tz = 0.0
     limit = law[0]
     mode, live = law[6], time + period <= law[7]
@@ -152,7 +153,7 @@ def _law_wrench(law, books, time, coordinates, rates, period):
 
 
 @njit(cache=True, nogil=True)
-def advance(coordinates, rates, joints, targets, law, books, force_limit, torque_limit, start,
+def advance(coordinates, rates, joints, targets, packed, books, force_limit, torque_limit, start,
             first, step, rendered, edges, pushing):
     """Run ``len(targets)`` servo periods from period ``first``, in place.
 
@@ -162,7 +163,7 @@ def advance(coordinates, rates, joints, targets, law, books, force_limit, torque
     written = 0
     for k in range(targets.shape[0]):
         done = first + k
-        fx, fy, fz, tx, ty, tz = _law_wrench(law, books, start + done * step, coordinates,
+        fx, fy, fz, tx, ty, tz = _law_wrench(packed, books, start + done * step, coordinates,
                                              rates, step)
         fx, fy, fz = _saturate(fx, fy, fz, force_limit)
         tx, ty, tz = _saturate(tx, ty, tz, torque_limit)
@@ -202,5 +203,6 @@ def advance(coordinates, rates, joints, targets, law, books, force_limit, torque
 
 def compile_now() -> None:
     """Compile ``advance`` for the types the wand passes (or load it from numba's cache)."""
-    advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)), np.zeros(LAW_SIZE),
+    advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)),
+            np.zeros((2, LAW_SIZE)),
             np.zeros(11), 1.0, 1.0, 0.0, 0, 1.0, np.zeros(6), np.empty(0, dtype=np.int64), False)
