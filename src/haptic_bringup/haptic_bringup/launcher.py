@@ -56,12 +56,14 @@ SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 BRIDGE_MODULE = 'remote_probe.bridge'
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
-# What crosses the link is recorded where it arrives (its sent copy is the same message, earlier;
-# recording both cost the recorder two more 1 kHz streams).
-OPERATOR_RECORDED = ('/wand/pose', '/wand/twist', '/wand/applied_wrench', '/teleop/feedback',
-                     '/diagnostics')
-REMOTE_RECORDED = ('/robot/target_pose', '/robot/tcp_pose', '/robot/ft_sensor/wrench',
-                   '/teleop/command', '/diagnostics')
+# A session's bag holds what each site measured and what crossed the link, recorded where it
+# arrives (its sent copy is the same message, earlier). Left out, each one step from those and
+# read by no analysis: the wand's twist (the pose's rate), the leader's answer to its driver (the
+# feedback through the leader) and the robot's target (the command through the patient-safety
+# filter). Each 1 kHz stream recorded costs its writer and the recorder about 5 % of a core
+# (docs/cpu_budget.md), on two cores that hold both sites.
+OPERATOR_RECORDED = ('/wand/pose', '/wand/applied_wrench', '/teleop/feedback', '/diagnostics')
+REMOTE_RECORDED = ('/robot/tcp_pose', '/robot/ft_sensor/wrench', '/teleop/command', '/diagnostics')
 COMPOSED_MODULE = 'haptic_bringup.composed'
 NO_INTRA_PROCESS = '--no-intra-process'  # the composed process's streams through DDS
 RECORDER_MODULE = 'haptic_bringup.recorder'
@@ -173,8 +175,7 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     for node in ('teleop_leader', 'teleop_follower'):
         options.setdefault(node, {})['scheme'] = scheme
     if config.record:
-        answer = '/wand/contact_model' if scheme == 'model' else '/wand/wrench'
-        options['recorder'].update(topics=[*OPERATOR_RECORDED, answer],
+        options['recorder'].update(topics=list(OPERATOR_RECORDED),
                                    remote_domain=config.remote_domain_id,
                                    remote_topics=list(REMOTE_RECORDED))
 
@@ -199,7 +200,7 @@ def teleop_endpoints(config: LoopConfig) -> dict:
                            '/teleop/feedback': (1, 1 + recording)},
         config.remote_domain_id: {'/teleop/command': (1, 1 + recording),
                                   '/teleop/feedback': (1, 1),
-                                  '/robot/target_pose': (1, site + recording),
+                                  '/robot/target_pose': (1, site),
                                   '/robot/tcp_pose': (1, site + recording),
                                   '/robot/ft_sensor/wrench': (1, site + recording)},
     }
