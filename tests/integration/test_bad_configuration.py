@@ -128,13 +128,15 @@ def test_driver_refuses_a_missing_replay_file(tmp_path):
     assert 'run.csv' in line
 
 
-def test_the_launcher_stops_a_partial_loop_and_fails(tmp_path):
+@pytest.mark.parametrize('flags, failed', [([], 'composed'), (['--separate'], 'wand_driver')],
+                         ids=['composed', 'separate'])
+def test_the_launcher_stops_a_partial_loop_and_fails(tmp_path, flags, failed):
     """A node that cannot start takes the loop down with it: no idle half-loop, exit 1."""
     result = subprocess.run(
-        [sys.executable, '-m', 'haptic_bringup.launcher', '--experiment', 'cubiod',
+        [sys.executable, '-m', 'haptic_bringup.launcher', *flags, '--experiment', 'cubiod',
          '--domain-id', '99', '--run-dir', str(tmp_path)],
         env=loop_environment(99, tmp_path / 'log'), capture_output=True, text=True, timeout=180)
     assert result.returncode == 1, result.stderr
     assert "error: wand_driver: experiment 'cubiod'" in result.stderr
-    assert 'wand_driver exited with code 2' in result.stderr
+    assert f'{failed} exited with code 2' in result.stderr
     assert 'Traceback' not in result.stderr, result.stderr
