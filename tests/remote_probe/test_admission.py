@@ -46,6 +46,14 @@ def test_a_repeat_or_an_older_message_is_not_taken():
         'not newer than the last taken'
 
 
+def test_a_sequence_number_far_ahead_of_its_stamp_is_refused_and_moves_nothing():
+    admission = Admission()
+    stream(admission, 0.0, 100)
+    assert admission.admit(0.15, SESSION, 2**63, 0.1 + OFFSET).kind == \
+        'sequence ahead of its stamp'
+    assert stream(admission, 0.1, 10, first=101) == [None] * 10
+
+
 @pytest.mark.parametrize('session', [0])
 def test_a_message_of_no_session_is_refused(session):
     assert Admission().admit(0.0, session, 1, 0.0).kind == 'no session'

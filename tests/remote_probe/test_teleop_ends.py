@@ -25,9 +25,9 @@ def feedback(stamp, force=(0.0, 0.0, 5.0), *, echo=0.0, hold=0.0, energy=0.0, pl
 
 
 def command(stamp, position=(0.0, 0.0, 0.0)):
-    """A command numbered by its stamp, in the microseconds (so later ones are newer)."""
+    """A command numbered by its stamp, in the milliseconds (so later ones are newer)."""
     return Command(stamp, np.array(position), np.zeros(3), 0.0, OPERATOR,
-                   round(stamp * 1e6) + 1)
+                   round(stamp * 1000) + 1)
 
 
 def follower(scheme='direct', **safety):
@@ -238,3 +238,52 @@ def test_the_plane_sent_has_the_tissue_in_series_with_the_robots_spring():
     assert plane.stiffness == pytest.approx(700.0 * 1500.0 / 2200.0, rel=0.02)
     assert plane.point[2] == pytest.approx(-0.01, abs=2e-4)
     np.testing.assert_allclose(plane.normal, UP, atol=1e-3)
+
+
+def test_the_shift_a_silence_left_is_given_back_at_the_rejoin_speed_and_then_updates_are_passive():
+    """Silent, the hand sank 30 mm into a patient nothing resisted; the model comes back shown
+    at the wand (no jolt), then the plane returns to the estimate at the rejoin speed, and the
+    robot's target with it, until they meet."""
+    config = LeaderConfig('model', force_scale=1.0, position_scale=1.0, rejoin_speed=0.03)
+    leader = Leader(config, np.zeros(3), np.zeros(3))
+    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
+    leader.receive(0.0, feedback(1.0, plane=skin))
+    assert leader.plane(0.001, np.array([0.0, 0.0, -0.005])) is not None  # above the skin
+    assert leader.plane(0.5, np.zeros(3)) is None  # silent
+    deep = np.array([0.0, 0.0, -0.04])
+    heights = []
+    for k in range(1500):
+        now = 1.0 + 0.001 * k
+        if k % 10 == 0:  # the model's feedback at 100 Hz
+            leader.receive(now, feedback(now + 1.0, plane=skin))
+        heights.append(leader.plane(now, deep).point[2])
+    assert heights[0] == pytest.approx(-0.04)  # shown at the wand: nothing felt at once
+    steps = np.diff(heights)
+    assert np.all(steps >= -1e-12) and steps.max() <= 0.03 * 0.001 + 1e-12
+    assert heights[-1] == pytest.approx(-0.01)  # back at the estimate, after 1 s
+    target = leader.command(2.495, deep, np.zeros(3)).position
+    np.testing.assert_allclose(target, deep)  # the robot's target met the wand
+    leader.receive(2.5, feedback(3.5, plane=RemotePlane(np.array([0.0, 0.0, 0.01]), UP,
+                                                        400.0, 0.0)))
+    again = leader.plane(2.501, deep)
+    assert stored(again, deep) <= stored(RemotePlane(np.array([0.0, 0.0, -0.01]), UP,
+                                                     400.0, 0.0), deep) + 1e-12  # passive
+
+
+def test_a_command_of_another_session_or_out_of_the_robots_reach_is_refused_and_changes_nothing():
+    end = follower('tdpa')
+    assert end.receive(0.0, command(1.0, [0.0, 0.0, -0.01])) is None
+    stranger = command(1.001, [0.0, 0.0, -0.3])._replace(session=OPERATOR + 1)
+    assert end.receive(0.001, stranger).kind == 'another session'
+    assert end.receive(0.002, command(1.002, [0.0, 0.0, -0.5])).kind == 'outside the workspace'
+    absurd = command(1.003)._replace(velocity=np.array([-1.7e308, 0.0, 0.0]))
+    assert end.receive(0.003, absurd).kind == 'faster than a hand'
+    assert end.receive(0.004, command(1.004)._replace(energy_in=-1.0)).kind == \
+        'negative energy'
+    nan = command(1.005)._replace(position=np.array([0.0, np.nan, 0.0]))
+    assert end.receive(0.005, nan).kind == 'not finite'
+    target = end.target(0.006, np.zeros(3), np.zeros(3), np.zeros(3), 1e-3)
+    np.testing.assert_allclose(target, [0.0, 0.0, -1e-3 * 0.0], atol=0.011)
+    sent = end.feedback(0.007)
+    assert np.isfinite(sent.energy_in) and sent.echo == 1.0 and sent.echo_sequence == \
+        command(1.0).sequence

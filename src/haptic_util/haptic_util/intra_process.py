@@ -29,6 +29,7 @@ from typing import Callable, Sequence
 
 from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.node import Node
+from rclpy.qos import QoSProfile
 
 from haptic_util.callback_errors import log_callback_error
 from haptic_util.cdr import MalformedMessage, MessageCodec
@@ -129,7 +130,8 @@ class StreamSubscription:
     """
 
     def __init__(self, node: Node, codec: MessageCodec, topic: str,
-                 callback: Callable[[Sequence], None], *, refused: Tally) -> None:
+                 callback: Callable[[Sequence], None], *, refused: Tally,
+                 qos: QoSProfile = HAPTIC_STREAM_QOS) -> None:
         self.callback = callback
         self._codec = codec
         self._refused = refused
@@ -140,8 +142,8 @@ class StreamSubscription:
         if self._topic is not None:
             self._topic.subscriptions.append(self)
         if self._topic is None or not self._topic.publishers:
-            self._dds = node.create_subscription(codec.message_class, topic, self._take,
-                                                 HAPTIC_STREAM_QOS, raw=True)
+            self._dds = node.create_subscription(codec.message_class, topic, self._take, qos,
+                                                 raw=True)
 
     def _take(self, data: bytes) -> None:
         try:
@@ -185,10 +187,12 @@ def stream_publisher(node: Node, codec: MessageCodec, topic: str) -> StreamPubli
 
 
 def stream_subscription(node: Node, codec: MessageCodec, topic: str,
-                        callback: Callable[[Sequence], None], *,
-                        refused: Tally) -> StreamSubscription:
+                        callback: Callable[[Sequence], None], *, refused: Tally,
+                        qos: QoSProfile = HAPTIC_STREAM_QOS) -> StreamSubscription:
     """Return a subscription of a 1 kHz stream: ``callback`` gets each message's leaf values.
 
     Malformed messages are counted in the node's ``refused`` tally, which its report logs.
+    ``qos`` must match the publishers' (the haptic streams'); a deeper history is the one
+    choice left to the reader.
     """
-    return StreamSubscription(node, codec, topic, callback, refused=refused)
+    return StreamSubscription(node, codec, topic, callback, refused=refused, qos=qos)

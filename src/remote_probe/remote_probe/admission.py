@@ -6,7 +6,8 @@ message is taken only if
 - it belongs to the session being followed: the first one heard, until it has been silent for
   ``session_timeout`` (a second operator, or a stray process, is refused and named);
 - it is newer than the last one taken, by sequence and by stamp (a repeat, or a message that
-  lost a race on the link, is old news);
+  lost a race on the link, is old news), and its sequence runs no further ahead than its stamp
+  allows at ``max_rate`` (else one forged number, 2**63, would make every true one old);
 - its stamp is on time. The sites share no clock, so how late a message is can only be judged
   against the link's own history: its lateness, arrival minus stamp (our clock minus theirs),
   is the clocks' offset plus its delay, and a low quantile of the lateness of the last
@@ -126,6 +127,11 @@ class Admission:
         if sequence <= self._sequence or (self._stamp is not None and stamp <= self._stamp):
             return Refusal('not newer than the last taken', f'sequence {sequence} stamped '
                            f'{stamp:.6f} s, after {self._sequence} stamped {self._stamp} s')
+        if self._stamp is not None and sequence - self._sequence > \
+                (stamp - self._stamp) * self.config.max_rate + self.config.max_rate * \
+                self.config.burst:
+            return Refusal('sequence ahead of its stamp', f'sequence {sequence} stamped '
+                           f'{stamp:.6f} s, after {self._sequence} stamped {self._stamp:.6f} s')
         lateness = now - stamp
         self._last_heard = now
         refusal = self._timing(now, stamp, lateness)

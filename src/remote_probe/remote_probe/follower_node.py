@@ -27,7 +27,7 @@ from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.qos import LATCHED_QOS
+from haptic_util.qos import LATCHED_QOS, LINK_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.experiments import surface_projection
@@ -82,8 +82,9 @@ class FollowerNode(Node):
         self._sent = 0
         self._target_pub = stream_publisher(self, POSE, 'robot/target_pose')
         self._feedback_pub = stream_publisher(self, FEEDBACK, 'teleop/feedback')
-        for codec, topic, callback in ((COMMAND, 'teleop/command', self.on_command),
-                                       (POSE, 'robot/tcp_pose', self.on_tcp),
+        stream_subscription(self, COMMAND, 'teleop/command', self.on_command,
+                            refused=self._refused, qos=LINK_QOS)
+        for codec, topic, callback in ((POSE, 'robot/tcp_pose', self.on_tcp),
                                        (WRENCH, 'robot/ft_sensor/wrench', self.on_wrench)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
         self.create_subscription(RobotImpedance, 'robot/impedance', self.on_impedance,

@@ -85,7 +85,7 @@ class LeaderConfig:
     position_scale: float = 1.0
     link_timeout: float = 0.1
     coupling: CouplingConfig | None = CouplingConfig()
-    rejoin_speed: float = 0.01
+    rejoin_speed: float = 0.03
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:

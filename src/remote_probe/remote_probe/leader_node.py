@@ -22,7 +22,7 @@ from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.qos import LATCHED_QOS
+from haptic_util.qos import LATCHED_QOS, LINK_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from remote_probe.admission import Admission, AdmissionConfig, Refusal
@@ -76,9 +76,10 @@ class LeaderNode(Node):
                   else (WRENCH, 'wand/wrench'))
         self._answer_pub = stream_publisher(self, *answer)
         for codec, topic, callback in ((POSE, 'wand/pose', self.on_pose),
-                                       (TWIST, 'wand/twist', self.on_twist),
-                                       (FEEDBACK, 'teleop/feedback', self.on_feedback)):
+                                       (TWIST, 'wand/twist', self.on_twist)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
+        stream_subscription(self, FEEDBACK, 'teleop/feedback', self.on_feedback,
+                            refused=self._refused, qos=LINK_QOS)
         self.create_subscription(Bool, 'teleop/clutch', self.on_clutch, LATCHED_QOS)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         self.get_logger().info(f'{params.scheme} scheme: force x{params.force_scale:g}, '

@@ -123,13 +123,13 @@ def command_refusal(command: Command, limits: CommandLimits) -> Refusal | None:
     """Return why ``command`` must not be used, or None if it is within ``limits``."""
     values = (command.stamp, *command.position, *command.velocity, command.energy_in)
     if not all(map(math.isfinite, values)):
-        return Refusal('command not finite', _numbers(values))
+        return Refusal('not finite', _numbers(values))
     if not all(low <= x <= high for low, x, high in zip(
             limits.workspace_lower, command.position, limits.workspace_upper)):
-        return Refusal('command outside the workspace', _numbers(command.position))
-    speed = math.sqrt(sum(v * v for v in command.velocity))
+        return Refusal('outside the workspace', _numbers(command.position))
+    speed = math.hypot(*command.velocity)
     if speed > limits.max_speed:
-        return Refusal('command faster than a hand', f'{speed:.3g} m/s')
+        return Refusal('faster than a hand', f'{speed:.3g} m/s')
     if command.energy_in < 0.0:
         return Refusal('negative energy', f'{command.energy_in:.3g} J')
     return None
@@ -143,7 +143,7 @@ def feedback_refusal(feedback: Feedback) -> Refusal | None:
               *(() if plane is None else (*plane.point, *plane.normal, plane.stiffness,
                                           plane.damping)))
     if not all(map(math.isfinite, values)):
-        return Refusal('feedback not finite', _numbers(values))
+        return Refusal('not finite', _numbers(values))
     if _length(feedback.force) > MAX_FEEDBACK_FORCE:
         return Refusal('force beyond any sensor', _numbers(feedback.force))
     if _length(feedback.tcp) > MAX_FEEDBACK_REACH:
@@ -165,7 +165,7 @@ def feedback_refusal(feedback: Feedback) -> Refusal | None:
 
 
 def _length(vector) -> float:
-    return math.sqrt(sum(v * v for v in vector))
+    return math.hypot(*vector)
 
 
 def _numbers(values) -> str:
