@@ -90,6 +90,15 @@ def test_after_a_stall_the_queued_commands_are_dropped_and_the_fresh_ones_taken(
     assert kinds[-99:] == [None] * 99  # the last 0.1 s is taken, as the rate allows
 
 
+def test_while_messages_flow_a_late_one_is_still_taken():
+    """A busy machine delays them all: the newest there is beats holding the robot."""
+    admission = Admission()
+    stream(admission, 0.0, 500)
+    kinds = [admission.admit(0.5 + k * 1e-3 + DELAY + k * 1e-3, SESSION, 501 + k,
+                             0.5 + k * 1e-3 + OFFSET) for k in range(300)]  # 0.3 s later
+    assert kinds == [None] * 300
+
+
 def test_a_stall_longer_than_the_history_is_still_judged_against_what_came_before():
     admission = Admission()
     stream(admission, 0.0, 600)

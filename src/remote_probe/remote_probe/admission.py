@@ -11,12 +11,14 @@ message is taken only if
 - its stamp is on time. The sites share no clock, so how late a message is can only be judged
   against the link's own history: its lateness, arrival minus stamp (our clock minus theirs),
   is the clocks' offset plus its delay, and a low quantile of the lateness of the last
-  ``history`` messages taken is the offset plus the link's best delay (the baseline). A message
-  later than that by more than ``max_age`` waited in a queue (a stalled link): executed, it
-  would move the robot to where the operator was. One earlier by more than ``max_lead`` carries
-  a stamp from the future: taken, it would make every true message after it look old. Only
-  messages taken make the baseline, so neither a stalled link's backlog nor forged stamps move
-  it, and it is a quantile, not the minimum, so a few forged stamps that pass do not either; it
+  ``history`` messages taken is the offset plus the link's best delay (the baseline). After a
+  silence of ``max_age`` (a stalled link, when it resumes), a message later than the baseline
+  by more than ``max_age`` is the backlog: executed, it would move the robot to where the
+  operator was. While messages flow, a late one is still the newest there is, and is taken (a
+  busy machine delays them all). One earlier than the baseline by more than ``max_lead`` carries
+  a stamp from the future, at any time: taken, it would make every true message after it look
+  old. Only messages taken make the baseline, so neither a backlog nor forged stamps move it,
+  and it is a quantile, not the minimum, so a few forged stamps that pass do not either; it
   counts messages, not time, so a stall does not empty it. A link that really became slower
   (or a clock that stepped) shows as messages refused for ``relearn`` seconds with none taken
   between: the baseline is then learnt again from them;
@@ -50,7 +52,8 @@ class AdmissionConfig:
     Parameters
     ----------
     max_age : float, s
-        How much later than the link's best delay a message may arrive.
+        How much later than the link's best delay a message may arrive after a silence this
+        long.
     max_lead : float, s
         How much earlier than the link's best delay a stamp may say it was sent.
     session_timeout : float, s
@@ -108,6 +111,7 @@ class Admission:
         self._arrivals = deque()  # the lateness of the messages taken, in arrival order
         self._sorted = []  # the same, sorted
         self._streak = None  # (first arrival, least lateness) of refusals since the last taken
+        self._taken_at = None  # [s] our clock, when the last message was taken
         self._tokens = 0.0
         self._filled = None  # [s] when the bucket was last filled
 
@@ -139,7 +143,7 @@ class Admission:
             return refusal
         if not self._take_token(now):
             return Refusal('over the session\'s rate', f'above {self.config.max_rate:g} Hz')
-        self._sequence, self._stamp, self._streak = sequence, stamp, None
+        self._sequence, self._stamp, self._streak, self._taken_at = sequence, stamp, None, now
         self._remember(lateness)
         return None
 
@@ -148,9 +152,10 @@ class Admission:
         baseline = self._baseline()
         if baseline is None:
             return None
-        if lateness > baseline + self.config.max_age:
+        resuming = now - self._taken_at > self.config.max_age
+        if resuming and lateness > baseline + self.config.max_age:
             refusal = Refusal('older than the link allows', f'stamp {stamp:.6f} s is '
-                              f'{lateness - baseline:.3f} s late')
+                              f'{lateness - baseline:.3f} s late after a silence')
         elif lateness < baseline - self.config.max_lead:
             refusal = Refusal('stamped in the future', f'stamp {stamp:.6f} s is '
                               f'{baseline - lateness:.3f} s ahead of the link')

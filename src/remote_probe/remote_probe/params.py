@@ -83,8 +83,9 @@ class FollowerParams:
     max_command_speed: float = parameter(HAND_SPEED, 'a command asking a speed above this is '
                                          'refused: no hand moves a wand faster', unit='m/s',
                                          low=0.01)
-    max_command_age: float = parameter(AdmissionConfig.max_age, 'a command arriving later than '
-                                       'the link\'s best by more than this is dropped', unit='s',
+    max_command_age: float = parameter(AdmissionConfig.max_age, 'after a silence this long, a '
+                                       'command later than the link\'s best by more than this '
+                                       'is dropped (a stalled link\'s backlog)', unit='s',
                                        low=0.001)
     max_stamp_lead: float = parameter(AdmissionConfig.max_lead, 'a command stamped earlier than '
                                       'the link allows by more than this is refused', unit='s',
@@ -122,9 +123,9 @@ class LeaderParams:
     rejoin_speed: float = parameter(LeaderConfig.rejoin_speed, 'model: after a silence, the '
                                     'shift it left is given back this fast, at the robot',
                                     unit='m/s', low=1e-4)
-    max_feedback_age: float = parameter(AdmissionConfig.max_age, 'feedback arriving later than '
-                                        'the link\'s best by more than this is dropped',
-                                        unit='s', low=0.001)
+    max_feedback_age: float = parameter(AdmissionConfig.max_age, 'after a silence this long, '
+                                        'feedback later than the link\'s best by more than '
+                                        'this is dropped', unit='s', low=0.001)
     max_stamp_lead: float = parameter(AdmissionConfig.max_lead, 'feedback stamped earlier than '
                                       'the link allows by more than this is refused', unit='s',
                                       low=0.001)
