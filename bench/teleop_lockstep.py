@@ -37,6 +37,7 @@ from remote_probe.link import EmulatedLink, LinkConfig
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
+from remote_probe.teleop import CommandLimits, HAND_SPEED
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
 __all__ = ['as_series', 'scan', 'SCHEMES']
@@ -95,6 +96,8 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     skin = PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])
     follower = Follower(FollowerConfig(scheme, robot_config.stiffness),
                         PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness)),
+                        CommandLimits(robot_config.workspace_lower,
+                                      robot_config.workspace_upper, HAND_SPEED),
                         ContactModelEstimator(), surface=lambda tcp: (skin.point, skin.normal))
     leader = Leader(leader_config, ZERO, robot_config.initial_position)
     link = LinkConfig(delay, jitter, loss, seed=seed)
@@ -104,7 +107,9 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     state, remote = device.read(0.0), robot.read(0.0)
     for k in range(1, round(duration / TICK)):
         now = k * TICK
-        to_robot.send(now, leader.command(now, state.position, state.linear_velocity))
+        command = leader.command(now, state.position, state.linear_velocity)
+        if command is not None:  # none until the feedback is heard
+            to_robot.send(now, command)
         for delivery in to_robot.deliver(now):
             follower.receive(now, delivery.payload)
         reading = sensor.measure(now, remote.external_force).force

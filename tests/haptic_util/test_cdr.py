@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 
-from haptic_util.cdr import MessageCodec
+from haptic_util.cdr import MalformedMessage, MessageCodec
 
 TYPES = ['geometry_msgs/PoseStamped', 'geometry_msgs/TwistStamped',
          'geometry_msgs/WrenchStamped', 'haptic_msgs/CollisionState', 'haptic_msgs/ContactModel',
@@ -120,3 +120,55 @@ def draw_free_value(code: str, count: int = 0):
 def test_a_sequence_of_messages_is_refused_by_name():
     with pytest.raises(ValueError, match='markers'):
         MessageCodec(message_class('visualization_msgs/MarkerArray'))
+
+
+@settings(max_examples=examples(300), deadline=None)
+@given(typed_values(), st.data())
+def test_any_damage_to_a_message_is_refused_as_malformed_or_read_as_some_message(case, data):
+    """Bytes from the network may be anything: cut short, lengths rewritten, bytes flipped.
+    Whatever comes, decoding gives a message of the type or says it is malformed; nothing else
+    raises, and nothing grows with the lengths a sender chooses."""
+    _, codec, values = case
+    encoded = bytearray(codec.encode(values))
+    damage = data.draw(st.sampled_from(['cut', 'flip', 'length']))
+    if damage == 'cut':
+        encoded = encoded[:data.draw(st.integers(0, len(encoded) - 1))]
+    elif damage == 'flip':
+        for _ in range(data.draw(st.integers(1, 8))):
+            encoded[data.draw(st.integers(0, len(encoded) - 1))] = data.draw(st.integers(0, 255))
+    else:
+        at = data.draw(st.integers(4, max(4, len(encoded) - 4)))
+        encoded[at:at + 4] = data.draw(st.integers(0, 2**32 - 1)).to_bytes(4, 'little')
+    try:
+        decoded = codec.decode(bytes(encoded))
+    except MalformedMessage as error:
+        assert codec.message_class.__name__ in str(error)
+    else:
+        assert len(decoded) == len(codec.fields)
+    assert len(codec._runs) <= 8 * len(codec._segments)
+
+
+def test_strings_of_every_length_leave_the_decoder_s_layouts_bounded():
+    """One layout per string length would grow by one entry per length an attacker picks."""
+    codec = MessageCodec(message_class('geometry_msgs/PoseStamped'))
+    for length in range(1, 2000):
+        values = [1, 2, 'x' * length, 0.1, 0.2, 0.3, 0.0, 0.0, 0.0, 1.0]
+        assert codec.decode(codec.encode(values)) == values
+    assert len(codec._runs) <= 8 * len(codec._segments)
+    assert len(codec._encode_layouts) <= 16
+
+
+@pytest.mark.parametrize('data, reason', [
+    (b'', 'not little-endian CDR'),
+    (b'\x01\x00\x00\x00' + bytes(60), 'not little-endian CDR'),  # big endian
+    (b'\x00\x01\x00\x00' + bytes(8) + (1000).to_bytes(4, 'little') + b'abc', 'does not fit'),
+    (b'\x00\x01\x00\x00' + bytes(8) + (2).to_bytes(4, 'little') + b'ab' + bytes(64),
+     'does not end in NUL'),
+    (b'\x00\x01\x00\x00' + bytes(8) + (2).to_bytes(4, 'little') + b'\xff\x00' + bytes(64),
+     'not UTF-8'),
+    (b'\x00\x01\x00\x00' + bytes(8) + (6).to_bytes(4, 'little') + b'world\x00', 'ends early'),
+])
+def test_a_malformed_message_says_what_is_wrong(data, reason):
+    codec = MessageCodec(message_class('geometry_msgs/PoseStamped'))
+    with pytest.raises(MalformedMessage, match=f'PoseStamped: .*{reason}'):
+        codec.decode(data)

@@ -18,6 +18,7 @@ from haptic_util.callback_errors import callback_errors
 from haptic_util.cdr import MessageCodec
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.tally import Tally
 
 POSE = MessageCodec(PoseStamped)
 WRENCH = MessageCodec(WrenchStamped)
@@ -62,7 +63,7 @@ def test_in_one_process_a_message_reaches_its_subscriber_as_values_before_publis
     got = []
     publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
     subscriber = node(context, 'collision')
-    stream_subscription(subscriber, POSE, 'wand/pose', got.append)
+    stream_subscription(subscriber, POSE, 'wand/pose', got.append, refused=Tally())
     publisher.publish(VALUES)
     assert got == [VALUES]
     assert list(subscriber.subscriptions) == []  # nothing taken over DDS
@@ -71,7 +72,8 @@ def test_in_one_process_a_message_reaches_its_subscriber_as_values_before_publis
 def test_a_subscription_made_before_its_publisher_stops_taking_the_topic_over_dds(
         context, bus):
     subscriber = node(context, 'collision')
-    subscription = stream_subscription(subscriber, POSE, 'wand/pose', lambda values: None)
+    subscription = stream_subscription(subscriber, POSE, 'wand/pose', lambda values: None,
+                                       refused=Tally())
     assert [s.topic_name for s in subscriber.subscriptions] == ['/wand/pose']
     publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
     assert list(subscriber.subscriptions) == []
@@ -88,11 +90,11 @@ def test_messages_are_delivered_in_the_order_they_were_published(context, bus):
         seen.append(('relay', values[1]))
         wrench_out.publish((*values[:3], 1.0, 2.0, 3.0, 0.0, 0.0, 0.0))
         seen.append(('relay published', values[1]))
-    stream_subscription(relay, POSE, 'wand/pose', answer)
+    stream_subscription(relay, POSE, 'wand/pose', answer, refused=Tally())
     stream_subscription(node(context, 'observer'), POSE, 'wand/pose',
-                        lambda values: seen.append(('observer', values[1])))
+                        lambda values: seen.append(('observer', values[1])), refused=Tally())
     stream_subscription(node(context, 'driver_in'), WRENCH, 'wand/wrench',
-                        lambda values: seen.append(('wrench', values[1])))
+                        lambda values: seen.append(('wrench', values[1])), refused=Tally())
     pose_out.publish(VALUES)
     seen.append('returned')
     # The relay's wrench waits for the relay's callback and the pose's other subscriber.
@@ -107,8 +109,8 @@ def test_a_raising_subscriber_is_counted_and_the_others_still_get_the_message(co
 
     def fails(values):
         raise RuntimeError('a bad pose')
-    stream_subscription(node(context, 'flaky'), POSE, 'wand/pose', fails)
-    stream_subscription(node(context, 'steady'), POSE, 'wand/pose', got.append)
+    stream_subscription(node(context, 'flaky'), POSE, 'wand/pose', fails, refused=Tally())
+    stream_subscription(node(context, 'steady'), POSE, 'wand/pose', got.append, refused=Tally())
     errors = callback_errors()
     publisher.publish(VALUES)
     publisher.publish(VALUES)
@@ -119,7 +121,8 @@ def test_a_raising_subscriber_is_counted_and_the_others_still_get_the_message(co
 def test_dds_carries_a_message_only_while_a_reader_of_another_process_matches(context, bus):
     driver = node(context, 'driver')
     publisher = stream_publisher(driver, POSE, 'wand/pose')
-    stream_subscription(node(context, 'collision'), POSE, 'wand/pose', lambda values: None)
+    stream_subscription(node(context, 'collision'), POSE, 'wand/pose', lambda values: None,
+                        refused=Tally())
     writes = []
     write = publisher._dds.publish
     publisher._dds.publish = lambda data: (writes.append(data), write(data))
@@ -150,7 +153,7 @@ def test_without_it_a_stream_is_cdr_over_dds_and_parsed_for_the_callback(context
     driver = node(context, 'driver')
     publisher = stream_publisher(driver, POSE, 'wand/pose')
     subscriber = node(context, 'collision')
-    stream_subscription(subscriber, POSE, 'wand/pose', got.append)
+    stream_subscription(subscriber, POSE, 'wand/pose', got.append, refused=Tally())
     assert [s.topic_name for s in subscriber.subscriptions] == ['/wand/pose']
     assert spin_until([driver, subscriber], lambda: publisher.publish(VALUES) or bool(got))
     assert got[0] == list(VALUES)
@@ -159,6 +162,29 @@ def test_without_it_a_stream_is_cdr_over_dds_and_parsed_for_the_callback(context
 def test_a_topic_of_two_types_or_a_message_of_the_wrong_length_is_refused(context, bus):
     publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
     with pytest.raises(ValueError, match='wand/pose is PoseStamped in this process'):
-        stream_subscription(node(context, 'other'), WRENCH, 'wand/pose', lambda values: None)
+        stream_subscription(node(context, 'other'), WRENCH, 'wand/pose', lambda values: None,
+                            refused=Tally())
     with pytest.raises(ValueError, match='9 values for the 10 fields of PoseStamped'):
         publisher.publish(VALUES[:-1])
+
+
+def test_bytes_that_are_no_message_are_counted_with_their_reason_and_the_good_ones_go_on(
+        context):
+    """A peer on the network may send anything on a topic: the callback sees only messages,
+    nothing raises into the executor, and the node's tally says what came."""
+    got, refused = [], Tally()
+    subscriber = node(context, 'collision')
+    stream_subscription(subscriber, POSE, 'wand/pose', got.append, refused=refused)
+    sender = node(context, 'sender')
+    raw = sender.create_publisher(PoseStamped, 'wand/pose', HAPTIC_STREAM_QOS)
+    good = POSE.encode(VALUES)
+    bad = good[:12] + (10**6).to_bytes(4, 'little') + good[16:]  # frame_id: too long to fit
+
+    def send() -> bool:
+        raw.publish(bad)
+        raw.publish(good)
+        return bool(got) and bool(refused.total())
+    assert spin_until([subscriber, sender], send)
+    assert all(values == list(VALUES) for values in got)
+    [(kind, count)] = refused.counts.items()
+    assert kind == 'malformed wand/pose' and count >= 1

@@ -69,13 +69,13 @@ def test_a_silent_link_holds_the_pose_then_retracts_until_the_force_is_released(
     assert press[-1] == pytest.approx(10.0, abs=1.0)
     pressed_at = site.state.position.copy()
     timeout = site.safety.config.link_timeout
-    # The link goes silent: for the timeout the robot follows its last target, then holds it.
+    # The link goes silent: for the timeout the robot follows its last target, then holds.
     waiting = site.run(timeout, lambda t: [0.0, 0.0, -0.025], link_up=False)
     assert not site.safety.holding
     assert np.ptp(waiting) < 0.05
     retreat = site.run(3.0, lambda t: [0.0, 0.0, -0.3], link_up=False)
     assert site.safety.holding
-    # No jump when holding: the force falls smoothly from where it was, never rising.
+    # Holding the TCP lets the spring go: the force falls from where it was, never rising.
     assert np.all(np.diff(retreat) <= 1e-3)
     assert retreat[0] == pytest.approx(press[-1], abs=0.1)
     assert retreat[-1] < site.safety.config.release_force
@@ -90,6 +90,34 @@ def test_a_silent_link_holds_the_pose_then_retracts_until_the_force_is_released(
     site.run(2.0, lambda t: [0.0, 0.0, -0.025])
     assert not site.safety.holding
     assert site.state.external_force[2] == pytest.approx(10.0, abs=1.0)
+
+
+def test_a_stall_while_pressing_in_holds_the_tcp_not_the_target_ahead_of_it():
+    """The operator presses in at 20 mm/s; the link stalls for 0.5 s. The last target lies
+    ahead of the TCP (up to the force bound's reach); holding it, the robot would press on."""
+    site = RemoteSite([0.0, 0.0, 0.0])
+    pressing = site.run(0.7, lambda t: [0.0, 0.0, -0.005 - 0.02 * t])
+    before = site.state
+    stalled = site.run(0.5, lambda t: [0.0, 0.0, -0.005 - 0.02 * t], link_up=False)
+    timeout = round(site.safety.config.link_timeout / TICK)
+    assert pressing[-1] > 5.0
+    # Within the watchdog's timeout it followed the last target; from then on it yields.
+    assert stalled[timeout:].max() <= stalled[timeout] + 0.05
+    assert stalled[-1] < stalled[timeout]
+    assert site.state.position[2] >= before.position[2] - 0.002  # 2 mm more in at most
+
+
+def test_when_the_link_returns_the_target_goes_back_to_the_operators_without_a_jump():
+    site = RemoteSite([0.0, 0.0, 0.0])
+    site.run(1.0, lambda t: [0.0, 0.0, -0.025])
+    site.run(2.0, lambda t: [0.0, 0.0, -0.025], link_up=False)  # retracted meanwhile
+    targets = []
+    command = site.robot.command
+    site.robot.command = lambda target: (targets.append(np.array(target)), command(target))
+    site.run(2.0, lambda t: [0.0, 0.0, -0.025])
+    steps = np.linalg.norm(np.diff(targets, axis=0), axis=1)
+    assert steps.max() <= site.safety.config.rejoin_speed * TICK * (1 + 1e-9) + 1e-12
+    assert site.state.external_force[2] == pytest.approx(10.0, abs=1.0)  # and they met
 
 
 def test_the_watchdog_counts_silence_from_the_latest_message():
@@ -108,6 +136,7 @@ def test_the_watchdog_counts_silence_from_the_latest_message():
     (dict(release_force=-1.0), 'release_force must be finite >= 0'),
     (dict(link_timeout=-0.1), 'link_timeout must be finite > 0'),
     (dict(retract_speed=math.inf), 'retract_speed must be finite > 0'),
+    (dict(rejoin_speed=0.0), 'rejoin_speed must be finite > 0'),
 ])
 def test_bad_configurations_are_refused(fields, message):
     with pytest.raises(ValueError, match=message):

@@ -56,7 +56,7 @@ class CollisionNode(Node):
         self._nearby_pub = (self.create_publisher(CollisionStateArray, 'collision/nearby',
                                                   HAPTIC_STREAM_QOS)
                             if self.params.report_radius > 0 else None)
-        stream_subscription(self, POSE, 'wand/pose', self.on_pose)
+        stream_subscription(self, POSE, 'wand/pose', self.on_pose, refused=self._refused)
 
         description = self.create_publisher(String, 'scene/description', LATCHED_QOS)
         description.publish(String(data=scene_path.read_text()))

@@ -77,14 +77,16 @@ class ForceNode(Node):
         self._twist = None
         self._published = 0
         self._zeroed = Tally()  # zero forces sent, by reason
+        self._refused = Tally()  # input that was no message of its type
         self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
         self._force = self._torque = _ZERO
         self._wrench_pub = stream_publisher(self, WRENCH, 'wand/wrench')
         self._model_pub = stream_publisher(self, MODEL, 'wand/contact_model')
-        stream_subscription(self, STATE, 'collision/state', self.on_state)
+        stream_subscription(self, STATE, 'collision/state', self.on_state,
+                            refused=self._refused)
         uses_damping = any(max(damping) > 0.0 for _, damping in gains)
         if uses_damping and params.velocity_source == 'twist':
-            stream_subscription(self, TWIST, 'wand/twist', self.on_twist)
+            stream_subscription(self, TWIST, 'wand/twist', self.on_twist, refused=self._refused)
         self.create_timer(params.watchdog_timeout / 2, self.check_stale)
         self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
         if params.marker_rate > 0:
@@ -205,9 +207,11 @@ class ForceNode(Node):
     def report(self) -> Report:
         """Report counts, the watchdog's last word and the passivity energy; log new zeroes."""
         self._zeroed.log_new(lambda line: self.get_logger().warn(f'force zeroed: {line}'))
+        self._refused.log_new(lambda line: self.get_logger().warn(f'refused: {line}'))
         reason = self.pipeline.last_reason
         values = {'law': self.params.law, 'published': self._published,
-                  'zeroed': self._zeroed.total(), 'approximate': self._approximate,
+                  'zeroed': self._zeroed.total(), 'refused': self._refused.total(),
+                  'approximate': self._approximate,
                   'last_reason': reason.value,
                   **{f'zeroed: {kind}': n for kind, n in self._zeroed.counts.items()}}
         if self.pipeline.passivity is not None:

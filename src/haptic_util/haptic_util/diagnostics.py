@@ -2,12 +2,15 @@
 
 The last report of a node that stops cleanly carries its final counts (messages published,
 inputs refused), so a recorded session documents its own completeness: a reader compares what each
-node says it published with what the bag holds.
+node says it published with what the bag holds. Every report also says how many callbacks of its
+process raised (``callback_errors``): a bad input must be refused, never raise.
 """
 from typing import Callable
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.node import Node
+
+from haptic_util.callback_errors import callback_errors
 
 __all__ = ['Diagnostics', 'Report', 'OK', 'WARN', 'ERROR']
 
@@ -38,7 +41,8 @@ class Diagnostics:
         status = DiagnosticStatus(
             level=report.level, name=self._node.get_fully_qualified_name(),
             message=report.message, hardware_id=self._node.get_name(),
-            values=[KeyValue(key=key, value=str(value)) for key, value in report.values.items()])
+            values=[KeyValue(key=key, value=str(value)) for key, value in
+                    {**report.values, 'callback_errors': callback_errors()}.items()])
         array = DiagnosticArray(status=[status])
         array.header.stamp = self._node.get_clock().now().to_msg()
         self._publisher.publish(array)

@@ -29,10 +29,12 @@ from typing import Callable, Sequence
 
 from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.node import Node
+from rclpy.qos import QoSProfile
 
 from haptic_util.callback_errors import log_callback_error
-from haptic_util.cdr import MessageCodec
+from haptic_util.cdr import MalformedMessage, MessageCodec
 from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.tally import Tally
 
 __all__ = ['close', 'enable', 'stream_publisher', 'stream_subscription',
            'StreamPublisher', 'StreamSubscription']
@@ -120,20 +122,36 @@ class StreamPublisher:
 
 
 class StreamSubscription:
-    """Takes a topic's messages as leaf values: from the process's publishers, or over DDS."""
+    """Takes a topic's messages as leaf values: from the process's publishers, or over DDS.
+
+    Bytes over DDS that are no message of the type are counted in ``refused``, with the reason,
+    and dropped: they never reach the callback, nor raise into the executor (an exception there
+    ends its spin, and restarting it stalled a site for hundreds of milliseconds).
+    """
 
     def __init__(self, node: Node, codec: MessageCodec, topic: str,
-                 callback: Callable[[Sequence], None]) -> None:
+                 callback: Callable[[Sequence], None], *, refused: Tally,
+                 qos: QoSProfile = HAPTIC_STREAM_QOS) -> None:
         self.callback = callback
+        self._codec = codec
+        self._refused = refused
+        self._malformed = f'malformed {topic}'
         self._node = node
         self._topic = _topic(node, codec.message_class, topic)
         self._dds = None
         if self._topic is not None:
             self._topic.subscriptions.append(self)
         if self._topic is None or not self._topic.publishers:
-            self._dds = node.create_subscription(
-                codec.message_class, topic, lambda data: callback(codec.decode(data)),
-                HAPTIC_STREAM_QOS, raw=True)
+            self._dds = node.create_subscription(codec.message_class, topic, self._take, qos,
+                                                 raw=True)
+
+    def _take(self, data: bytes) -> None:
+        try:
+            values = self._codec.decode(data)
+        except MalformedMessage as error:
+            self._refused.add(self._malformed, str(error))
+            return
+        self.callback(values)
 
     def served_locally(self) -> None:
         """Stop taking the topic over DDS: a node of this process publishes it."""
@@ -169,6 +187,12 @@ def stream_publisher(node: Node, codec: MessageCodec, topic: str) -> StreamPubli
 
 
 def stream_subscription(node: Node, codec: MessageCodec, topic: str,
-                        callback: Callable[[Sequence], None]) -> StreamSubscription:
-    """Return a subscription of a 1 kHz stream: ``callback`` gets each message's leaf values."""
-    return StreamSubscription(node, codec, topic, callback)
+                        callback: Callable[[Sequence], None], *, refused: Tally,
+                        qos: QoSProfile = HAPTIC_STREAM_QOS) -> StreamSubscription:
+    """Return a subscription of a 1 kHz stream: ``callback`` gets each message's leaf values.
+
+    Malformed messages are counted in the node's ``refused`` tally, which its report logs.
+    ``qos`` must match the publishers' (the haptic streams'); a deeper history is the one
+    choice left to the reader.
+    """
+    return StreamSubscription(node, codec, topic, callback, refused=refused, qos=qos)

@@ -8,7 +8,7 @@ transient-local, so that a late subscriber, such as a recorder or RViz, still re
 """
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-__all__ = ['HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'RECORDER_QOS', 'RELIABLE_RECORDER_QOS',
+__all__ = ['HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_QOS', 'RECORDER_QOS', 'RELIABLE_RECORDER_QOS',
            'MARKER_QOS']
 
 STREAM_DEPTH = 10
@@ -16,6 +16,16 @@ STREAM_DEPTH = 10
 HAPTIC_STREAM_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=STREAM_DEPTH,
+    reliability=ReliabilityPolicy.BEST_EFFORT,
+    durability=DurabilityPolicy.VOLATILE,
+)
+
+# What comes from another site: the same policy, a history deep enough that a flood from any
+# publisher on the topic does not push the followed session's messages out before the node has
+# refused the flood's (it sheds them by content, at a few microseconds each).
+LINK_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1000,
     reliability=ReliabilityPolicy.BEST_EFFORT,
     durability=DurabilityPolicy.VOLATILE,
 )

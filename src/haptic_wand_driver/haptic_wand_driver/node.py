@@ -100,7 +100,7 @@ class WandDriverNode(Node):
         answers = ((MODEL, 'wand/contact_model', self.on_model)
                    if self.renderer is not None else
                    (WRENCH, 'wand/wrench', self.on_wrench))
-        self._answer_sub = stream_subscription(self, *answers)
+        self._answer_sub = stream_subscription(self, *answers, refused=self._refused)
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
         self.create_timer(1.0 / params.rate, self.tick)

@@ -25,8 +25,12 @@ model would reach the operator a round trip after the touch, with the wand alrea
 in (18 mm at 100 ms in the scripted scan), and the hand would first feel the patient there.
 
 A sensor reading with NaN is not used: the feedback carries zero force and no plane until a good
-reading comes, and the safety goes on with the last good force. An older or repeated command is
-ignored by its stamp.
+reading comes, and the safety goes on with the last good force.
+
+Every command is checked at the door before anything uses it (``teleop.command_refusal``: finite,
+in the robot's workspace, at a hand's speed) and admitted (``remote_probe.admission``): one
+operator session at a time, in order, on time, at a sane rate. A refused command changes
+nothing, not even the link's watchdog; ``receive`` says why it was refused.
 """
 from dataclasses import dataclass
 import math
@@ -35,10 +39,12 @@ from typing import Callable
 import numpy as np
 
 from remote_probe._checks import finite_number
+from remote_probe.admission import Admission, Refusal
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.safety import PatientSafety
 from remote_probe.tdpa import RobotPassivity
-from remote_probe.teleop import Command, Feedback, RemotePlane, SCHEMES
+from remote_probe.teleop import (Command, command_refusal, CommandLimits, Feedback, new_session,
+                                 RemotePlane, SCHEMES)
 
 __all__ = ['Follower', 'FollowerConfig']
 
@@ -75,20 +81,31 @@ class Follower:
     ----------
     config : FollowerConfig
     safety : PatientSafety
+    limits : CommandLimits
+        What a command may ask of this robot.
     estimator : ContactModelEstimator or None
         Needed for ``model``; ignored otherwise.
     surface : callable or None
         ``surface(position) -> (point, outward normal)``: the patient's skin nearest a point,
         for the model out of contact; None: only what contact has taught.
+    admission : Admission
+        Which commands are taken.
+    session : int or None
+        This site's session id in its feedback; None: a random one.
     """
 
-    def __init__(self, config: FollowerConfig, safety: PatientSafety,
+    def __init__(self, config: FollowerConfig, safety: PatientSafety, limits: CommandLimits,
                  estimator: ContactModelEstimator | None = None, *,
-                 surface: Callable | None = None) -> None:
+                 surface: Callable | None = None, admission: Admission | None = None,
+                 session: int | None = None) -> None:
         if config.scheme == 'model' and estimator is None:
             raise ValueError('the model scheme needs a contact estimator')
         self.config = config
         self.safety = safety
+        self.limits = limits
+        self.admission = admission if admission is not None else Admission()
+        self.session = new_session() if session is None else session
+        self._sent = 0  # feedback so far
         self.estimator = estimator if config.scheme == 'model' else None
         self.passivity = RobotPassivity(config.drift_rate)
         self._command: Command | None = None
@@ -103,14 +120,17 @@ class Follower:
             prior = self.estimator.config
             self._gains = self._as_commanded(prior.initial_stiffness, prior.initial_damping)
 
-    def receive(self, now: float, command: Command) -> bool:
-        """Take ``command`` arrived at ``now`` (s); False if it is not newer than the held one."""
-        if self._command is not None and command.stamp <= self._command.stamp:
-            return False
+    def receive(self, now: float, command: Command) -> Refusal | None:
+        """Take ``command`` arrived at ``now`` (s); return None, or why it was refused."""
+        refusal = (command_refusal(command, self.limits)
+                   or self.admission.admit(now, command.session, command.sequence,
+                                           command.stamp))
+        if refusal is not None:
+            return refusal
         self._command, self._command_heard = command, now
         self.safety.heard(now)
         self.passivity.books.receive(command.energy_in)
-        return True
+        return None
 
     def target(self, now: float, tcp, tcp_velocity, force, dt: float) -> np.ndarray:
         """Return the robot's target position (3,) m for the next ``dt`` s, from its state now.
@@ -164,9 +184,11 @@ class Follower:
     def feedback(self, now: float) -> Feedback:
         """Return the feedback to send at ``now`` (s)."""
         command = self._command
-        echo, hold = (0.0, 0.0) if command is None else (command.stamp,
-                                                         now - self._command_heard)
+        echo, hold, echoed = ((0.0, 0.0, 0) if command is None else
+                              (command.stamp, now - self._command_heard, command.sequence))
         good = self._force_good
         force = self._port_force() if self.config.scheme == 'tdpa' else self._force
+        self._sent += 1
         return Feedback(now, echo, hold, force if good else np.zeros(3), self._tcp,
-                        self.passivity.books.energy_in, self._plane if good else None)
+                        self.passivity.books.energy_in, self._plane if good else None,
+                        self.session, self._sent, echoed)

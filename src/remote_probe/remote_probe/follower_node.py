@@ -4,9 +4,13 @@ Takes the operator's commands (through the link), the robot's TCP pose and its F
 at ``rate`` commands the robot a target that the patient's safety allows (``Follower``). Sends
 ``teleop/feedback`` back over the link at ``feedback_rate``: the measured force, the energy books
 and the estimated contact plane. A TCP pose or wrench older than ``sensor_timeout`` feeds back no
-force; a command older or repeated is ignored by its stamp. ``scene_file`` is the patient's
-surface as this site sees it (a depth camera's, here the phantom's mesh), for the model out of
-contact.
+force. ``scene_file`` is the patient's surface as this site sees it (a depth camera's, here the
+phantom's mesh), for the model out of contact.
+
+It follows only once the robot has said what it is (``robot/impedance``, latched): the force
+bound holds only for the robot's own stiffness, so a robot whose stiffness is not this node's
+``robot_stiffness`` is not commanded at all (an error says so), and commands are checked against
+its workspace. Every refused command is counted and logged once a second with its reason.
 """
 import math
 from typing import Sequence
@@ -16,30 +20,32 @@ import numpy as np
 from rclpy.node import Node
 
 from collision_engine import load_scene
-from haptic_msgs.msg import TeleopCommand, TeleopFeedback
+from haptic_msgs.msg import RobotImpedance
 from haptic_util.cdr import MessageCodec
-from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
+from haptic_util.diagnostics import Diagnostics, ERROR, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
+from haptic_util.qos import LATCHED_QOS, LINK_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.experiments import surface_projection
+from remote_probe.admission import Admission, AdmissionConfig
 from remote_probe.follower import Follower, FollowerConfig
+from remote_probe.link_messages import (COMMAND, command_from_fields, FEEDBACK, feedback_fields,
+                                        impedance_report)
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import FollowerParams
 from remote_probe.safety import PatientSafety, SafetyConfig
-from remote_probe.teleop import Command
 
 __all__ = ['FollowerNode', 'main']
 
-COMMAND = MessageCodec(TeleopCommand)
-FEEDBACK = MessageCodec(TeleopFeedback)
 POSE = MessageCodec(PoseStamped)
 WRENCH = MessageCodec(WrenchStamped)
 MODEL_FEEDBACK_RATE, FORCE_FEEDBACK_RATE = 100.0, 1000.0  # [Hz] what each scheme's content needs
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
+STIFFNESS_TOLERANCE = 0.01  # relative: the robot's reported stiffness against robot_stiffness
 
 
 class FollowerNode(Node):
@@ -49,21 +55,25 @@ class FollowerNode(Node):
         super().__init__('teleop_follower', **kwargs)
         self.params = params = declare_parameters(self, FollowerParams)
         try:
-            safety = PatientSafety(SafetyConfig(
+            self._safety = PatientSafety(SafetyConfig(
                 robot_stiffness=params.robot_stiffness,
                 max_patient_force=params.max_patient_force, force_margin=params.force_margin,
                 link_timeout=params.link_timeout, release_force=params.release_force,
-                retract_speed=params.retract_speed))
-            surface = None
+                retract_speed=params.retract_speed, rejoin_speed=params.rejoin_speed))
+            self._surface = None
             if params.scene_file:
-                surface = surface_projection(load_scene(
+                self._surface = surface_projection(load_scene(
                     resolve_path(params.scene_file, what='parameter scene_file'),
                     announce=self.get_logger().info))
-            self.follower = Follower(
-                FollowerConfig(params.scheme, params.robot_stiffness, params.drift_rate),
-                safety, ContactModelEstimator(), surface=surface)
+            self._config = FollowerConfig(params.scheme, params.robot_stiffness,
+                                          params.drift_rate)
+            self._admission = AdmissionConfig(
+                max_age=params.max_command_age, max_lead=params.max_stamp_lead,
+                session_timeout=params.session_timeout, max_rate=params.max_command_rate)
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
+        self.follower: Follower | None = None  # once the robot has said what it is
+        self._robot_problem = (WARN, 'waiting for the robot\'s robot/impedance')
         self._period = 1.0 / params.rate
         self._tcp = self._tcp_velocity = None
         self._tcp_time = self._force_time = -math.inf
@@ -72,9 +82,13 @@ class FollowerNode(Node):
         self._sent = 0
         self._target_pub = stream_publisher(self, POSE, 'robot/target_pose')
         self._feedback_pub = stream_publisher(self, FEEDBACK, 'teleop/feedback')
-        stream_subscription(self, COMMAND, 'teleop/command', self.on_command)
-        stream_subscription(self, POSE, 'robot/tcp_pose', self.on_tcp)
-        stream_subscription(self, WRENCH, 'robot/ft_sensor/wrench', self.on_wrench)
+        stream_subscription(self, COMMAND, 'teleop/command', self.on_command,
+                            refused=self._refused, qos=LINK_QOS)
+        for codec, topic, callback in ((POSE, 'robot/tcp_pose', self.on_tcp),
+                                       (WRENCH, 'robot/ft_sensor/wrench', self.on_wrench)):
+            stream_subscription(self, codec, topic, callback, refused=self._refused)
+        self.create_subscription(RobotImpedance, 'robot/impedance', self.on_impedance,
+                                 LATCHED_QOS)
         self.create_timer(self._period, self.tick)
         rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == 'model'
                                         else FORCE_FEEDBACK_RATE)
@@ -88,16 +102,38 @@ class FollowerNode(Node):
         return clock_ns(self.get_clock()) * 1e-9
 
     def on_command(self, fields: Sequence) -> None:
-        if fields[2] != self.params.frame_id:
-            self._refused.add(f'command in frame {fields[2]!r}')
-            return
-        values = np.array(fields[3:10], dtype=np.float64)
-        if not np.all(np.isfinite(values)):
-            self._refused.add('command not finite')
-            return
-        command = Command(fields[0] + fields[1] * 1e-9, values[:3], values[3:6], values[6])
-        if not self.follower.receive(self._now(), command):
-            self._refused.add('command older than the held one')
+        frame, command = command_from_fields(fields)
+        if frame != self.params.frame_id:
+            self._refused.add('command in another frame', repr(frame))
+        elif self.follower is None:
+            self._refused.add('command before the robot is known', self._robot_problem[1])
+        else:
+            refusal = self.follower.receive(self._now(), command)
+            if refusal is not None:
+                self._refused.add(f'command {refusal.kind}', refusal.detail)
+
+    def on_impedance(self, message: RobotImpedance) -> None:
+        """Follow once the robot says it is the one the force bound was set for; else stop."""
+        frame, report = impedance_report(message, self.params.max_command_speed)
+        expected = self.params.robot_stiffness
+        if frame != self.params.frame_id:
+            problem = f'the robot reports in frame {frame!r}, not {self.params.frame_id!r}'
+        elif not abs(report.stiffness - expected) <= STIFFNESS_TOLERANCE * expected:
+            problem = (f'the robot\'s stiffness is {report.stiffness:g} N/m, not '
+                       f'robot_stiffness {expected:g} N/m: the force bound would not hold')
+        else:
+            problem = None
+        if problem is not None:
+            self.follower, self._robot_problem = None, (ERROR, problem)
+            self.get_logger().error(f'not commanding the robot: {problem}')
+        elif self.follower is None:
+            self.follower = Follower(self._config, self._safety, report.limits,
+                                     ContactModelEstimator(), surface=self._surface,
+                                     admission=Admission(self._admission))
+            self.get_logger().info(f'the robot is as expected ({report.stiffness:g} N/m): '
+                                   'following')
+        else:
+            self.follower.limits = report.limits
 
     def on_tcp(self, fields: Sequence) -> None:
         now = self._now()
@@ -113,8 +149,8 @@ class FollowerNode(Node):
 
     def tick(self) -> None:
         now = self._now()
-        if self._tcp is None:
-            return  # the robot has not spoken yet
+        if self._tcp is None or self.follower is None:
+            return  # the robot has not spoken yet, or is not the one expected
         fresh = (now - self._force_time <= self.params.sensor_timeout
                  and now - self._tcp_time <= self.params.sensor_timeout)
         force = self._force if fresh else np.full(3, np.nan)
@@ -125,30 +161,22 @@ class FollowerNode(Node):
                                   *target.tolist(), *_IDENTITY))
 
     def send_feedback(self) -> None:
-        if self._tcp is None:
+        if self._tcp is None or self.follower is None:
             return
-        now_ns = clock_ns(self.get_clock())
-        feedback = self.follower.feedback(now_ns * 1e-9)
-        echo = round(feedback.echo * 1e9)
-        plane = feedback.plane
-        kind = TeleopFeedback.KIND_FREE if plane is None else TeleopFeedback.KIND_PLANE
-        plane_fields = ((0.0,) * 15 if plane is None else
-                        (*plane.point.tolist(), *plane.normal.tolist(), *[plane.stiffness] * 3,
-                         *[plane.damping] * 3, 0.0, 0.0, 0.0))
-        self._feedback_pub.publish((
-            *divmod(now_ns, 1_000_000_000), self.params.frame_id, *divmod(echo, 1_000_000_000),
-            feedback.echo_hold, *feedback.force.tolist(), *feedback.tcp.tolist(),
-            feedback.energy_in, kind, *plane_fields))
+        feedback = self.follower.feedback(clock_ns(self.get_clock()) * 1e-9)
+        self._feedback_pub.publish(feedback_fields(feedback, self.params.frame_id))
         self._sent += 1
 
     def report(self) -> Report:
         self._refused.log_new(lambda line: self.get_logger().warn(f'refused: {line}'))
+        values = {'published': self._sent, 'refused': self._refused.total(),
+                  **{f'refused: {kind}': n for kind, n in self._refused.counts.items()}}
+        if self.follower is None:
+            return Report(*self._robot_problem, values)
         holding = self.follower.safety.holding
+        values.update(holding=holding, session=f'{self.follower.admission.session:#x}')
         return Report(WARN if holding else OK,
-                      'link silent: holding and retracting' if holding else 'following',
-                      {'published': self._sent, 'holding': holding,
-                       'refused': self._refused.total(),
-                       **{f'refused: {kind}': n for kind, n in self._refused.counts.items()}})
+                      'link silent: holding and retracting' if holding else 'following', values)
 
     def destroy_node(self) -> bool:
         self.diagnostics.final()

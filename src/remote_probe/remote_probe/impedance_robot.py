@@ -153,6 +153,11 @@ class ImpedanceRobot:
         return self._config
 
     @property
+    def position(self) -> tuple:
+        """Where the TCP is (m) at the last substep, as floats: no arrays, for every tick."""
+        return self._position
+
+    @property
     def target(self) -> np.ndarray:
         """The commanded TCP position (3,) m, as given (the workspace stops the TCP, not it)."""
         return np.array(self._target)

@@ -23,23 +23,40 @@ every wand pose at once from the newest feedback it holds, never waiting on the 
   allows. A reserve rather than a ratchet: refusing every rise while keeping every fall, the
   estimate's noise alone drove the shift out to tens of millimetres.
 
+After a silence the model would come back with the wand deep (nothing resisted the hand), and
+that first update is shown moved out as any other: no jolt, but the operator would go on
+pressing into nothing, the robot held at the skin by the same shift. So the shift that a
+silence left is given back at ``rejoin_speed`` (m/s at the robot): the plane comes back to where
+the remote site sees it, and the robot's target with it, as a ramp of force on both sides. That
+energy, at most half the felt stiffness times the shift squared, is not booked: it is the one
+place the model's updates are not passive, and only after a silence.
+
 Feedback older than ``link_timeout`` (on this site's clock: the sites share none) gives zero
-force and no model; an older or repeated feedback is ignored by its stamp. The link's round trip
-is measured from the echoed command stamps, as NTP does (``RoundTripEstimator``).
+force and no model, and no command is sent while it lasts: the robot then holds, as it does when
+its commands stop, rather than follow an operator who feels nothing. Feedback is checked and
+admitted at the door as the robot's end does with commands (``teleop.feedback_refusal``,
+``remote_probe.admission``), and its echo must be of a command this end sent. The link's round
+trip is measured from those echoes, as NTP does (``RoundTripEstimator``).
 """
+from collections import OrderedDict
 from dataclasses import dataclass
 import math
 
 import numpy as np
 
 from remote_probe._checks import finite_number
+from remote_probe.admission import Admission, Refusal
 from remote_probe.link import RoundTripEstimator
 from remote_probe.tdpa import OperatorPassivity
-from remote_probe.teleop import Command, Feedback, RemotePlane, SCHEMES
+from remote_probe.teleop import Command, Feedback, feedback_refusal, new_session, RemotePlane, \
+    SCHEMES
 from remote_probe.virtual_coupling import CouplingConfig, VirtualCoupling
 from remote_probe.workspace_map import WorkspaceMap
 
 __all__ = ['Leader', 'LeaderConfig']
+
+_ROUNDING = 1e-9  # [m] how far a shift computed back from its own energy may come out off
+_STAMP_ROUNDING = 1e-6  # [s] a stamp through the message's integer seconds and nanoseconds
 
 
 @dataclass(frozen=True)
@@ -59,6 +76,8 @@ class LeaderConfig:
     coupling : CouplingConfig or None
         ``tdpa``: between the link's port and the wand. None: the controller acts on the wand
         itself, as plain TDPA does (the baseline the coupling improves on: it chatters).
+    rejoin_speed : float, m/s
+        ``model``: how fast the shift a silence left is given back, at the robot.
     """
 
     scheme: str = 'model'
@@ -66,11 +85,13 @@ class LeaderConfig:
     position_scale: float = 1.0
     link_timeout: float = 0.1
     coupling: CouplingConfig | None = CouplingConfig()
+    rejoin_speed: float = 0.03
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:
             raise ValueError(f'scheme {self.scheme!r} is not one of {list(SCHEMES)}')
         finite_number(self.link_timeout, 'link_timeout', minimum=0.0, strict=True)
+        finite_number(self.rejoin_speed, 'rejoin_speed', minimum=0.0, strict=True)
 
 
 class Leader:
@@ -81,10 +102,20 @@ class Leader:
     config : LeaderConfig
     wand_start, robot_start : (3,) float, m
         Where the wand and the probe are when the session starts (the first anchors).
+    admission : Admission
+        Which feedback is taken.
+    session : int or None
+        This operator's session id in its commands; None: a random one.
     """
 
-    def __init__(self, config: LeaderConfig, wand_start, robot_start) -> None:
+    SENT_KEPT = 8192  # commands whose stamps an echo may name: 8 s at 1 kHz
+
+    def __init__(self, config: LeaderConfig, wand_start, robot_start, *,
+                 admission: Admission | None = None, session: int | None = None) -> None:
         self.config = config
+        self.admission = admission if admission is not None else Admission()
+        self.session = new_session() if session is None else session
+        self._sent = OrderedDict()  # sequence -> stamp of the latest commands
         self.map = WorkspaceMap(config.position_scale, config.force_scale, wand_start,
                                 robot_start)
         self.passivity = OperatorPassivity()
@@ -94,28 +125,56 @@ class Leader:
         self._shown: RemotePlane | None = None  # the plane last shown, shift included
         self._shift = np.zeros(3)  # [m] wand frame: how far it is shown out from the estimate
         self._reserve = 0.0  # [J] energy model updates took out of the wand's spring, net
+        self._rejoining = False  # giving back the shift a silence left
+        self._shown_at = 0.0  # [s] when the plane was last shown
         self._coupling: VirtualCoupling | None = None  # tdpa, while the link is live
 
-    def receive(self, now: float, feedback: Feedback) -> bool:
-        """Take ``feedback`` arrived at ``now`` (s); False if it is not newer than the held one."""
-        if self._feedback is not None and feedback.stamp <= self._feedback.stamp:
-            return False
+    def receive(self, now: float, feedback: Feedback) -> Refusal | None:
+        """Take ``feedback`` arrived at ``now`` (s); return None, or why it was refused."""
+        refusal = (feedback_refusal(feedback) or self._echo_refusal(now, feedback)
+                   or self.admission.admit(now, feedback.session, feedback.sequence,
+                                           feedback.stamp))
+        if refusal is not None:
+            return refusal
         self._feedback, self._heard = feedback, now
         self.passivity.books.receive(feedback.energy_in)
-        if feedback.echo > 0.0:
+        if feedback.echo_sequence:
             replied = feedback.stamp
             self.round_trip.add(feedback.echo, replied - feedback.echo_hold, replied, now)
-        return True
+        return None
+
+    def _echo_refusal(self, now: float, feedback: Feedback) -> Refusal | None:
+        """Why ``feedback``'s echo cannot be of a command sent here, if it cannot."""
+        if not feedback.echo_sequence:
+            return None  # the far end has heard no command yet
+        sent = self._sent.get(feedback.echo_sequence)
+        if sent is None or abs(sent - feedback.echo) > _STAMP_ROUNDING:
+            return Refusal('echo of no command sent here', f'sequence '
+                           f'{feedback.echo_sequence} stamped {feedback.echo:.6f} s')
+        if now - sent < feedback.echo_hold:
+            return Refusal('echo held longer than its round trip',
+                           f'{feedback.echo_hold:.3f} s in {now - sent:.3f} s')
+        return None
 
     def live(self, now: float) -> bool:
         """Whether feedback came within ``link_timeout`` before ``now``."""
         return now - self._heard <= self.config.link_timeout
 
-    def command(self, stamp: float, wand, wand_velocity) -> Command:
-        """Return the command for the wand's pose stamped ``stamp`` (s, this site's clock)."""
+    def command(self, stamp: float, wand, wand_velocity) -> Command | None:
+        """Return the command for the wand's pose stamped ``stamp`` (s, this site's clock).
+
+        None while the feedback is silent: the robot holds rather than follow an operator who
+        feels nothing.
+        """
+        if not self.live(stamp):
+            return None
         target = self.map.to_robot(wand) + self.map.position_scale * self._shift
+        sequence = next(reversed(self._sent), 0) + 1
+        self._sent[sequence] = stamp
+        if len(self._sent) > self.SENT_KEPT:
+            self._sent.popitem(last=False)
         return Command(stamp, target, self.map.velocity_to_robot(wand_velocity),
-                       self.passivity.books.energy_in)
+                       self.passivity.books.energy_in, self.session, sequence)
 
     def force(self, now: float, wand, wand_velocity, dt: float) -> np.ndarray:
         """Return what the wand at ``wand`` (3,) m should push with over the next ``dt`` s, N.
@@ -148,6 +207,7 @@ class Leader:
         None too while the link is silent or the clutch is engaged.
         """
         if not self.live(now) or self.map.clutched or self._feedback.plane is None:
+            self._rejoining = self._rejoining or not self.live(now)
             self._shown, self._shift, self._reserve = None, np.zeros(3), 0.0
             return None
         remote = self._feedback.plane
@@ -158,11 +218,29 @@ class Leader:
         depth = _depth(point, remote.normal, wand)
         allowed = (math.sqrt(2.0 * max(affordable, 0.0) / stiffness) if stiffness > 0.0
                    else math.inf)
-        self._shift = max(depth - allowed, 0.0) * remote.normal
+        shift = max(depth - allowed, 0.0)  # [m] the least a passive update is shown moved out
+        if self._rejoining and self._shown is not None:
+            shift = self._given_back(shift, float(self._shift @ remote.normal), now)
+        self._shift = shift * remote.normal
         self._shown = RemotePlane(point - self._shift, remote.normal, stiffness,
                                   self.map.felt_gain(remote.damping))
-        self._reserve = affordable - _stored(self._shown, wand)
+        self._reserve = max(affordable - _stored(self._shown, wand), 0.0)
+        self._shown_at = now
         return self._shown
+
+    def _given_back(self, passive: float, shown: float, now: float) -> float:
+        """Return the shift (m) after giving back what a silence left, at ``rejoin_speed``.
+
+        An update that needs more than is shown is shown as passivity asks; else the shift
+        shrinks at the rejoin speed, or to what passivity allows if that is less. Once it is
+        all given back, updates are passive again.
+        """
+        if passive > shown + _ROUNDING:
+            return passive
+        step = self.config.rejoin_speed / self.map.position_scale * (now - self._shown_at)
+        shift = min(passive, max(shown - step, 0.0))
+        self._rejoining = shift > 0.0
+        return shift
 
 
 def _stored(plane: RemotePlane, wand) -> float:

@@ -16,24 +16,25 @@ import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
-from haptic_msgs.msg import ContactModel, TeleopCommand, TeleopFeedback
+from haptic_msgs.msg import ContactModel
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.qos import LATCHED_QOS
+from haptic_util.qos import LATCHED_QOS, LINK_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
+from remote_probe.admission import Admission, AdmissionConfig, Refusal
 from remote_probe.leader import Leader, LeaderConfig
+from remote_probe.link_messages import (COMMAND, command_fields, FEEDBACK,
+                                        feedback_from_fields)
 from remote_probe.params import LeaderParams
-from remote_probe.teleop import Feedback, RemotePlane
+from remote_probe.teleop import feedback_refusal
 from remote_probe.virtual_coupling import CouplingConfig
 
 __all__ = ['LeaderNode', 'main']
 
-COMMAND = MessageCodec(TeleopCommand)
-FEEDBACK = MessageCodec(TeleopFeedback)
 MODEL = MessageCodec(ContactModel)
 POSE = MessageCodec(PoseStamped)
 TWIST = MessageCodec(TwistStamped)
@@ -54,7 +55,11 @@ class LeaderNode(Node):
                                        CouplingConfig(params.coupling_mass,
                                                       params.coupling_stiffness,
                                                       params.coupling_damping,
-                                                      params.coupling_ground_damping))
+                                                      params.coupling_ground_damping),
+                                       params.rejoin_speed)
+            self._admission = AdmissionConfig(
+                max_age=params.max_feedback_age, max_lead=params.max_stamp_lead,
+                session_timeout=params.session_timeout)
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self.leader: Leader | None = None  # from the first feedback on
@@ -65,13 +70,16 @@ class LeaderNode(Node):
         self._clutch = False
         self._refused = Tally()
         self._answers = 0
+        self._withheld = 0  # poses whose command was not sent: the feedback was silent
         self._command_pub = stream_publisher(self, COMMAND, 'teleop/command')
         answer = ((MODEL, 'wand/contact_model') if params.scheme == 'model'
                   else (WRENCH, 'wand/wrench'))
         self._answer_pub = stream_publisher(self, *answer)
-        stream_subscription(self, POSE, 'wand/pose', self.on_pose)
-        stream_subscription(self, TWIST, 'wand/twist', self.on_twist)
-        stream_subscription(self, FEEDBACK, 'teleop/feedback', self.on_feedback)
+        for codec, topic, callback in ((POSE, 'wand/pose', self.on_pose),
+                                       (TWIST, 'wand/twist', self.on_twist)):
+            stream_subscription(self, codec, topic, callback, refused=self._refused)
+        stream_subscription(self, FEEDBACK, 'teleop/feedback', self.on_feedback,
+                            refused=self._refused, qos=LINK_QOS)
         self.create_subscription(Bool, 'teleop/clutch', self.on_clutch, LATCHED_QOS)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         self.get_logger().info(f'{params.scheme} scheme: force x{params.force_scale:g}, '
@@ -81,26 +89,25 @@ class LeaderNode(Node):
         return clock_ns(self.get_clock()) * 1e-9
 
     def on_feedback(self, fields: Sequence) -> None:
-        if fields[2] != self.params.robot_frame:
-            self._refused.add(f'feedback in frame {fields[2]!r}')
-            return
-        values = np.array(fields[5:29], dtype=np.float64)
-        if not np.all(np.isfinite(values)):
-            self._refused.add('feedback not finite')
-            return
-        plane = None
-        if fields[13] == TeleopFeedback.KIND_PLANE:
-            plane = RemotePlane(values[9:12], values[12:15], values[15], values[18])
-        feedback = Feedback(fields[0] + fields[1] * 1e-9, fields[3] + fields[4] * 1e-9,
-                            values[0], values[1:4], values[4:7], values[7], plane)
-        if self.leader is None:
-            if self._pending is None:
-                return  # the wand's start is not known yet
-            self.leader = Leader(self.config, self._pending[1], feedback.tcp)
+        frame, feedback = feedback_from_fields(fields)
+        if frame != self.params.robot_frame:
+            self._refuse(Refusal('in another frame', repr(frame)))
+        elif self.leader is not None:
+            self._refuse(self.leader.receive(self._now(), feedback))
+        elif self._pending is not None:  # the wand's start is known: the session starts
+            refusal = feedback_refusal(feedback)
+            if refusal is not None:
+                self._refuse(refusal)
+                return
+            self.leader = Leader(self.config, self._pending[1], feedback.tcp,
+                                 admission=Admission(self._admission))
             self.get_logger().info(f'robot found at {np.round(feedback.tcp, 4).tolist()} m: '
-                                   'following the wand')
-        if not self.leader.receive(self._now(), feedback):
-            self._refused.add('feedback older than the held one')
+                                   f'following the wand (session {self.leader.session:#x})')
+            self._refuse(self.leader.receive(self._now(), feedback))
+
+    def _refuse(self, refusal: Refusal | None) -> None:
+        if refusal is not None:
+            self._refused.add(f'feedback {refusal.kind}', refusal.detail)
 
     def on_pose(self, fields: Sequence) -> None:
         if fields[2] != self.params.frame_id:
@@ -132,9 +139,10 @@ class LeaderNode(Node):
         period = (stamp_ns - self._last_stamp_ns) * 1e-9 if self._last_stamp_ns else 1e-3
         self._last_stamp_ns = stamp_ns
         command = self.leader.command(stamp_ns * 1e-9, position, velocity)
-        self._command_pub.publish((
-            *divmod(stamp_ns, 1_000_000_000), self.params.robot_frame,
-            *command.position.tolist(), *command.velocity.tolist(), command.energy_in))
+        if command is None:
+            self._withheld += 1
+        else:
+            self._command_pub.publish(command_fields(command, self.params.robot_frame))
         now = self._now()
         if self.params.scheme == 'model':
             self._answer(stamp_ns, self.leader.plane(now, position), position)
@@ -177,7 +185,8 @@ class LeaderNode(Node):
         values = {'published': self._answers, 'link_live': live,
                   'round_trip_s': math.nan if round_trip is None else round_trip,
                   'clutched': leader is not None and leader.map.clutched,
-                  'refused': self._refused.total()}
+                  'withheld': self._withheld, 'refused': self._refused.total(),
+                  **{f'refused: {kind}': n for kind, n in self._refused.counts.items()}}
         if leader is not None:
             values['operator_energy_out_j'] = leader.passivity.books.energy_out
         message = ('waiting for the robot' if leader is None else

@@ -2,7 +2,10 @@
 from dataclasses import dataclass
 
 from haptic_util.parameters import parameter
-from remote_probe.teleop import SCHEMES
+from remote_probe.admission import AdmissionConfig
+from remote_probe.leader import LeaderConfig
+from remote_probe.safety import SafetyConfig
+from remote_probe.teleop import HAND_SPEED, SCHEMES
 
 __all__ = ['FollowerParams', 'LeaderParams', 'SimulatedRobotParams']
 
@@ -34,6 +37,17 @@ class SimulatedRobotParams:
     sensor_bandwidth: float = parameter(200.0, 'F/T sensor first-order cut-off', unit='Hz',
                                         low=1.0)
     seed: int = parameter(0, 'seed of the sensor noise', low=0)
+    max_patient_force: float = parameter(SafetyConfig.max_patient_force, 'the robot keeps each '
+                                         'target within the reach of its own TCP at which its '
+                                         'spring presses this hard', unit='N', low=0.1)
+    force_margin: float = parameter(SafetyConfig.force_margin, 'the spring stays this far below '
+                                    'the limit', unit='N', low=0.0)
+    target_timeout: float = parameter(SafetyConfig.link_timeout, 'no target for this long: hold '
+                                      'the TCP, then retract', unit='s', low=0.001)
+    release_force: float = parameter(SafetyConfig.release_force, 'retraction stops below this '
+                                     'force', unit='N', low=0.0)
+    retract_speed: float = parameter(SafetyConfig.retract_speed, 'retraction speed', unit='m/s',
+                                     low=1e-4)
 
 
 @dataclass(frozen=True)
@@ -50,18 +64,37 @@ class FollowerParams:
                                 'of contact; empty: only what contact teaches')
     robot_stiffness: float = parameter(1500.0, 'the robot\'s impedance stiffness', unit='N/m',
                                        low=1.0)
-    max_patient_force: float = parameter(20.0, 'the force the patient may feel at most',
-                                         unit='N', low=0.1)
-    force_margin: float = parameter(1.0, 'the spring stays this far below the limit', unit='N',
-                                    low=0.0)
-    link_timeout: float = parameter(0.1, 'no command for this long: hold, then retract',
-                                    unit='s', low=0.001)
-    release_force: float = parameter(1.0, 'retraction stops below this force', unit='N',
-                                     low=0.0)
-    retract_speed: float = parameter(0.02, 'retraction speed', unit='m/s', low=1e-4)
+    max_patient_force: float = parameter(SafetyConfig.max_patient_force, 'the force the patient '
+                                         'may feel at most', unit='N', low=0.1)
+    force_margin: float = parameter(SafetyConfig.force_margin, 'the spring stays this far below '
+                                    'the limit', unit='N', low=0.0)
+    link_timeout: float = parameter(SafetyConfig.link_timeout, 'no command for this long: hold '
+                                    'the TCP, then retract', unit='s', low=0.001)
+    release_force: float = parameter(SafetyConfig.release_force, 'retraction stops below this '
+                                     'force', unit='N', low=0.0)
+    retract_speed: float = parameter(SafetyConfig.retract_speed, 'retraction speed', unit='m/s',
+                                     low=1e-4)
+    rejoin_speed: float = parameter(SafetyConfig.rejoin_speed, 'once commands come again, the '
+                                    'target goes back to the operator\'s this fast', unit='m/s',
+                                    low=1e-4)
     drift_rate: float = parameter(2.0, 'tdpa: drift compensation rate', unit='1/s', low=0.0)
     sensor_timeout: float = parameter(0.05, 'no F/T wrench or TCP pose for this long: no force '
                                       'is fed back', unit='s', low=0.001)
+    max_command_speed: float = parameter(HAND_SPEED, 'a command asking a speed above this is '
+                                         'refused: no hand moves a wand faster', unit='m/s',
+                                         low=0.01)
+    max_command_age: float = parameter(AdmissionConfig.max_age, 'after a silence this long, a '
+                                       'command later than the link\'s best by more than this '
+                                       'is dropped (a stalled link\'s backlog)', unit='s',
+                                       low=0.001)
+    max_stamp_lead: float = parameter(AdmissionConfig.max_lead, 'a command stamped earlier than '
+                                      'the link allows by more than this is refused', unit='s',
+                                      low=0.001)
+    session_timeout: float = parameter(AdmissionConfig.session_timeout, 'the followed '
+                                       'operator\'s silence after which another may take over',
+                                       unit='s', low=0.01)
+    max_command_rate: float = parameter(AdmissionConfig.max_rate, 'commands of the session taken '
+                                        'per second at most', unit='Hz', low=1.0)
 
 
 @dataclass(frozen=True)
@@ -87,3 +120,15 @@ class LeaderParams:
                                       'pose\'s stamp', unit='s', low=0.0005, high=1.0)
     model_radius: float = parameter(0.01, 'a rendered model holds this far from the wand',
                                     unit='m', low=1e-4, high=1.0)
+    rejoin_speed: float = parameter(LeaderConfig.rejoin_speed, 'model: after a silence, the '
+                                    'shift it left is given back this fast, at the robot',
+                                    unit='m/s', low=1e-4)
+    max_feedback_age: float = parameter(AdmissionConfig.max_age, 'after a silence this long, '
+                                        'feedback later than the link\'s best by more than '
+                                        'this is dropped', unit='s', low=0.001)
+    max_stamp_lead: float = parameter(AdmissionConfig.max_lead, 'feedback stamped earlier than '
+                                      'the link allows by more than this is refused', unit='s',
+                                      low=0.001)
+    session_timeout: float = parameter(AdmissionConfig.session_timeout, 'the remote site\'s '
+                                       'silence after which another may take over', unit='s',
+                                       low=0.01)

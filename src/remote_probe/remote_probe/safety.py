@@ -13,11 +13,15 @@ that protect the patient must hold at the robot's side, on its own measurements,
   the bound), tens of newtons on a stiff one (20 kN/m at 0.18 m/s), which this bound does not
   cover; a speed limit near contact would.
 - **Link watchdog.** When nothing has come from the operator for longer than ``link_timeout``
-  (never heard counts as silent), the robot stops following the operator: it holds its last
-  safe target, so the TCP stays where it is, then draws that target back along the measured
-  force's direction (out of the patient, as the tissue pushes) at ``retract_speed`` until the
-  measured force is below ``release_force``. Targets are followed again as soon as a message
-  comes.
+  (never heard counts as silent), the robot stops following the operator: it holds the TCP where
+  it is, not the last target (which lies up to the force bound's reach further in, and pressed
+  on: 12.8 N became 16.5 N over a 0.5 s stall), so its spring lets go at once and the tissue
+  pushes the probe back; and it draws that hold back along the measured force's direction (out
+  of the patient, as the tissue pushes) at ``retract_speed`` while the measured force is above
+  ``release_force``.
+- **Rejoining.** When messages come again, the target goes from where the robot held to the
+  operator's at ``rejoin_speed``, not in one step: the robot and the operator meet again without
+  a jump, however far apart the silence left them.
 """
 
 from dataclasses import dataclass
@@ -48,6 +52,8 @@ class SafetyConfig:
     release_force : float, N
         The retraction stops once the measured force is below this.
     retract_speed : float, m/s
+    rejoin_speed : float, m/s
+        How fast the target goes back to the operator's once the link is heard again.
     """
 
     robot_stiffness: float
@@ -56,9 +62,11 @@ class SafetyConfig:
     link_timeout: float = 0.1
     release_force: float = 1.0
     retract_speed: float = 0.02
+    rejoin_speed: float = 0.05
 
     def __post_init__(self):
-        for name in ('robot_stiffness', 'max_patient_force', 'link_timeout', 'retract_speed'):
+        for name in ('robot_stiffness', 'max_patient_force', 'link_timeout', 'retract_speed',
+                     'rejoin_speed'):
             finite_number(getattr(self, name), f'SafetyConfig.{name}', minimum=0.0, strict=True)
         finite_number(self.force_margin, 'SafetyConfig.force_margin', minimum=0.0,
                       maximum=self.max_patient_force)
@@ -92,6 +100,11 @@ class LinkWatchdog:
         time = finite_number(time, 'LinkWatchdog.heard time')
         self._last_heard = max(self._last_heard, time)
 
+    @property
+    def heard_any(self) -> bool:
+        """Whether anything was ever heard."""
+        return self._last_heard > -math.inf
+
     def silent(self, now: float) -> bool:
         """Whether nothing was heard in the ``timeout`` before ``now`` s (or ever)."""
         return now - self._last_heard > self.timeout
@@ -109,7 +122,7 @@ class PatientSafety:
         self.config = config
         self.watchdog = LinkWatchdog(config.link_timeout)
         self._hold: np.ndarray | None = None  # the held target while the link is silent
-        self._last_target: np.ndarray | None = None
+        self._rejoin: np.ndarray | None = None  # the target on its way back to the operator's
         self._last_tick: float | None = None
 
     @property
@@ -141,13 +154,16 @@ class PatientSafety:
         elapsed = 0.0 if self._last_tick is None else max(now - self._last_tick, 0.0)
         self._last_tick = now
         if self.watchdog.silent(now):
-            if self._hold is None:
-                self._hold = tcp if self._last_target is None else self._last_target
+            self._hold = tcp if self._hold is None else self._hold
             self._hold = target = self._retracted(self._hold, measured_force, elapsed)
+            if self.watchdog.heard_any:  # a silence after following, not the start
+                self._rejoin = self._hold
         else:
             self._hold = None
-        self._last_target = within_force_bound(target, tcp, self.config.spring_reach)
-        return self._last_target
+            if self._rejoin is not None:
+                self._rejoin = _toward(self._rejoin, target, self.config.rejoin_speed * elapsed)
+                target = target if self._rejoin is None else self._rejoin
+        return within_force_bound(target, tcp, self.config.spring_reach)
 
     def _retracted(self, hold: np.ndarray, measured_force: np.ndarray,
                    elapsed: float) -> np.ndarray:
@@ -156,3 +172,12 @@ class PatientSafety:
         if magnitude <= self.config.release_force:
             return hold
         return hold + measured_force * (self.config.retract_speed * elapsed / magnitude)
+
+
+def _toward(start: np.ndarray, goal: np.ndarray, step: float) -> np.ndarray | None:
+    """Return ``start`` moved ``step`` m toward ``goal``; None once it is there."""
+    offset = goal - start
+    length = float(np.linalg.norm(offset))
+    if length <= step:
+        return None
+    return start + offset * (step / length)

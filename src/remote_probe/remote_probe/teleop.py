@@ -2,18 +2,41 @@
 
 ``Command`` goes from the operator to the robot with every wand pose; ``Feedback`` comes back.
 Both are in the robot's base frame and SI units; the ROS nodes read them from and write them to
-``haptic_msgs/TeleopCommand`` and ``TeleopFeedback``.
+``haptic_msgs/TeleopCommand`` and ``TeleopFeedback`` (``remote_probe.link_messages``).
+
+What arrives is checked at the door (``command_refusal``, ``feedback_refusal``) before anything
+uses it: finite, and within what the physics allows. A number far outside that is not a fast
+operator or a hard press but a broken or hostile peer, and one absurd value (a speed of 1e308
+m/s) used once poisons every energy book after it.
 """
+import math
+import secrets
 from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ['Command', 'Feedback', 'RemotePlane', 'SCHEMES']
+from remote_probe.admission import Refusal
+
+__all__ = ['Command', 'CommandLimits', 'Feedback', 'HAND_SPEED', 'RemotePlane', 'SCHEMES',
+           'command_refusal', 'feedback_refusal', 'new_session']
 
 SCHEMES = ('direct', 'tdpa', 'model')
 """The bilateral schemes: direct force reflection (the baseline), time-domain passivity on both
 ports (Artigas et al. 2011), and model-mediated teleoperation (the device renders the remote
 site's estimate of the contact)."""
+
+HAND_SPEED = 5.0  # [m/s] no hand moves a wand faster (fast jabs reach 1-2 m/s)
+MAX_FEEDBACK_FORCE = 500.0  # [N] beyond the range of any F/T sensor that holds a probe
+MAX_FEEDBACK_REACH = 10.0  # [m] a TCP or contact point farther from the robot's base
+MAX_PLANE_STIFFNESS = 1e6  # [N/m] stiffer than bone under a probe
+MAX_PLANE_DAMPING = 1e4  # [N·s/m]
+MAX_ECHO_HOLD = 60.0  # [s] a command held longer than this at the robot is no echo
+UNIT_TOLERANCE = 1e-6  # how far from unit length a normal may be
+
+
+def new_session() -> int:
+    """Return a session id: 63 random bits, never 0 (which says "none")."""
+    return secrets.randbits(63) | 1
 
 
 class Command(NamedTuple):
@@ -27,12 +50,16 @@ class Command(NamedTuple):
     velocity : (3,) float, m/s
     energy_in : float, J
         Energy into the link at the operator's port so far.
+    session, sequence : int
+        The operator's session, and the command's number in it (from 1).
     """
 
     stamp: float
     position: np.ndarray
     velocity: np.ndarray
     energy_in: float
+    session: int = 0
+    sequence: int = 0
 
 
 class RemotePlane(NamedTuple):
@@ -62,6 +89,10 @@ class Feedback(NamedTuple):
         Energy into the link at the robot's port so far.
     plane : RemotePlane or None
         The latest contact estimate; None before any contact.
+    session, sequence : int
+        The remote site's session, and the feedback's number in it (from 1).
+    echo_sequence : int
+        The echoed command's sequence; 0 before any.
     """
 
     stamp: float
@@ -71,3 +102,71 @@ class Feedback(NamedTuple):
     tcp: np.ndarray
     energy_in: float
     plane: RemotePlane | None
+    session: int = 0
+    sequence: int = 0
+    echo_sequence: int = 0
+
+
+class CommandLimits(NamedTuple):
+    """What a command may ask of the robot: its workspace box (m) and a speed (m/s).
+
+    The speed bounds the operator's hand, not the robot: the robot moves no faster than it can
+    whatever it is asked, but a hand never moves a wand at 1e308 m/s, and ``tdpa`` integrates it.
+    """
+
+    workspace_lower: np.ndarray
+    workspace_upper: np.ndarray
+    max_speed: float
+
+
+def command_refusal(command: Command, limits: CommandLimits) -> Refusal | None:
+    """Return why ``command`` must not be used, or None if it is within ``limits``."""
+    values = (command.stamp, *command.position, *command.velocity, command.energy_in)
+    if not all(map(math.isfinite, values)):
+        return Refusal('not finite', _numbers(values))
+    if not all(low <= x <= high for low, x, high in zip(
+            limits.workspace_lower, command.position, limits.workspace_upper)):
+        return Refusal('outside the workspace', _numbers(command.position))
+    speed = math.hypot(*command.velocity)
+    if speed > limits.max_speed:
+        return Refusal('faster than a hand', f'{speed:.3g} m/s')
+    if command.energy_in < 0.0:
+        return Refusal('negative energy', f'{command.energy_in:.3g} J')
+    return None
+
+
+def feedback_refusal(feedback: Feedback) -> Refusal | None:
+    """Return why ``feedback`` must not be used, or None if it is physically plausible."""
+    plane = feedback.plane
+    values = (feedback.stamp, feedback.echo, feedback.echo_hold, *feedback.force, *feedback.tcp,
+              feedback.energy_in,
+              *(() if plane is None else (*plane.point, *plane.normal, plane.stiffness,
+                                          plane.damping)))
+    if not all(map(math.isfinite, values)):
+        return Refusal('not finite', _numbers(values))
+    if _length(feedback.force) > MAX_FEEDBACK_FORCE:
+        return Refusal('force beyond any sensor', _numbers(feedback.force))
+    if _length(feedback.tcp) > MAX_FEEDBACK_REACH:
+        return Refusal('TCP out of reach', _numbers(feedback.tcp))
+    if feedback.energy_in < 0.0:
+        return Refusal('negative energy', f'{feedback.energy_in:.3g} J')
+    if not 0.0 <= feedback.echo_hold <= MAX_ECHO_HOLD:
+        return Refusal('echo held impossibly long', f'{feedback.echo_hold:.3g} s')
+    if plane is not None:
+        if abs(_length(plane.normal) - 1.0) > UNIT_TOLERANCE:
+            return Refusal('plane normal not unit', _numbers(plane.normal))
+        if _length(plane.point) > MAX_FEEDBACK_REACH:
+            return Refusal('plane out of reach', _numbers(plane.point))
+        if not (0.0 <= plane.stiffness <= MAX_PLANE_STIFFNESS
+                and 0.0 <= plane.damping <= MAX_PLANE_DAMPING):
+            return Refusal('plane gains out of range',
+                           f'{plane.stiffness:.3g} N/m, {plane.damping:.3g} N·s/m')
+    return None
+
+
+def _length(vector) -> float:
+    return math.hypot(*vector)
+
+
+def _numbers(values) -> str:
+    return ', '.join(f'{float(v):.6g}' for v in values)

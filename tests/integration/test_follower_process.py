@@ -18,12 +18,14 @@ from rclpy.node import Node
 
 from haptic_bringup.launcher import loop_environment
 from haptic_bringup.processes import start_child, stop_children
-from haptic_msgs.msg import TeleopCommand, TeleopFeedback
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_msgs.msg import RobotImpedance, TeleopCommand, TeleopFeedback
+from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
+from remote_probe.link_messages import impedance_message
 
 PRESSED = 8.0  # [N] the sensor's good reading: the probe pressed on the patient
 CONNECT_TIMEOUT = 60.0  # [s] the node's imports and the phantom's mesh, on a busy machine
 SETTLE = 0.1  # [s] past a change: the feedback is at 100 Hz for the model, and in flight
+OPERATOR_SESSION = 0x5E55
 
 
 class RobotAndLink:
@@ -44,6 +46,12 @@ class RobotAndLink:
                                                    HAPTIC_STREAM_QOS)
         self.node.create_subscription(TeleopFeedback, 'teleop/feedback', self._on_feedback,
                                       HAPTIC_STREAM_QOS)
+        self._impedance = self.node.create_publisher(RobotImpedance, 'robot/impedance',
+                                                     LATCHED_QOS)
+        self._impedance.publish(impedance_message(
+            'base_link', stiffness=1500.0, max_speed=0.25, workspace_lower=(-0.4,) * 3,
+            workspace_upper=(0.4,) * 3, max_patient_force=20.0))
+        self._sequence = 0
         self.node.create_timer(0.002, self._publish)
 
     def _publish(self) -> None:
@@ -57,7 +65,8 @@ class RobotAndLink:
         wrench.header.stamp, wrench.header.frame_id = stamp, 'base_link'
         wrench.wrench.force.z = self.reading
         self._wrench.publish(wrench)
-        command = TeleopCommand()
+        self._sequence += 1
+        command = TeleopCommand(session=OPERATOR_SESSION, sequence=self._sequence)
         command.header.stamp, command.header.frame_id = stamp, 'base_link'
         command.position.z = -0.01
         self._command.publish(command)

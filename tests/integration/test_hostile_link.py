@@ -1,0 +1,218 @@
+"""A telerobotic session under attack from the remote site's network: the patient stays safe.
+
+Both sites run as real processes over the link bridge, their streams through DDS as a real
+arm's would be. A stranger process joins the remote site's DDS domain and, one after another:
+forges a command of another session stamped 10 s ahead; reads the operator's session and forges
+one in it, 10 s ahead, one numbered 2**63, and one at 1e308 m/s; sends malformed bytes on the
+command topic at 50 Hz; floods commands at 20 kHz; forges a target 60 mm deep, then a TCP pose
+50 mm below the real one (from which the commanding node would let its target go deeper).
+Every figure comes from the bag (the patient's F/T force, the wand's poses) or from the nodes'
+own reports, never from their internals.
+"""
+import threading
+import time
+
+from domains import session_domain_id
+from geometry_msgs.msg import PoseStamped
+import numpy as np
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from test_teleop import DELAY, reports, streams
+
+from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
+from haptic_msgs.msg import TeleopCommand
+from haptic_util.cdr import MalformedMessage, MessageCodec
+from haptic_util.qos import HAPTIC_STREAM_QOS
+from remote_probe.link_messages import COMMAND
+
+MAX_PATIENT_FORCE = 20.0  # [N] the follower's and the robot's default
+POSE = MessageCodec(PoseStamped)
+ATTACK_START = 5.0  # [s] after the loop closed: the scan is pressing from about 4 s
+
+
+class Stranger:
+    """A process on the remote site's network: it hears and publishes what it likes."""
+
+    def __init__(self, domain: int) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain)
+        self.node = Node('stranger', context=self.context)
+        self.heard = None  # the operator's latest command, as fields
+        self.node.create_subscription(TeleopCommand, 'teleop/command', self._hear,
+                                      HAPTIC_STREAM_QOS, raw=True)
+        self.command = self.node.create_publisher(TeleopCommand, 'teleop/command',
+                                                  HAPTIC_STREAM_QOS)
+        self.target = self.node.create_publisher(PoseStamped, 'robot/target_pose',
+                                                 HAPTIC_STREAM_QOS)
+        self.tcp = self.node.create_publisher(PoseStamped, 'robot/tcp_pose', HAPTIC_STREAM_QOS)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self._running = True
+        self._spinner = threading.Thread(target=self._spin, daemon=True)
+        self._spinner.start()
+
+    def _hear(self, data: bytes) -> None:
+        """Keep the operator's latest command: not one of ours, which it also hears."""
+        try:
+            fields = COMMAND.decode(data)
+        except MalformedMessage:
+            return
+        session = fields[COMMAND.index('session')]
+        stamp = fields[COMMAND.index('header.stamp.sec')]
+        if self.heard is None or (session == self.heard[COMMAND.index('session')]
+                                  and fields[COMMAND.index('sequence')] < 2**62
+                                  and stamp < time.time() + 1.0
+                                  and abs(fields[COMMAND.index('velocity.x')]) < 100.0):
+            self.heard = fields
+
+    def _spin(self) -> None:
+        while self._running:
+            self.executor.spin_once(timeout_sec=0.01)
+
+    def forged_command(self, *, session=None, sequence=None, sequence_step=1, ahead=0.0,
+                       velocity=0.0) -> bytes:
+        """A command like the operator's latest, in its session unless told, changed as asked."""
+        fields = list(self.heard)
+        now = time.time() + ahead
+        fields[COMMAND.index('header.stamp.sec')] = int(now)
+        fields[COMMAND.index('header.stamp.nanosec')] = int(now % 1 * 1e9)
+        if session is not None:
+            fields[COMMAND.index('session')] = session
+        fields[COMMAND.index('sequence')] = (sequence if sequence is not None else
+                                             fields[COMMAND.index('sequence')] + sequence_step)
+        fields[COMMAND.index('velocity.x')] = velocity
+        return COMMAND.encode(fields)
+
+    def pose(self, frame: str, z_offset: float) -> bytes:
+        """A pose in ``frame``, ``z_offset`` m from the real TCP's last commanded position."""
+        now = time.time()
+        position = self.heard[COMMAND.index('position.x'):COMMAND.index('position.z') + 1]
+        return POSE.encode((int(now), int(now % 1 * 1e9), frame, position[0], position[1],
+                            position[2] + z_offset, 0.0, 0.0, 0.0, 1.0))
+
+    def repeat(self, publisher, make, rate: float, duration: float) -> int:
+        """Publish ``make()`` at ``rate`` Hz for ``duration`` s; return how many."""
+        sent, start = 0, time.monotonic()
+        while time.monotonic() - start < duration:
+            publisher.publish(make())
+            sent += 1
+            lag = start + sent / rate - time.monotonic()
+            if lag > 0:
+                time.sleep(lag)
+        return sent
+
+    def close(self) -> None:
+        self._running = False
+        self._spinner.join()
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.context.try_shutdown()
+
+
+def malformed(count: int):
+    """Bytes that start like a TeleopCommand and name string lengths that cannot fit."""
+    for k in range(count):
+        yield b'\x00\x01\x00\x00' + bytes(8) + (1000 + k).to_bytes(4, 'little') + b'base_link'
+
+
+@pytest.fixture(scope='module')
+def attacked(tmp_path_factory):
+    folder = tmp_path_factory.mktemp('hostile')
+    config = LoopConfig(teleop='tdpa', duration=SCAN_DURATION, record=str(folder / 'bag'),
+                        domain_id=session_domain_id(),
+                        remote_domain=session_domain_id(second=True), run_dir=folder / 'launch',
+                        intra_process=False, link={'delay': DELAY, 'jitter': 0.1 * DELAY})
+    windows = {}
+    with Loop(config) as loop:
+        stranger = Stranger(config.remote_domain_id)
+        try:
+            time.sleep(ATTACK_START)
+            assert stranger.heard is not None, 'the operator\'s commands were never heard'
+            session = stranger.heard[COMMAND.index('session')]
+
+            def attack(name, publisher, make, rate, duration):
+                start = time.time()
+                sent = stranger.repeat(publisher, make, rate, duration)
+                windows[name] = (start, time.time(), sent)
+            attack('another session', stranger.command,
+                   lambda: stranger.forged_command(session=session ^ 1, ahead=10.0), 50, 0.5)
+            attack('ahead', stranger.command,  # numbered past the operator's next ones
+                   lambda: stranger.forged_command(ahead=10.0, sequence_step=50), 50, 0.5)
+            attack('numbered far ahead', stranger.command,
+                   lambda: stranger.forged_command(sequence=2**63), 50, 0.5)
+            attack('absurd speed', stranger.command,
+                   lambda: stranger.forged_command(velocity=-1.7e308), 50, 0.5)
+            bytes_out = malformed(10_000)
+            attack('malformed', stranger.command, lambda: next(bytes_out), 50, 1.0)
+            attack('flood', stranger.command,
+                   lambda: stranger.forged_command(session=session ^ 1), 20_000, 1.0)
+            attack('deep target', stranger.target, lambda: stranger.pose('base_link', -0.06),
+                   1000, 0.5)
+            attack('tcp below', stranger.tcp, lambda: stranger.pose('base_link', -0.05),
+                   2000, 0.5)
+            windows['quiet'] = (windows['another session'][0] - 1.0,
+                                windows['another session'][0], 0)
+        finally:
+            stranger.close()
+        assert loop.wait(60.0) is not None, 'the scan did not end'
+    return folder, streams(folder), windows
+
+
+def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
+    """Pressed within the limit through every attack; and never let go through those on the
+    link: had one locked the operator out, or a flood crowded out the operator's commands, the
+    robot would have held and retracted."""
+    _, series, windows = attacked
+    times, patient = series['/remote/robot/ft_sensor/wrench']
+    force = np.linalg.norm(patient, axis=1)
+    assert force.max() <= MAX_PATIENT_FORCE
+    for name, (start, end, _) in windows.items():
+        if name not in ('quiet', 'deep target', 'tcp below'):
+            assert force[(times >= start) & (times < end)].min() > 3.0, name
+
+
+def test_the_operator_s_site_keeps_its_rate_through_every_attack(attacked):
+    """The attacks reach the remote site only: the operator's site goes on at its rate (a forged
+    echo once took it from 954 Hz to 0). The stranger's own 20 kHz flood takes a core of the two
+    this machine has, beside the sites: during it the operator's site may lose its share of the
+    time to that, and not more."""
+    _, series, windows = attacked
+    poses = series['/wand/pose'][0]
+
+    def rate(start, end):
+        return np.count_nonzero((poses >= start) & (poses < end)) / (end - start)
+    quiet = rate(*windows['quiet'][:2])
+    for name, (start, end, _) in windows.items():
+        assert rate(start, end) >= (0.5 if name == 'flood' else 0.8) * quiet, name
+
+
+def test_each_attack_is_refused_and_named_by_the_follower(attacked):
+    folder, _, windows = attacked
+
+    def refused(kind):
+        said = reports(folder, 'teleop_follower', f'refused: {kind}')
+        return int(said[-1]) if said else 0
+    # Of the flood, DDS drops what the reader's history cannot hold while the site is busy:
+    # not a refusal, and not the operator's commands (the patient stayed pressed).
+    assert refused('command another session') > windows['another session'][2]
+    assert refused('command stamped in the future') >= windows['ahead'][2]
+    assert refused('command sequence ahead of its stamp') >= windows['numbered far ahead'][2]
+    assert refused('command faster than a hand') >= windows['absurd speed'][2]
+    assert refused('malformed teleop/command') >= 0.9 * windows['malformed'][2]
+
+
+def test_the_session_goes_on_by_itself_and_nothing_raised(attacked):
+    folder, series, windows = attacked
+    for node in ('teleop_leader', 'teleop_follower', 'sim_robot', 'wand_driver'):
+        said = reports(folder, node, 'callback_errors')
+        assert said and said[-1] == '0', node
+    last_attack = max(end for _, end, _ in windows.values())
+    assert np.count_nonzero(series['/teleop/feedback'] > last_attack) > 1000
+    tcp_times, tcp = series['/remote/robot/tcp_pose']
+    after = tcp_times > last_attack + 0.1
+    assert np.ptp(tcp[after, 2]) > 0.01  # it followed the scan's lift to the end
+    energy = reports(folder, 'teleop_leader', 'operator_energy_out_j')
+    assert energy and all(np.isfinite(float(value)) for value in energy)
