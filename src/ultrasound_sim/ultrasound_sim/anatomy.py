@@ -23,8 +23,8 @@ MEDIA_COLUMNS = ('speed_of_sound', 'impedance', 'attenuation', 'backscatter')
 """The columns of ``Anatomy.media``: m/s, kg/(m^2 s), dB/(cm MHz), and the backscatter
 amplitude a sqrt(density), with density per mm^3."""
 
-_ROUND_SECTIONS = 256  # a circle's segments: off by r (1 - cos(pi / 256)) = 7.5e-5 r
-_SPHERE_SUBDIVISIONS = 6  # icosphere edges of about r / 80: off by about 8e-5 r
+_ROUND_SECTIONS = 128  # a circle's segments: off by r (1 - cos(pi / 128)) = 3e-4 r
+_SPHERE_SUBDIVISIONS = 5  # icosphere edges of about r / 40: off by about 3e-4 r
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,9 +71,10 @@ def _mesh(shape):
     if isinstance(shape, CylinderSpec):
         return trimesh.creation.cylinder(radius=shape.radius, height=shape.height,
                                          sections=_ROUND_SECTIONS)
-    if isinstance(shape, CapsuleSpec):
-        return trimesh.creation.capsule(height=shape.length, radius=shape.radius,
-                                        count=[_ROUND_SECTIONS, _ROUND_SECTIONS // 2])
+    if isinstance(shape, CapsuleSpec):  # convex: the hull of its two end spheres, closed
+        ball = trimesh.creation.icosphere(subdivisions=_SPHERE_SUBDIVISIONS, radius=shape.radius)
+        ends = [ball.vertices + [0.0, 0.0, z] for z in (-0.5 * shape.length, 0.5 * shape.length)]
+        return trimesh.convex.convex_hull(np.vstack(ends))
     mesh = trimesh.load_mesh(Path(shape.file), process=True)
     mesh.apply_scale(shape.scale)
     return mesh

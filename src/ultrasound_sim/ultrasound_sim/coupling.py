@@ -58,8 +58,8 @@ def scanline_coupling(face_points, face_distance, settings: ProbeSettings) -> np
         return np.full(len(elements), nearest[0] <= settings.coupling_gap)
     at = np.interp(elements, along, nearest)
     for end, (a, b) in ((elements < along[0], (0, 1)), (elements > along[-1], (-2, -1))):
-        slope = (nearest[b] - nearest[a]) / (along[b] - along[a])
         with np.errstate(invalid='ignore'):  # inf - inf: a lifted end stays lifted
+            slope = (nearest[b] - nearest[a]) / (along[b] - along[a])
             at[end] = nearest[a] + slope * (elements[end] - along[a])
         at[end & ~np.isfinite(at)] = np.inf
     return at <= settings.coupling_gap
