@@ -53,5 +53,5 @@ def block_scene(folder: Path, medium: str, structures: str = '', media: dict = N
 
 
 def straight_down():
-    """The probe at the origin, looking down: (position, quaternion)."""
+    """Return the probe at the origin, looking down: (position, quaternion)."""
     return np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0])

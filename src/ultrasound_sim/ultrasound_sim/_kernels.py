@@ -87,7 +87,7 @@ def _line_hits(segments, segment_owner, count, oy, oz, dy, dz, hit_t, hit_owner)
 
 @jit
 def _top(inside, structure_medium):
-    """The medium of the last-listed structure the point is inside, or ``_OUTSIDE``."""
+    """Return the medium of the last-listed structure the point is in, or ``_OUTSIDE``."""
     for s in range(inside.shape[0] - 1, -1, -1):
         if inside[s] & 1:
             return structure_medium[s]
@@ -96,7 +96,7 @@ def _top(inside, structure_medium):
 
 @jit
 def _scatter(noise, px, py, pz, voxel):
-    """The tissue-fixed random field at a point: trilinear over a hashed grid, unit variance."""
+    """Sample the tissue-fixed random field: trilinear over a hashed grid, unit variance."""
     fx, fy, fz = px / voxel, py / voxel, pz / voxel
     ix, iy, iz = math.floor(fx), math.floor(fy), math.floor(fz)
     wx, wy, wz = fx - ix, fy - iy, fz - iz

@@ -61,7 +61,7 @@ class Anatomy:
 
 
 def _mesh(shape):
-    """A closed trimesh of a scene file's shape, in the shape's own frame."""
+    """Return a closed trimesh of a scene file's shape, in the shape's own frame."""
     import trimesh
 
     if isinstance(shape, BoxSpec):

@@ -75,7 +75,7 @@ class ScanConversion:
 
 
 def _lateral_span(settings: ProbeSettings) -> float:
-    """The distance between the outermost lines' elements (linear) or their angle (convex)."""
+    """Return the distance between the outermost lines' elements (linear) or their angle."""
     return settings.width if settings.probe_type == LINEAR else settings.angle
 
 

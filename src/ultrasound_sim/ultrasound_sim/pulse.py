@@ -89,7 +89,7 @@ def axial_pulse(settings: ProbeSettings) -> tuple[np.ndarray, float]:
 
 
 def lateral_width(settings: ProbeSettings, ranges: np.ndarray) -> np.ndarray:
-    """The two-way beam's FWHM (m) at each range (m) from the elements (module docstring)."""
+    """Return the two-way beam's FWHM (m) at each range (m) from the elements."""
     aperture = settings.width if settings.probe_type == LINEAR else \
         2.0 * settings.radius * math.sin(0.5 * settings.angle)
     f_number = np.maximum(settings.f_number, np.asarray(ranges) / aperture)
