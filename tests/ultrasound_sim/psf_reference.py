@@ -47,7 +47,7 @@ def fwhm(profile: np.ndarray, spacing: float) -> float:
 
 
 def simus_psf(probe: str, *, cycles: float, f_number: float, depth: float) -> dict:
-    """SIMUS's point target at ``depth`` below the array's centre: its probe and widths (m)."""
+    """Simulate a point target at ``depth`` below the array's centre: probe and widths (m)."""
     import pymust
 
     param = pymust.getparam(probe)
@@ -74,7 +74,7 @@ def simus_psf(probe: str, *, cycles: float, f_number: float, depth: float) -> di
 
 def model_psf(folder, *, centre_frequency: float, bandwidth: float, aperture: float,
               cycles: float, f_number: float, depth: float) -> dict:
-    """The model's image of a thin wire at ``depth`` below the face's centre: widths (m)."""
+    """Image a thin wire at ``depth`` below the face's centre with the model: widths (m)."""
     structures = f"""\
         - name: wire
           shape: {{cylinder: {{radius: {_WIRE_RADIUS:.6f}, height: 0.1}}}}

@@ -143,8 +143,8 @@ def reference_trace(imager, segments, owners, coupled, rotation, position):
                     elif after == -1:
                         r = -1.0
                     else:
-                        r = (media[after, 1] - media[medium, 1]) / (media[after, 1]
-                                                                     + media[medium, 1])
+                        z1, z2 = media[medium, 1], media[after, 1]
+                        r = (z2 - z1) / (z2 + z1)
                     if r:
                         echo = r * passed * 10 ** (-loss / 10) * np.exp(
                             -4j * np.pi * settings.centre_frequency * tau)
@@ -199,8 +199,8 @@ def test_point_spread(imager):
     shape = (imager.settings.scanlines, imager.settings.samples)
     field = rng.normal(size=shape) + 1j * rng.normal(size=shape)
     envelope = np.empty(shape, dtype=np.float32)
-    _kernels.point_spread(field, imager.psf.axial, imager.psf.lateral, np.empty_like(field),
-                          envelope)
+    _kernels.point_spread(field, imager.psf.axial, np.ascontiguousarray(imager.psf.lateral.T),
+                          np.empty_like(field), envelope)
     axial = np.array([np.convolve(row, imager.psf.axial, mode='same') for row in field])
     kl = imager.psf.lateral.shape[1] // 2
     padded = np.pad(axial, ((kl, kl), (0, 0)))

@@ -40,6 +40,16 @@ def decibels(frame, settings) -> np.ndarray:
         - settings.dynamic_range - settings.gain
 
 
+def denser_below(depth: float) -> str:
+    """Return a structure filling everything deeper than ``depth`` with the denser medium."""
+    return f"""\
+        - name: below
+          shape: {{box: {{size: [0.2, 0.2, 0.1]}}}}
+          pose: {{position: [0.0, 0.0, {-depth - 0.05!r}]}}
+          medium: denser
+        """
+
+
 def rows_depth(geometry) -> np.ndarray:
     return geometry.depth_origin + geometry.pixel_height * np.arange(geometry.height)
 
@@ -53,13 +63,7 @@ def test_a_flat_interface_appears_at_its_depth(tmp_path, speed):
     # Silent above 20 mm, a denser medium below: the one echo is the interface's. At a speed
     # of sound other than the scanner's, it appears where its echo time says: d c0 / c.
     depth = 0.02
-    structures = f"""\
-        - name: below
-          shape: {{box: {{size: [0.1, 0.1, 0.1]}}}}
-          pose: {{position: [0.0, 0.0, {-depth - 0.05!r}]}}
-          medium: denser
-        """
-    path = block_scene(tmp_path, 'upper', structures,
+    path = block_scene(tmp_path, 'upper', denser_below(depth),
                        media={'upper': (speed, 1.5e6, 0.0, 0.0, 0.0)})
     settings = ProbeSettings(depth=0.04, image_width=256, image_height=512)
     frame = image_of(path, settings)
@@ -74,13 +78,7 @@ def test_a_flat_interface_appears_at_its_depth(tmp_path, speed):
 def test_a_convex_probe_shows_a_flat_interface_flat(tmp_path):
     # Scan conversion of a fan: every column in the sector finds the plane at the same depth.
     depth = 0.03
-    structures = f"""\
-        - name: below
-          shape: {{box: {{size: [0.2, 0.2, 0.1]}}}}
-          pose: {{position: [0.0, 0.0, {-depth - 0.05!r}]}}
-          medium: denser
-        """
-    path = block_scene(tmp_path, 'silent', structures)
+    path = block_scene(tmp_path, 'silent', denser_below(depth))
     settings = ProbeSettings(probe_type='convex', centre_frequency=3.5e6, depth=0.05,
                              radius=0.05, angle=math.radians(40.0))
     frame = image_of(path, settings)
@@ -195,3 +193,25 @@ def test_fluid_enhances_what_lies_behind_it(tmp_path):
     # less what the cyst's two walls reflect.
     print(f'enhancement: behind the cyst {behind - beside:.1f} dB brighter')
     assert behind - beside > 6.0
+
+
+def test_speckle_is_fixed_to_the_tissue_not_to_the_probe(tmp_path):
+    # Slide the probe by whole line spacings along y, and push it down by whole samples: the
+    # same tissue points fall on other lines and samples, so the speckle moves by as many.
+    settings = ProbeSettings(depth=0.03, scanlines=128, samples=512)
+    imager = Imager(load_anatomy(block_scene(tmp_path, 'tissue')), settings)
+    spacing = settings.width / (settings.scanlines - 1)
+    lines, samples = 6, 20
+    position, quaternion = straight_down()
+    coupled = np.ones(settings.scanlines, dtype=bool)
+    first = imager.frame(position, quaternion, coupled).envelope
+    moved = imager.frame(position + [0.0, lines * spacing, -samples * settings.sample_spacing],
+                         quaternion, coupled).envelope
+    # Away from the edges, where the lateral kernel is whole, and past the press's first mm.
+    kept = first[lines + 8:-8, samples + 16:-16]
+    seen = moved[8:-lines - 8, 16:-samples - 16]
+    shifted = np.corrcoef(kept.ravel(), seen.ravel())[0, 1]
+    fixed_to_probe = np.corrcoef(first[8:-8, 16:-16].ravel(), moved[8:-8, 16:-16].ravel())[0, 1]
+    print(f'speckle after the move: {shifted:.4f} correlated with the tissue-shifted frame, '
+          f'{fixed_to_probe:.4f} with the unshifted one')
+    assert shifted > 0.99 and fixed_to_probe < 0.2

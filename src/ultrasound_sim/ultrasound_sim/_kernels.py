@@ -206,25 +206,28 @@ def trace_lines(segments, segment_owner, count, origins, directions, coupled, st
 def point_spread(field, axial, lateral, work, envelope):
     """Convolve the I/Q field with the axial pulse, then the lateral beam; its magnitude.
 
-    ``axial`` (2 ka + 1,) complex taps along a line; ``lateral`` (samples, 2 kl + 1) real taps
-    across lines, one row per depth (the beam widens where the aperture stops growing).
+    ``axial`` (2 ka + 1,) complex taps along a line; ``lateral`` (2 kl + 1, samples) real taps
+    across lines, one column per depth (the beam widens where the aperture stops growing).
     """
     n_lines, n_samples = field.shape
     ka = axial.shape[0] // 2
-    kl = lateral.shape[1] // 2
+    kl = lateral.shape[0] // 2
+    for line in range(n_lines):  # tap by tap over whole rows: contiguous, vectorised
+        row = work[line]
+        row[:] = 0j
+        for k in range(-ka, ka + 1):
+            tap = axial[k + ka]
+            for j in range(max(0, k), min(n_samples, n_samples + k)):
+                row[j] += tap * field[line, j - k]
+    acc = np.empty(n_samples, dtype=np.complex128)
     for line in range(n_lines):
+        acc[:] = 0j
+        for k in range(max(-kl, line - n_lines + 1), min(kl, line) + 1):
+            taps = lateral[k + kl]
+            for j in range(n_samples):
+                acc[j] += taps[j] * work[line - k, j]
         for j in range(n_samples):
-            acc = 0j
-            for k in range(max(-ka, j - n_samples + 1), min(ka, j) + 1):
-                acc += axial[k + ka] * field[line, j - k]
-            work[line, j] = acc
-    for line in range(n_lines):
-        lo, hi = max(-kl, line - n_lines + 1), min(kl, line)
-        for j in range(n_samples):
-            acc = 0j
-            for k in range(lo, hi + 1):
-                acc += lateral[j, k + kl] * work[line - k, j]
-            envelope[line, j] = abs(acc)
+            envelope[line, j] = abs(acc[j])
 
 
 @jit

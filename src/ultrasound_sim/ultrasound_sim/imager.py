@@ -106,6 +106,7 @@ class Imager:
         noise = np.random.default_rng(_NOISE_SEED).standard_normal((_NOISE_SIZE, 2))
         self._noise = ((noise[:, 0] + 1j * noise[:, 1]) / math.sqrt(2.0)).astype(np.complex128)
         self._voxel = settings.sample_spacing
+        self._lateral = np.ascontiguousarray(self.psf.lateral.T)  # taps by depth, as the kernel
         shape = (settings.scanlines, settings.samples)
         self._segments = np.empty((len(anatomy.triangles), 4))
         self._segment_owner = np.empty(len(anatomy.triangles), dtype=np.int64)
@@ -168,8 +169,7 @@ class Imager:
             settings.centre_frequency, rotation, p, self._voxel, self._noise,
             self._scatter_gain, self._field, self._hit_t, self._hit_owner, self._inside)
         envelope = np.empty((settings.scanlines, settings.samples), dtype=np.float32)
-        _kernels.point_spread(self._field, self.psf.axial, self.psf.lateral, self._work,
-                              envelope)
+        _kernels.point_spread(self._field, self.psf.axial, self._lateral, self._work, envelope)
         envelope[~mask] = 0.0
         geometry = self.conversion.geometry
         image = np.empty((geometry.height, geometry.width), dtype=np.uint8)
