@@ -68,6 +68,7 @@ class ProbeSettings:
         The beam's elevation width: with the in-plane cell, the volume whose scatterers make one
         speckle grain.
     gain : float, dB
+        Added to every echo level (20 dB: the phantom's tissues in the middle greys).
     tgc : tuple of float, dB
         Time-gain compensation: gains at depths spread evenly from the face to ``depth``,
         interpolated between (all zero: off).
@@ -94,7 +95,7 @@ class ProbeSettings:
     image_height: int = 256
     f_number: float = 1.5
     slice_thickness: float = 1.0e-3
-    gain: float = 0.0
+    gain: float = 20.0
     tgc: tuple = (0.0,) * 8
     dynamic_range: float = 60.0
     speed_of_sound: float = 1540.0
