@@ -13,8 +13,6 @@ from scipy import ndimage
 
 from ultrasound_sim import _kernels, Imager, load_anatomy, ProbeSettings
 
-MASK = np.uint64(0xFFFF)
-
 
 @pytest.fixture(scope='module')
 def imager(tmp_path_factory):
@@ -76,7 +74,7 @@ def test_section(imager):
     np.testing.assert_array_equal(owners[:count], expected_owners)
 
 
-def reference_noise(noise, point, voxel):
+def reference_noise(noise, keys, point, voxel):
     scaled = np.asarray(point) / voxel
     base = np.floor(scaled).astype(np.int64)
     frac = scaled - base
@@ -84,13 +82,9 @@ def reference_noise(noise, point, voxel):
     for corner in range(8):
         offset = np.array([corner & 1, (corner >> 1) & 1, (corner >> 2) & 1])
         w = np.prod(np.where(offset == 1, frac, 1.0 - frac))
-        keys = [np.uint64(int(v) & 0x1FFFFF) for v in base + offset]
-        key = keys[0] | (keys[1] << np.uint64(21)) | (keys[2] << np.uint64(42))
-        with np.errstate(over='ignore'):
-            key = (key ^ (key >> np.uint64(31))) * np.uint64(0x7FB5D329728EA185)
-            key = (key ^ (key >> np.uint64(27))) * np.uint64(0x81DADEF4BC2DD44D)
-        key = key ^ (key >> np.uint64(33))
-        total += w * noise[int(key & MASK)]
+        node = (base + offset) % 4096
+        key = keys[0, node[0]] ^ keys[1, node[1]] ^ keys[2, node[2]]
+        total += w * noise[key % 4096]
         norm += w * w
     return total / math.sqrt(norm)
 
@@ -167,7 +161,8 @@ def reference_trace(imager, segments, owners, coupled, rotation, position):
             point = position + rotation @ np.array([0.0, *(o + s * d)])
             field[line, j] += (media[medium, 3] * imager._scatter_gain[j] * passed
                                * 10 ** (-loss / 10)
-                               * reference_noise(imager._noise, point, imager._voxel))
+                               * reference_noise(imager._noise, imager._keys, point,
+                                                 imager._voxel))
     return field
 
 
@@ -185,7 +180,7 @@ def test_trace_lines(imager):
                          coupled, anatomy.structure_medium, imager._media,
                          settings.sample_spacing / settings.speed_of_sound,
                          settings.speed_of_sound, settings.centre_frequency, rotation, POSE[0],
-                         imager._voxel, imager._noise, imager._scatter_gain, field,
+                         imager._voxel, imager._noise, imager._keys, imager._scatter_gain, field,
                          np.empty(256), np.empty(256, dtype=np.int64),
                          np.empty(len(anatomy.names), dtype=np.int64))
     expected = reference_trace(imager, segments[:count], owners[:count], coupled, rotation,

@@ -22,7 +22,8 @@ _OUTSIDE = -1
 # media columns (``anatomy.MEDIA_COLUMNS``)
 _SPEED, _IMPEDANCE, _ATTENUATION, _BACKSCATTER = 0, 1, 2, 3
 _LN10_OVER_10 = math.log(10.0) / 10.0
-_NOISE_MASK = np.uint64(0xFFFF)  # the noise table holds 2**16 values
+_NOISE_MASK = 0xFFF  # the noise table holds 2**12 values (64 KB: it stays in cache)
+_AXIS_MASK = 0xFFF  # each axis's key table too: the field repeats every 2**12 voxels
 
 
 @jit
@@ -95,23 +96,25 @@ def _top(inside, structure_medium):
 
 
 @jit
-def _scatter(noise, px, py, pz, voxel):
-    """Sample the tissue-fixed random field: trilinear over a hashed grid, unit variance."""
+def _scatter(noise, keys, px, py, pz, voxel):
+    """Sample the tissue-fixed random field: trilinear over a hashed grid, unit variance.
+
+    A grid node's value is ``noise`` at the xor of its three coordinates' ``keys`` (simple
+    tabulation hashing: each axis's key from a table of random words, 3-independent).
+    """
     fx, fy, fz = px / voxel, py / voxel, pz / voxel
     ix, iy, iz = math.floor(fx), math.floor(fy), math.floor(fz)
     wx, wy, wz = fx - ix, fy - iy, fz - iz
+    x0, x1 = keys[0, ix & _AXIS_MASK], keys[0, (ix + 1) & _AXIS_MASK]
+    y0, y1 = keys[1, iy & _AXIS_MASK], keys[1, (iy + 1) & _AXIS_MASK]
+    z0, z1 = keys[2, iz & _AXIS_MASK], keys[2, (iz + 1) & _AXIS_MASK]
     total = 0j
     norm = 0.0
     for corner in range(8):
         cx, cy, cz = corner & 1, (corner >> 1) & 1, (corner >> 2) & 1
         w = ((wx if cx else 1.0 - wx) * (wy if cy else 1.0 - wy) * (wz if cz else 1.0 - wz))
-        key = (np.uint64(np.int64(ix + cx) & 0x1FFFFF)
-               | (np.uint64(np.int64(iy + cy) & 0x1FFFFF) << np.uint64(21))
-               | (np.uint64(np.int64(iz + cz) & 0x1FFFFF) << np.uint64(42)))
-        key = (key ^ (key >> np.uint64(31))) * np.uint64(0x7FB5D329728EA185)
-        key = (key ^ (key >> np.uint64(27))) * np.uint64(0x81DADEF4BC2DD44D)
-        key = key ^ (key >> np.uint64(33))
-        total += w * noise[np.intp(key & _NOISE_MASK)]
+        key = (x1 if cx else x0) ^ (y1 if cy else y0) ^ (z1 if cz else z0)
+        total += w * noise[key & _NOISE_MASK]
         norm += w * w
     return total / math.sqrt(norm)
 
@@ -119,7 +122,7 @@ def _scatter(noise, px, py, pz, voxel):
 @jit
 def trace_lines(segments, segment_owner, count, origins, directions, coupled, structure_medium,
                 media, dtau, speed_of_sound, centre_frequency, rotation, position, voxel, noise,
-                scatter_gain, field, hit_t, hit_owner, inside):
+                keys, scatter_gain, field, hit_t, hit_owner, inside):
     """Follow each coupled scanline through the cut anatomy; write its I/Q echo into ``field``.
 
     Along the line, in echo time: two-way attenuation at the centre frequency; at each change of
@@ -199,7 +202,7 @@ def trace_lines(segments, segment_owner, count, origins, directions, coupled, st
             pz = position[2] + rotation[2, 1] * y + rotation[2, 2] * z
             field[line, j] += (media[medium, _BACKSCATTER] * scatter_gain[j] * transmitted
                                * math.exp(-_LN10_OVER_10 * attenuation)
-                               * _scatter(noise, px, py, pz, voxel))
+                               * _scatter(noise, keys, px, py, pz, voxel))
 
 
 @jit

@@ -30,7 +30,7 @@ from ultrasound_sim.settings import ProbeSettings
 __all__ = ['BModeFrame', 'Imager']
 
 _NOISE_SEED = 20130801  # the scatterer field is the same in every run
-_NOISE_SIZE = 1 << 16  # as _kernels._NOISE_MASK
+_NOISE_SIZE = 1 << 12  # as _kernels._NOISE_MASK and _AXIS_MASK
 _HIT_CAPACITY = 256  # crossings of one scanline with the cut anatomy
 _PER_MM3 = 1e9  # per m^3
 _DB_PER_CM_MHZ = 100.0 / 1e6  # dB/(cm MHz) times Hz gives dB/m
@@ -103,8 +103,10 @@ class Imager:
                         * settings.slice_thickness)
         energy = (np.sum(np.abs(self.psf.axial) ** 2) * np.sum(self.psf.lateral ** 2, axis=1))
         self._scatter_gain = np.sqrt(nominal_cell * _PER_MM3 / energy)
-        noise = np.random.default_rng(_NOISE_SEED).standard_normal((_NOISE_SIZE, 2))
-        self._noise = ((noise[:, 0] + 1j * noise[:, 1]) / math.sqrt(2.0)).astype(np.complex128)
+        rng = np.random.default_rng(_NOISE_SEED)
+        noise = rng.standard_normal((_NOISE_SIZE, 2))
+        self._noise = (noise[:, 0] + 1j * noise[:, 1]) / math.sqrt(2.0)
+        self._keys = rng.integers(0, 2 ** 62, (3, _NOISE_SIZE), dtype=np.int64)
         self._voxel = settings.sample_spacing
         self._lateral = np.ascontiguousarray(self.psf.lateral.T)  # taps by depth, as the kernel
         shape = (settings.scanlines, settings.samples)
@@ -166,7 +168,7 @@ class Imager:
             self._segments, self._segment_owner, count, self.scan.origins, self.scan.directions,
             mask, anatomy.structure_medium, self._media,
             settings.sample_spacing / settings.speed_of_sound, settings.speed_of_sound,
-            settings.centre_frequency, rotation, p, self._voxel, self._noise,
+            settings.centre_frequency, rotation, p, self._voxel, self._noise, self._keys,
             self._scatter_gain, self._field, self._hit_t, self._hit_owner, self._inside)
         envelope = np.empty((settings.scanlines, settings.samples), dtype=np.float32)
         _kernels.point_spread(self._field, self.psf.axial, self._lateral, self._work, envelope)
@@ -177,4 +179,4 @@ class Imager:
         _kernels.display(envelope, mask, self._gain, settings.dynamic_range, self._levels,
                          conversion.line_at, conversion.sample_at, conversion.line_weight,
                          conversion.sample_weight, image)
-        return BModeFrame(image, geometry, envelope, mask)
+        return BModeFrame(image, geometry, envelope, mask.copy())
