@@ -5,6 +5,9 @@ slowly and without numba, so that what the compiled code does is checked by a se
 """
 
 import math
+import os
+import subprocess
+import sys
 
 from imaging_scenes import block_scene, HALF_TURN_Y
 import numpy as np
@@ -231,3 +234,15 @@ def test_display(imager):
     expected = np.where(inside, np.floor(expected + 0.5), 0).reshape(image.shape)
     assert inside.any()
     np.testing.assert_allclose(image, expected, atol=1)
+
+
+def test_the_kernels_as_plain_python_agree_too():
+    """The same checks with numba off: the kernels' Python is what numba compiles."""
+    if os.environ.get('NUMBA_DISABLE_JIT') == '1':
+        pytest.skip('this is the uncompiled run')
+    result = subprocess.run([sys.executable, '-m', 'pytest', '-q', '-p', 'no:cacheprovider',
+                             __file__, '-k', 'not plain_python'],
+                            env=dict(os.environ, NUMBA_DISABLE_JIT='1'), capture_output=True,
+                            text=True, timeout=600)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert '4 passed' in result.stdout
