@@ -63,6 +63,7 @@ BENCHMARKS = (
     Benchmark('probe', 'bench_probe.py', ('--poses', '300')),
     Benchmark('teleop_lockstep', 'teleop_lockstep.py', ('--delays', '0.05')),
     Benchmark('teleop_scan', 'teleop_scan.py', ('--delays', '0.05')),
+    Benchmark('image', 'bench_image.py', ('--frames', '100', '--no-simus')),
 )
 
 
