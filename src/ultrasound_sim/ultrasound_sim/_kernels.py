@@ -4,7 +4,7 @@ Every kernel here goes through the project's one numba decorator (``collision_en
 They all live in this one module and call only each other, so numba's own cache (keyed on this
 file) can never hold stale machine code of a kernel edited elsewhere. The public wrappers in
 ``imager`` check shapes and dtypes; these trust them. Plain numpy references of each kernel are
-in ``tests/ultrasound_sim/reference.py``.
+in ``tests/ultrasound_sim/test_kernels.py``.
 
 Conventions: the probe frame of ``settings``; positions (y, z) in the scan plane x = 0; the
 field is the complex baseband (I/Q) echo, demodulated at the centre frequency.

@@ -4,7 +4,7 @@ A scene file's ``anatomy`` section (``collision_engine.scene_file``) lists media
 acoustic properties and structures filled with them, painted in order: where structures overlap,
 the later one's medium is the one there. Every structure becomes a closed triangle mesh in the
 scene frame (a mesh file as it is, a primitive tessellated finely enough that its cut by the
-scan plane is off its true outline by under 1e-4 of its size); all meshes go into one array,
+scan plane is off its true outline by about 3e-4 of its size); all meshes go into one array,
 each triangle tagged with its structure. The anatomy is fixed to the scene frame, and so is
 the scatterer field: the speckle stays with the tissue as the probe moves.
 """

@@ -116,7 +116,7 @@ def _lower(position: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
 
 def scan_conversion(settings: ProbeSettings) -> ScanConversion:
     """Map every pixel of the image onto the scanlines' samples (module docstring)."""
-    left, right, top, bottom = _image_box(settings)
+    left, right, top, bottom = (float(edge) for edge in _image_box(settings))
     width, height = settings.image_width, settings.image_height
     pixel_width, pixel_height = (right - left) / width, (bottom - top) / height
     geometry = ImageGeometry(width, height, pixel_width, pixel_height,
