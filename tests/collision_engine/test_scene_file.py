@@ -63,6 +63,77 @@ def test_a_full_scene_parses(tmp_path):
     assert hand.shape == MeshSpec((tmp_path / 'hand.stl').resolve(), 0.001, None)
 
 
+ANATOMY = """\
+anatomy:
+  media:
+    liver: {speed_of_sound: 1595.0, impedance: 1.65e+6, attenuation: 0.5,
+            scatterer_density: 100.0, scatterer_amplitude: 0.003}
+    fluid: {speed_of_sound: 1480.0, impedance: 1.48e+6, attenuation: 0.0022,
+            scatterer_density: 0.0, scatterer_amplitude: 0.0}
+  structures:
+    - {name: body, object: cuboid, medium: liver}
+    - name: cyst
+      shape: {sphere: {radius: 0.01}}
+      pose: {position: [0.0, 0.0, -0.05]}
+      medium: fluid
+"""
+
+
+def test_an_anatomy_parses_and_shares_its_object(tmp_path):
+    spec = read_scene(write(tmp_path, GOOD + ANATOMY))
+    assert list(spec.anatomy.media) == ['liver', 'fluid']
+    liver = spec.anatomy.media['liver']
+    assert (liver.speed_of_sound, liver.impedance, liver.attenuation, liver.scatterer_density,
+            liver.scatterer_amplitude) == (1595.0, 1.65e6, 0.5, 100.0, 0.003)
+    body, cyst = spec.anatomy.structures
+    assert body.object == 'cuboid' and body.shape is spec.objects[0].shape
+    assert body.pose is spec.objects[0].pose and body.medium == 'liver'
+    assert cyst.object is None and cyst.shape == SphereSpec(0.01) and cyst.medium == 'fluid'
+    np.testing.assert_allclose(cyst.pose.translation, [0.0, 0.0, -0.05])
+    assert read_scene(write(tmp_path, GOOD)).anatomy is None
+
+
+@pytest.mark.parametrize('old, new, message', [
+    ('  media:', '  medias:', r"anatomy\.medias: unknown key \(did you mean 'media'\?\)"),
+    ('impedance: 1.65e+6, ', '', r'anatomy\.media\.liver\.impedance: missing'),
+    ('speed_of_sound: 1595.0', 'speed_of_sound: 0.0',
+     r'anatomy\.media\.liver\.speed_of_sound: must be a finite number > 0'),
+    ('attenuation: 0.5', 'attenuation: -0.5',
+     r'anatomy\.media\.liver\.attenuation: must be a finite number >= 0'),
+    ('scatterer_density: 100.0', 'scatterer_density: .nan',
+     r'anatomy\.media\.liver\.scatterer_density: must be a finite number'),
+    ('scatterer_amplitude: 0.003', 'scatterer_amplitude: 0.003, colour: red',
+     r'anatomy\.media\.liver\.colour: unknown key'),
+    ('object: cuboid, medium: liver', 'object: nothing, medium: liver',
+     r"anatomy\.structures\[0\]\.object: no object 'nothing' in objects"),
+    ('object: cuboid, medium: liver', 'object: cuboid, medium: bone',
+     r"anatomy\.structures\[0\]\.medium: no medium 'bone' in anatomy\.media"),
+    ('object: cuboid, medium: liver', 'medium: liver',
+     r'anatomy\.structures\[0\]: give object .* or shape, one of them'),
+    ('object: cuboid, medium: liver', 'object: cuboid, pose: {}, medium: liver',
+     r"anatomy\.structures\[0\]\.pose: an object's surface has the object's pose"),
+    ('name: cyst', 'name: body', r"anatomy\.structures\[1\]\.name: duplicate name 'body'"),
+    ('radius: 0.01}}', 'radius: -0.01}}',
+     r'anatomy\.structures\[1\]\.shape\.sphere\.radius: must be a finite number > 0'),
+])
+def test_anatomy_errors_name_the_file_and_the_key(tmp_path, old, new, message):
+    assert old in ANATOMY
+    path = write(tmp_path, GOOD + ANATOMY.replace(old, new, 1))
+    with pytest.raises(SceneError, match=f'^{re.escape(str(path))}: {message}'):
+        read_scene(path)
+
+
+@pytest.mark.parametrize('anatomy, message', [
+    ('anatomy: {media: {}, structures: []}', r'anatomy\.media: must be a mapping of at least one'),
+    ('anatomy: {media: {a: 1}, structures: []}', r'anatomy\.media\.a: must be a mapping'),
+    ('anatomy: {media: []}', r'anatomy\.structures: missing'),
+])
+def test_anatomy_structure_errors(tmp_path, anatomy, message):
+    path = write(tmp_path, GOOD + anatomy + '\n')
+    with pytest.raises(SceneError, match=f'^{re.escape(str(path))}: {message}'):
+        read_scene(path)
+
+
 def test_defaults(tmp_path):
     spec = read_scene(write(tmp_path, 'objects: []\n'))
     assert spec.frame_id == 'world' and spec.tip_radius == 0.0 and spec.objects == ()
@@ -165,7 +236,9 @@ def test_scene_error_is_a_value_error():
 KEYS = ['frame_id', 'tip_radius', 'cross_validation', 'fcl', 'every', 'tolerance', 'objects',
         'name', 'shape', 'pose', 'position', 'rpy', 'quaternion', 'material', 'stiffness',
         'damping', 'box', 'size', 'sphere', 'radius', 'cylinder', 'height', 'capsule', 'length',
-        'mesh', 'file', 'scale', 'convex', 'colour']
+        'mesh', 'file', 'scale', 'convex', 'colour', 'anatomy', 'media', 'structures', 'medium',
+        'object', 'speed_of_sound', 'impedance', 'attenuation', 'scatterer_density',
+        'scatterer_amplitude']
 SCALARS = st.one_of(st.none(), st.booleans(), st.integers(-10**6, 10**6),
                     st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=8))
 DOCUMENTS = st.recursive(

@@ -20,6 +20,18 @@ Format (SI units, REP-103 frames; paths relative to the scene file)::
         shape: {box: {size: [0.1, 0.1, 0.2]}}
         pose: {position: [0.0, 0.0, -0.075], rpy: [0.0, 0.0, 0.0]}   # or quaternion: [x, y, z, w]
         material: {stiffness: [160, 160, 160], damping: [0.8, 0.8, 0.8]}   # optional
+    anatomy:                        # optional: what the ultrasound image sees, never the force
+      media:                        # acoustic properties, by tissue name
+        liver: {speed_of_sound: 1595.0, impedance: 1.65e6, attenuation: 0.5,
+                scatterer_density: 50.0, scatterer_amplitude: 0.004}
+        fluid: {speed_of_sound: 1480.0, impedance: 1.48e6, attenuation: 0.002,
+                scatterer_density: 0.0, scatterer_amplitude: 0.0}
+      structures:                   # painted in order: where they overlap, the later one wins
+        - {name: body, object: cuboid, medium: liver}   # an object's own surface and pose
+        - name: cyst                # or a shape and pose of its own, as objects have
+          shape: {sphere: {radius: 0.01}}
+          pose: {position: [0.0, 0.0, -0.05]}
+          medium: fluid
 
 Shapes: ``box: {size}``, ``sphere: {radius}``, ``cylinder: {radius, height}`` (axis z),
 ``capsule: {radius, length}`` (axis z, ``length`` of the segment), ``mesh: {file, scale,
@@ -27,6 +39,12 @@ convex}`` (``file`` relative to the scene file's folder, absolute, ``~/...`` or
 ``package://<pkg>/<path>``; ``scale`` from file units to m, default 1; ``convex`` true queries
 the mesh's convex hull by GJK, false the exact non-convex surface; omitted, it is detected on
 load).
+
+Anatomy media: ``speed_of_sound`` m/s, ``impedance`` kg/(m^2 s) (Rayl), ``attenuation``
+dB/(cm MHz), ``scatterer_density`` per mm^3 and ``scatterer_amplitude`` (one scatterer's echo
+over a perfect plane reflector's), all five required. The anatomy is parsed here, strictly, and
+built by the ultrasound simulator alone: ``load_scene`` makes no collision object of it, so a
+scene's forces and distances are the same with or without it.
 
 The tool takes the same shapes but a mesh must be convex (``convex: false`` is refused here, a
 non-convex file when the scene is loaded, naming the file). Without a ``tool`` the tip is a point
@@ -45,8 +63,9 @@ import yaml
 from collision_engine.errors import SceneError
 from collision_engine.transforms import Pose
 
-__all__ = ['BoxSpec', 'CapsuleSpec', 'CrossValidationSpec', 'CylinderSpec', 'MaterialSpec',
-           'MeshSpec', 'ObjectSpec', 'SceneSpec', 'SphereSpec', 'ToolSpec', 'read_scene']
+__all__ = ['AnatomySpec', 'BoxSpec', 'CapsuleSpec', 'CrossValidationSpec', 'CylinderSpec',
+           'MaterialSpec', 'MediumSpec', 'MeshSpec', 'ObjectSpec', 'SceneSpec', 'SphereSpec',
+           'StructureSpec', 'ToolSpec', 'read_scene']
 
 
 @dataclass(frozen=True)
@@ -124,9 +143,45 @@ class ToolSpec:
     face_spacing: float
 
 
+@dataclass(frozen=True)
+class MediumSpec:
+    """A tissue's acoustic properties (units in the module docstring)."""
+
+    speed_of_sound: float
+    impedance: float
+    attenuation: float
+    scatterer_density: float
+    scatterer_amplitude: float
+
+
+@dataclass(frozen=True, eq=False)
+class StructureSpec:
+    """One anatomical structure: ``shape`` at ``pose``, filled with the medium named ``medium``.
+
+    ``object`` names the scene object whose shape and pose it shares (None: its own).
+    """
+
+    name: str
+    shape: BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec
+    pose: Pose
+    medium: str
+    object: str | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class AnatomySpec:
+    """What the ultrasound image sees: ``media`` by name, ``structures`` in painting order."""
+
+    media: dict[str, MediumSpec]
+    structures: tuple[StructureSpec, ...]
+
+
 @dataclass(frozen=True, eq=False)
 class SceneSpec:
-    """A validated scene file: ``path``, ``frame_id``, ``tip_radius`` m, objects, ``tool``."""
+    """A validated scene file: ``path``, ``frame_id``, ``tip_radius`` m, objects, ``tool``.
+
+    ``anatomy`` is None for a scene without acoustic properties.
+    """
 
     path: Path
     frame_id: str
@@ -134,9 +189,14 @@ class SceneSpec:
     cross_validation: CrossValidationSpec
     objects: tuple[ObjectSpec, ...]
     tool: ToolSpec | None = None
+    anatomy: AnatomySpec | None = None
 
 
 DEFAULT_FACE_SPACING = 0.005  # m: a 10 x 40 mm probe face gets 2 x 8 points
+
+_MEDIUM_KEYS = ('speed_of_sound', 'impedance', 'attenuation', 'scatterer_density',
+                'scatterer_amplitude')
+_POSITIVE_MEDIUM_KEYS = ('speed_of_sound', 'impedance')
 
 _SHAPE_KEYS = {
     'box': (('size',), ()),
@@ -241,7 +301,7 @@ def read_scene(path) -> SceneSpec:
         raise SceneError(f'{path}: {at}: not valid YAML: '
                          f'{getattr(error, "problem", error)}') from None
     top = reader.mapping(document, '', ('objects',),
-                         ('frame_id', 'tip_radius', 'cross_validation', 'tool'))
+                         ('frame_id', 'tip_radius', 'cross_validation', 'tool', 'anatomy'))
     frame_id = reader.text(top.get('frame_id', 'world'), 'frame_id')
     tip_radius = reader.number(top.get('tip_radius', 0.0), 'tip_radius', minimum=0.0)
     cross_validation = _cross_validation(reader, top.get('cross_validation', {}))
@@ -258,7 +318,58 @@ def read_scene(path) -> SceneSpec:
         if tip_radius > 0.0:
             reader.fail('tool', 'give tool or tip_radius, not both (the tool is the tip)')
         tool = _tool(reader, top['tool'])
-    return SceneSpec(path, frame_id, tip_radius, cross_validation, objects, tool)
+    anatomy = None
+    if top.get('anatomy') is not None:
+        anatomy = _anatomy(reader, top['anatomy'], {o.name: o for o in objects})
+    return SceneSpec(path, frame_id, tip_radius, cross_validation, objects, tool, anatomy)
+
+
+def _anatomy(reader: _Reader, value, objects: dict) -> AnatomySpec:
+    fields = reader.mapping(value, 'anatomy', ('media', 'structures'))
+    media = fields['media']
+    if not isinstance(media, dict) or not media:
+        reader.fail('anatomy.media', f'must be a mapping of at least one medium, got {media!r}')
+    media = {reader.text(name, f'anatomy.media.{name}'): _medium(reader, properties,
+                                                                 f'anatomy.media.{name}')
+             for name, properties in media.items()}
+    listed = fields['structures']
+    if not isinstance(listed, list) or not listed:
+        reader.fail('anatomy.structures', f'must be a non-empty list, got {listed!r}')
+    structures = []
+    for i, item in enumerate(listed):
+        where = f'anatomy.structures[{i}]'
+        structure = _structure(reader, item, where, media, objects)
+        if structure.name in [s.name for s in structures]:
+            reader.fail(f'{where}.name', f'duplicate name {structure.name!r}')
+        structures.append(structure)
+    return AnatomySpec(media, tuple(structures))
+
+
+def _medium(reader: _Reader, value, where: str) -> MediumSpec:
+    fields = reader.mapping(value, where, _MEDIUM_KEYS)
+    return MediumSpec(*(reader.number(fields[key], f'{where}.{key}', minimum=0.0,
+                                      strict=key in _POSITIVE_MEDIUM_KEYS)
+                        for key in _MEDIUM_KEYS))
+
+
+def _structure(reader: _Reader, value, where: str, media: dict, objects: dict) -> StructureSpec:
+    fields = reader.mapping(value, where, ('name', 'medium'), ('object', 'shape', 'pose'))
+    name = reader.text(fields['name'], f'{where}.name')
+    medium = reader.text(fields['medium'], f'{where}.medium')
+    if medium not in media:
+        reader.fail(f'{where}.medium', f'no medium {medium!r} in anatomy.media '
+                    f'({", ".join(media)})')
+    if ('object' in fields) == ('shape' in fields):
+        reader.fail(where, 'give object (an object\'s own surface) or shape, one of them')
+    if 'shape' in fields:
+        return StructureSpec(name, _shape(reader, fields['shape'], f'{where}.shape'),
+                             _pose(reader, fields.get('pose', {}), f'{where}.pose'), medium)
+    if 'pose' in fields:
+        reader.fail(f'{where}.pose', 'an object\'s surface has the object\'s pose')
+    shared = reader.text(fields['object'], f'{where}.object')
+    if shared not in objects:
+        reader.fail(f'{where}.object', f'no object {shared!r} in objects')
+    return StructureSpec(name, objects[shared].shape, objects[shared].pose, medium, shared)
 
 
 def _tool(reader: _Reader, value) -> ToolSpec:

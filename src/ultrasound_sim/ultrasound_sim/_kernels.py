@@ -1,0 +1,265 @@
+"""The per-frame work, compiled: section, trace, point spread, display.
+
+Every kernel here goes through the project's one numba decorator (``collision_engine._jit``).
+They all live in this one module and call only each other, so numba's own cache (keyed on this
+file) can never hold stale machine code of a kernel edited elsewhere. The public wrappers in
+``imager`` check shapes and dtypes; these trust them. Plain numpy references of each kernel are
+in ``tests/ultrasound_sim/test_kernels.py``.
+
+Conventions: the probe frame of ``settings``; positions (y, z) in the scan plane x = 0; the
+field is the complex baseband (I/Q) echo, demodulated at the centre frequency.
+"""
+
+import math
+
+import numpy as np
+
+from collision_engine._jit import jit
+
+__all__ = ['display', 'point_spread', 'section', 'trace_lines']
+
+_OUTSIDE = -1
+# media columns (``anatomy.MEDIA_COLUMNS``)
+_SPEED, _IMPEDANCE, _ATTENUATION, _BACKSCATTER = 0, 1, 2, 3
+_LN10_OVER_10 = math.log(10.0) / 10.0
+_NOISE_MASK = 0xFFF  # the noise table holds 2**12 values (64 KB: it stays in cache)
+_AXIS_MASK = 0xFFF  # each axis's key table too: the field repeats every 2**12 voxels
+
+
+@jit
+def section(vertices, triangles, owner, rotation, position, segments, segment_owner):
+    """Cut the anatomy's triangles by the probe's scan plane (x = 0 in the probe frame).
+
+    A vertex is on the plane's positive side when its x > 0, else on the other, the same rule
+    for every triangle that shares it, so the cut of a closed mesh is closed polygons. Writes
+    each cut as (y0, z0, y1, z1) into ``segments`` and its structure into ``segment_owner``;
+    returns how many.
+    """
+    n_vertices = vertices.shape[0]
+    local = np.empty((n_vertices, 3))
+    for v in range(n_vertices):
+        dx = vertices[v, 0] - position[0]
+        dy = vertices[v, 1] - position[1]
+        dz = vertices[v, 2] - position[2]
+        for a in range(3):  # the probe frame: rotation transposed
+            local[v, a] = rotation[0, a] * dx + rotation[1, a] * dy + rotation[2, a] * dz
+    count = 0
+    for t in range(triangles.shape[0]):
+        a, b, c = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+        pa, pb, pc = local[a, 0] > 0.0, local[b, 0] > 0.0, local[c, 0] > 0.0
+        if pa == pb and pb == pc:
+            continue
+        found = 0
+        for edge in range(3):
+            i, j = (a, b) if edge == 0 else ((b, c) if edge == 1 else (c, a))
+            if (local[i, 0] > 0.0) != (local[j, 0] > 0.0):
+                w = local[i, 0] / (local[i, 0] - local[j, 0])
+                segments[count, 2 * found] = local[i, 1] + w * (local[j, 1] - local[i, 1])
+                segments[count, 2 * found + 1] = local[i, 2] + w * (local[j, 2] - local[i, 2])
+                found += 1
+        segment_owner[count] = owner[t]
+        count += 1
+    return count
+
+
+@jit
+def _line_hits(segments, segment_owner, count, oy, oz, dy, dz, hit_t, hit_owner):
+    """Where the full line o + t d crosses the cut polygons: t (sorted) and owners; how many."""
+    n = 0
+    capacity = hit_t.shape[0]
+    for s in range(count):
+        ay, az, by, bz = segments[s, 0], segments[s, 1], segments[s, 2], segments[s, 3]
+        sa = dy * (az - oz) - dz * (ay - oy)
+        sb = dy * (bz - oz) - dz * (by - oy)
+        if (sa > 0.0) == (sb > 0.0) or n == capacity:
+            continue
+        u = sa / (sa - sb)
+        t = (ay + u * (by - ay) - oy) * dy + (az + u * (bz - az) - oz) * dz
+        k = n  # insertion sort: a line crosses a few dozen edges at most
+        while k > 0 and hit_t[k - 1] > t:
+            hit_t[k] = hit_t[k - 1]
+            hit_owner[k] = hit_owner[k - 1]
+            k -= 1
+        hit_t[k] = t
+        hit_owner[k] = segment_owner[s]
+        n += 1
+    return n
+
+
+@jit
+def _top(inside, structure_medium):
+    """Return the medium of the last-listed structure the point is in, or ``_OUTSIDE``."""
+    for s in range(inside.shape[0] - 1, -1, -1):
+        if inside[s] & 1:
+            return structure_medium[s]
+    return _OUTSIDE
+
+
+@jit
+def _scatter(noise, keys, px, py, pz, voxel):
+    """Sample the tissue-fixed random field: trilinear over a hashed grid, unit variance.
+
+    A grid node's value is ``noise`` at the xor of its three coordinates' ``keys`` (simple
+    tabulation hashing: each axis's key from a table of random words, 3-independent).
+    """
+    fx, fy, fz = px / voxel, py / voxel, pz / voxel
+    ix, iy, iz = math.floor(fx), math.floor(fy), math.floor(fz)
+    wx, wy, wz = fx - ix, fy - iy, fz - iz
+    x0, x1 = keys[0, ix & _AXIS_MASK], keys[0, (ix + 1) & _AXIS_MASK]
+    y0, y1 = keys[1, iy & _AXIS_MASK], keys[1, (iy + 1) & _AXIS_MASK]
+    z0, z1 = keys[2, iz & _AXIS_MASK], keys[2, (iz + 1) & _AXIS_MASK]
+    total = 0j
+    norm = 0.0
+    for corner in range(8):
+        cx, cy, cz = corner & 1, (corner >> 1) & 1, (corner >> 2) & 1
+        w = ((wx if cx else 1.0 - wx) * (wy if cy else 1.0 - wy) * (wz if cz else 1.0 - wz))
+        key = (x1 if cx else x0) ^ (y1 if cy else y0) ^ (z1 if cz else z0)
+        total += w * noise[key & _NOISE_MASK]
+        norm += w * w
+    return total / math.sqrt(norm)
+
+
+@jit
+def trace_lines(segments, segment_owner, count, origins, directions, coupled, structure_medium,
+                media, dtau, speed_of_sound, centre_frequency, rotation, position, voxel, noise,
+                keys, scatter_gain, field, hit_t, hit_owner, inside):
+    """Follow each coupled scanline through the cut anatomy; write its I/Q echo into ``field``.
+
+    Along the line, in echo time: two-way attenuation at the centre frequency; at each change of
+    medium an echo of the pressure reflection coefficient (Z2 - Z1) / (Z2 + Z1), at its time and
+    carrier phase, and the rest passed on both ways (1 - r^2); the scatterer field, fixed to the
+    scene, times the medium's backscatter. From outside into the first tissue is the gel's
+    coupling (no echo); out of the body into air reflects all and the line ends.
+    """
+    n_lines, n_samples = field.shape
+    for line in range(n_lines):
+        for j in range(n_samples):
+            field[line, j] = 0j
+        if not coupled[line]:
+            continue
+        oy, oz = origins[line, 0], origins[line, 1]
+        dy, dz = directions[line, 0], directions[line, 1]
+        n = _line_hits(segments, segment_owner, count, oy, oz, dy, dz, hit_t, hit_owner)
+        inside[:] = 0
+        h = 0
+        while h < n and hit_t[h] < 0.0:
+            inside[hit_owner[h]] += 1
+            h += 1
+        medium = _top(inside, structure_medium)
+        in_body = medium != _OUTSIDE
+        s = 0.0  # m along the line
+        tau = 0.0  # s, one way
+        transmitted = 1.0  # two-way pressure amplitude passed through the interfaces so far
+        attenuation = 0.0  # dB, one way
+        for j in range(n_samples):
+            tau_j = (j + 0.5) * dtau
+            while True:
+                speed = media[medium, _SPEED] if medium != _OUTSIDE else speed_of_sound
+                alpha = media[medium, _ATTENUATION] if medium != _OUTSIDE else 0.0
+                reach = s + (tau_j - tau) * speed
+                if h < n and hit_t[h] <= reach:
+                    step = hit_t[h] - s
+                    tau += step / speed
+                    attenuation += alpha * step
+                    s = hit_t[h]
+                    inside[hit_owner[h]] += 1
+                    h += 1
+                    after = _top(inside, structure_medium)
+                    if after == medium:
+                        continue
+                    if medium == _OUTSIDE and not in_body:
+                        r = 0.0
+                    elif after == _OUTSIDE:
+                        r = -1.0
+                    else:
+                        z1, z2 = media[medium, _IMPEDANCE], media[after, _IMPEDANCE]
+                        r = (z2 - z1) / (z2 + z1)
+                    if r != 0.0:
+                        echo = (r * transmitted * math.exp(-_LN10_OVER_10 * attenuation)
+                                * np.exp(-4j * math.pi * centre_frequency * tau))
+                        at = tau / dtau - 0.5
+                        k = math.floor(at)
+                        w = at - k
+                        if 0 <= k < n_samples:
+                            field[line, k] += (1.0 - w) * echo
+                        if 0 <= k + 1 < n_samples:
+                            field[line, k + 1] += w * echo
+                    transmitted *= 1.0 - r * r
+                    medium = after
+                    in_body = in_body or medium != _OUTSIDE
+                else:
+                    attenuation += alpha * (reach - s)
+                    s = reach
+                    tau = tau_j
+                    break
+            if transmitted == 0.0:
+                break
+            if medium == _OUTSIDE or media[medium, _BACKSCATTER] == 0.0:
+                continue
+            y, z = oy + s * dy, oz + s * dz
+            px = position[0] + rotation[0, 1] * y + rotation[0, 2] * z
+            py = position[1] + rotation[1, 1] * y + rotation[1, 2] * z
+            pz = position[2] + rotation[2, 1] * y + rotation[2, 2] * z
+            field[line, j] += (media[medium, _BACKSCATTER] * scatter_gain[j] * transmitted
+                               * math.exp(-_LN10_OVER_10 * attenuation)
+                               * _scatter(noise, keys, px, py, pz, voxel))
+
+
+@jit
+def point_spread(field, axial, lateral, work, envelope):
+    """Convolve the I/Q field with the axial pulse, then the lateral beam; its magnitude.
+
+    ``axial`` (2 ka + 1,) complex taps along a line; ``lateral`` (2 kl + 1, samples) real taps
+    across lines, one column per depth (the beam widens where the aperture stops growing).
+    """
+    n_lines, n_samples = field.shape
+    ka = axial.shape[0] // 2
+    kl = lateral.shape[0] // 2
+    for line in range(n_lines):  # tap by tap over whole rows: contiguous, vectorised
+        row = work[line]
+        row[:] = 0j
+        for k in range(-ka, ka + 1):
+            tap = axial[k + ka]
+            for j in range(max(0, k), min(n_samples, n_samples + k)):
+                row[j] += tap * field[line, j - k]
+    acc = np.empty(n_samples, dtype=np.complex128)
+    for line in range(n_lines):
+        acc[:] = 0j
+        for k in range(max(-kl, line - n_lines + 1), min(kl, line) + 1):
+            taps = lateral[k + kl]
+            for j in range(n_samples):
+                acc[j] += taps[j] * work[line - k, j]
+        for j in range(n_samples):
+            envelope[line, j] = abs(acc[j])
+
+
+@jit
+def display(envelope, coupled, gain, dynamic_range, levels, line_at, sample_at, line_weight,
+            sample_weight, image):
+    """Log-compress the envelope to grey levels, then scan-convert them into ``image``.
+
+    Level 255 is 0 dB (a perfect reflector at the face, after ``gain`` (samples,) dB), level 0
+    is ``dynamic_range`` below; an uncoupled line is black. Each pixel interpolates the levels
+    of the four samples around it (``line_at`` < 0: outside the field, black).
+    """
+    n_lines, n_samples = envelope.shape
+    scale = 255.0 / dynamic_range
+    for line in range(n_lines):
+        for j in range(n_samples):
+            value = envelope[line, j]
+            level = 0.0
+            if coupled[line] and value > 0.0:
+                level = (20.0 * math.log10(value) + gain[j] + dynamic_range) * scale
+                level = min(max(level, 0.0), 255.0)
+            levels[line, j] = level
+    flat = image.ravel()
+    for p in range(flat.shape[0]):
+        i = line_at[p]
+        if i < 0:
+            flat[p] = 0
+            continue
+        j = sample_at[p]
+        wl, ws = line_weight[p], sample_weight[p]
+        value = ((1.0 - wl) * ((1.0 - ws) * levels[i, j] + ws * levels[i, j + 1])
+                 + wl * ((1.0 - ws) * levels[i + 1, j] + ws * levels[i + 1, j + 1]))
+        flat[p] = np.uint8(value + 0.5)
