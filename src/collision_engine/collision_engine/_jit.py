@@ -16,6 +16,10 @@ module's content, in a per-user folder (``$NUMBA_CACHE_DIR`` or ``~/.cache``; th
 module means another folder (nothing is deleted, so nothing races), and every install of the
 same code shares one cache. ``compiling`` lets one process compile while the others wait for
 its cache, and says so in one line.
+
+Another package's kernels compiled through ``jit`` (the ultrasound image's) live in one module
+that calls only its own, so numba's stamp of that file is enough; they too are cached in the
+per-user folder, never beside the source, which a build must leave as it found it.
 """
 
 import contextlib
@@ -59,12 +63,14 @@ def _writable(folder: Path) -> bool:
         return False
 
 
+_USER_CACHE = Path(os.environ.get('NUMBA_CACHE_DIR') or Path(
+    os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache')) / 'haptic_toolkit'
+
+
 def _cache_dir() -> Path:
     """Return the per-user cache of this fingerprint, or the package's own if not writable."""
-    user = Path(os.environ.get('NUMBA_CACHE_DIR')
-                or Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache'))
     fingerprint = _fingerprint()
-    candidates = (user / 'haptic_toolkit' / 'collision_engine' / fingerprint,
+    candidates = (_USER_CACHE / 'collision_engine' / fingerprint,
                   _PACKAGE / '__pycache__' / fingerprint)
     return next((folder for folder in candidates if _writable(folder)), candidates[0])
 
@@ -96,8 +102,38 @@ if _FingerprintLocator not in caching.CacheImpl._locator_classes:
     caching.CacheImpl._locator_classes.insert(0, _FingerprintLocator)
 
 
+class _UserCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
+    """numba's cache locator for another package's kernels compiled through ``jit``.
+
+    Under the per-user folder, by package; stamped with the source file, as numba's own.
+    """
+
+    def __init__(self, py_func, py_file) -> None:
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._folder = _USER_CACHE / Path(py_file).resolve().parent.name
+
+    def get_cache_path(self) -> str:
+        return str(self._folder)
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if Path(py_file).resolve() not in _OTHER_KERNEL_FILES:
+            return None
+        locator = cls(py_func, py_file)
+        return locator if _writable(locator._folder) else None
+
+
+_OTHER_KERNEL_FILES: set = set()  # other packages' modules with kernels compiled through jit
+if _UserCacheLocator not in caching.CacheImpl._locator_classes:
+    caching.CacheImpl._locator_classes.insert(1, _UserCacheLocator)
+
+
 def jit(function):
     """Compile ``function`` with the engine's numba options (see the module docstring)."""
+    source = Path(function.__code__.co_filename).resolve()
+    if source.parent != _PACKAGE:
+        _OTHER_KERNEL_FILES.add(source)
     return njit(cache=True, error_model='numpy', nogil=True)(function)
 
 
