@@ -109,7 +109,7 @@ def _passive(books, fx, fy, fz, coordinates, rates, period):
         books[0] -= work
         books[1] += work
     books[5], books[6], books[7], books[8] = coordinates[0], coordinates[1], coordinates[2], 1.0
-    magnitude = math.sqrt(fx ** 2 + fy ** 2 + fz ** 2)
+    magnitude = math.sqrt(fx * fx + fy * fy + fz * fz)
     if magnitude == 0.0:
         books[9] += period
         if books[9] >= BOOKS_CLOSE_AFTER:
