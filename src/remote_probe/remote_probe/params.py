@@ -7,11 +7,26 @@ from remote_probe.leader import LeaderConfig
 from remote_probe.safety import SafetyConfig
 from remote_probe.teleop import HAND_SPEED, SCHEMES
 
-__all__ = ['FollowerParams', 'LeaderParams', 'SimulatedRobotParams']
+__all__ = ['FollowerParams', 'LeaderParams', 'PatientBoundParams', 'SimulatedRobotParams']
 
 
 @dataclass(frozen=True)
-class SimulatedRobotParams:
+class PatientBoundParams:
+    """The patient's force bound, which the robot and the node commanding it both enforce."""
+
+    max_patient_force: float = parameter(SafetyConfig.max_patient_force, 'each target is kept '
+                                         'within the reach of the TCP at which the robot\'s '
+                                         'spring presses this hard', unit='N', low=0.1)
+    force_margin: float = parameter(SafetyConfig.force_margin, 'the spring stays this far below '
+                                    'the limit', unit='N', low=0.0)
+    release_force: float = parameter(SafetyConfig.release_force, 'retraction stops below this '
+                                     'force', unit='N', low=0.0)
+    retract_speed: float = parameter(SafetyConfig.retract_speed, 'retraction speed', unit='m/s',
+                                     low=1e-4)
+
+
+@dataclass(frozen=True)
+class SimulatedRobotParams(PatientBoundParams):
     rate: float = parameter(1000.0, 'TCP pose and F/T wrench publishing rate', unit='Hz',
                             low=1.0, high=10000.0)
     frame_id: str = parameter('base_link', 'the robot\'s base frame, also the scene\'s frame')
@@ -37,21 +52,12 @@ class SimulatedRobotParams:
     sensor_bandwidth: float = parameter(200.0, 'F/T sensor first-order cut-off', unit='Hz',
                                         low=1.0)
     seed: int = parameter(0, 'seed of the sensor noise', low=0)
-    max_patient_force: float = parameter(SafetyConfig.max_patient_force, 'the robot keeps each '
-                                         'target within the reach of its own TCP at which its '
-                                         'spring presses this hard', unit='N', low=0.1)
-    force_margin: float = parameter(SafetyConfig.force_margin, 'the spring stays this far below '
-                                    'the limit', unit='N', low=0.0)
     target_timeout: float = parameter(SafetyConfig.link_timeout, 'no target for this long: hold '
                                       'the TCP, then retract', unit='s', low=0.001)
-    release_force: float = parameter(SafetyConfig.release_force, 'retraction stops below this '
-                                     'force', unit='N', low=0.0)
-    retract_speed: float = parameter(SafetyConfig.retract_speed, 'retraction speed', unit='m/s',
-                                     low=1e-4)
 
 
 @dataclass(frozen=True)
-class FollowerParams:
+class FollowerParams(PatientBoundParams):
     scheme: str = parameter('model', 'bilateral scheme', choices=SCHEMES)
     rate: float = parameter(1000.0, 'control rate: a target per tick', unit='Hz', low=1.0,
                             high=10000.0)
@@ -64,16 +70,8 @@ class FollowerParams:
                                 'of contact; empty: only what contact teaches')
     robot_stiffness: float = parameter(1500.0, 'the robot\'s impedance stiffness', unit='N/m',
                                        low=1.0)
-    max_patient_force: float = parameter(SafetyConfig.max_patient_force, 'the force the patient '
-                                         'may feel at most', unit='N', low=0.1)
-    force_margin: float = parameter(SafetyConfig.force_margin, 'the spring stays this far below '
-                                    'the limit', unit='N', low=0.0)
     link_timeout: float = parameter(SafetyConfig.link_timeout, 'no command for this long: hold '
                                     'the TCP, then retract', unit='s', low=0.001)
-    release_force: float = parameter(SafetyConfig.release_force, 'retraction stops below this '
-                                     'force', unit='N', low=0.0)
-    retract_speed: float = parameter(SafetyConfig.retract_speed, 'retraction speed', unit='m/s',
-                                     low=1e-4)
     rejoin_speed: float = parameter(SafetyConfig.rejoin_speed, 'once commands come again, the '
                                     'target goes back to the operator\'s this fast', unit='m/s',
                                     low=1e-4)
