@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from report_benchmarks import TELEOP_FIGURE
 from report_experiments import PAPER
 from report_probe import probe_section
 from report_sections import (counts_section, DEFINITIONS, error_time_section,
@@ -221,9 +222,10 @@ def _teleop_chapter(findings: Findings) -> list[str]:
     parts += _stored(findings, 'teleop_lockstep', lambda rows: [
         teleop_section([{**r, 'source': 'lockstep'} for r in rows]), ''])
     parts += ['### Over ROS 2', '']
+    figure = (['![force against time per scheme](teleop_forces.png)', '']
+              if (findings.results / TELEOP_FIGURE).exists() else [])
     parts += _stored(findings, 'teleop_scan', lambda rows: [
-        teleop_section([{**r, 'source': 'ROS 2'} for r in rows]), '',
-        '![force against time per scheme](teleop_forces.png)', ''])
+        teleop_section([{**r, 'source': 'ROS 2'} for r in rows]), '', *figure])
     parts += ['### The demo\'s scan', '',
               'Measured by this run, from the bag `demo` recorded: model-mediated over a 50 ms '
               'link with 5 ms jitter and 1 % loss.', '']

@@ -55,9 +55,9 @@ def _plain(value):
 
 
 def _command(argv: list) -> str:
-    script = Path(argv[0]).resolve()
-    shown = script.relative_to(ROOT) if script.is_relative_to(ROOT) else script
-    return ' '.join(['python', str(shown), *argv[1:]])
+    """Return the command as run from the repository: its paths in it relative to it."""
+    return ' '.join(['python', *(_shown(Path(a)) if Path(a).is_absolute() else a
+                                 for a in [str(Path(argv[0]).resolve()), *argv[1:]])])
 
 
 def write(path: Path | None, results, argv: list | None = None) -> None:

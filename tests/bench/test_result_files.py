@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from result_files import add_option, describe, missing, read, write
+from result_files import add_option, describe, missing, read, RESULTS, write
 
 
 @dataclass(frozen=True)
@@ -20,7 +20,8 @@ def test_rows_read_back_as_written_with_the_machine_date_commit_and_command(tmp_
     path = tmp_path / 'results' / 'sweep.json'
     rows = {'bound': np.float64(1234.5), 'rows': [Row(100.0, 'on'), Row(1e3, 'off')],
             'counts': np.arange(3), 'missing': math.nan}
-    write(path, rows, ['/somewhere/bench/sweep.py', '--points', '3'])
+    write(path, rows, ['/somewhere/bench/sweep.py', '--points', '3', '--json',
+                       str(RESULTS / 'sweep.json')])
     stored = read('sweep', tmp_path / 'results')
     assert stored.path == path
     assert stored.results['bound'] == 1234.5
@@ -28,7 +29,8 @@ def test_rows_read_back_as_written_with_the_machine_date_commit_and_command(tmp_
                                       {'stiffness': 1000.0, 'mode': 'off'}]
     assert stored.results['counts'] == [0, 1, 2]
     assert math.isnan(stored.results['missing'])
-    assert stored.command == 'python /somewhere/bench/sweep.py --points 3'
+    assert stored.command == ('python /somewhere/bench/sweep.py --points 3 --json '
+                              'bench/results/sweep.json')
     assert {'date', 'cpu', 'cores', 'commit', 'load', 'versions'} <= set(stored.measured)
     assert len(stored.measured['load']) == 3
 
