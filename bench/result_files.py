@@ -97,9 +97,10 @@ def describe(stored: Stored) -> str:
     """Say, in one Markdown line, where and when a stored result was measured."""
     m = stored.measured
     load = ' / '.join(f'{v:.1f}' for v in m['load'])
-    return (f'*From the last benchmark run, not this one:* `{_shown(stored.path)}`, measured '
-            f'{m["date"]} on {m["cpu"]} ({m["cores"]} cores, load average {load} at the start),'
-            f' commit `{m["commit"]}`, by `{stored.command}`. `make bench` measures it again.')
+    return (f'*From the last benchmark run, not this one:* `{_shown(stored.path)}`, stored '
+            f'{m["date"]} on {m["cpu"]} ({m["cores"]} cores; load average {load} over the last '
+            f'1, 5 and 15 minutes as it ended), commit `{m["commit"]}`, by `{stored.command}`. '
+            '`make bench` measures it again.')
 
 
 def missing(name: str, folder: Path = RESULTS) -> str:
