@@ -1,8 +1,10 @@
-# Two commands for a fresh machine: `make demo` and `make test`. Both set up first if needed.
+# Two commands for a fresh machine: `make demo` and `make test`. Both set up first if needed:
+# the demo only what it runs, the tests (and lint, bench) their tools on top (requirements-dev.txt).
 SHELL := /bin/bash
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.setup-complete
+DEV_STAMP := $(VENV)/.dev-complete
 PACKAGES := haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup remote_probe \
 	ultrasound_sim
 SETUP_INPUTS := requirements.txt constraints.txt tools/setup_venv.sh tools/fix_wheel_cmake_paths.py \
@@ -18,27 +20,41 @@ export ROS_HOME := $(CURDIR)/build/ros_home
 export AMENT_PREFIX_PATH := $(CURDIR)/$(VENV)
 unexport _ROS_WHEELS_BOOTSTRAP_COMPLETE
 
-.PHONY: setup demo test fuzz bench lint clean
-setup: $(STAMP)
+.PHONY: setup demo report test fuzz bench lint clean
+setup: $(DEV_STAMP)
 
 $(STAMP): $(SETUP_INPUTS)
 	tools/setup_venv.sh $(VENV)
 	touch $@
 
+$(DEV_STAMP): $(STAMP) requirements-dev.txt
+	tools/setup_venv.sh --dev $(VENV)
+	touch $@
+
+# The demo's experiments over ROS 2, then the report: from their bags, and from the benchmarks'
+# last stored results (bench/results/, which `make bench` refreshes; nothing is benchmarked here).
 demo: $(STAMP)
 	$(VENV)/bin/demo --out build/demo
 	$(PY) bench/report.py --demo-dir build/demo --out report
 
+# The report again from the last demo's bags and the stored results (after `make bench`).
+report: $(STAMP)
+	$(PY) bench/report.py --demo-dir build/demo --out report
+
 # Deterministic: Hypothesis's ci profile draws the same examples on every run.
-test: $(STAMP)
+test: $(DEV_STAMP)
 	CI=$${CI:-1} $(PY) -m pytest -q tests
 
 # Fresh random examples, ten times as many, for the property tests (no ROS processes).
-fuzz: $(STAMP)
+fuzz: $(DEV_STAMP)
 	HYPOTHESIS_PROFILE=fuzz $(PY) -m pytest -q tests --ignore=tests/integration
 
-bench: $(STAMP)
+# Every benchmark; the report's are stored in bench/results/ (not with --quick).
+bench: $(DEV_STAMP)
 	$(PY) bench/run_all.py $(ARGS)
+
+lint: $(DEV_STAMP)
+	$(PY) -m pytest -q tests/test_lint.py
 
 clean:
 	rm -rf build $(VENV)

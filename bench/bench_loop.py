@@ -1,7 +1,7 @@
 """The haptic loop over ROS 2 against its floor, and the loop's round trip per layout and rate.
 
     .venv/bin/python bench/bench_loop.py [--layouts separate composed composed-dds] [--runs 3]
-                                         [--seconds 8] [--recorder off on]
+                                         [--seconds 8] [--recorder off on] [--json PATH]
     .venv/bin/python bench/bench_loop.py --sweep [--rates 500 1000 2000] [--duration 10]
     .venv/bin/python bench/bench_loop.py --cross-validation [--runs 3] [--seconds 8]
 
@@ -34,6 +34,7 @@ import time
 import machine
 import numpy as np
 import psutil
+import result_files
 import yaml
 
 from haptic_bringup.launcher import add_venv_prefix, Loop, loop_environment, LoopConfig
@@ -236,6 +237,7 @@ def main(argv=None) -> int:
     parser.add_argument('--rates', nargs='+', type=float, default=[1000.0])
     parser.add_argument('--duration', type=float, default=10.0, help='per --sweep run')
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    result_files.add_option(parser)
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -264,6 +266,7 @@ def main(argv=None) -> int:
               f'{ratios["p50"]:6.2f} {ratios["p99"]:6.2f}  {"held" if held else "MISSED"}')
         for what, ok in verdicts(comparison):
             print(f'    {"ok  " if ok else "MISS"} {what}')
+    result_files.write(args.json, table)
     return 0
 
 

@@ -1,6 +1,6 @@
 """Our signed distance on extreme geometry: tiny, huge, far, thin, grazing, degenerate, NaN.
 
-    .venv/bin/python bench/extreme_cases.py [--points 200] [--seed 0]
+    .venv/bin/python bench/extreme_cases.py [--points 200] [--seed 0] [--json PATH]
 
 Each case queries ``collision_engine.distance`` (the public one-shape API, default request) on
 a few hundred points and reports, against exact ground truth (``tests/ground_truth.py``:
@@ -26,6 +26,7 @@ import tempfile
 from typing import Callable
 
 import numpy as np
+import result_files
 from scipy.spatial.transform import Rotation
 
 import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
@@ -309,8 +310,11 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--points', type=int, default=200, help='query points per case')
     parser.add_argument('--seed', type=int, default=0)
+    result_files.add_option(parser)
     args = parser.parse_args(argv)
-    print(format_rows(rows(args.points, args.seed)))
+    table = rows(args.points, args.seed)
+    print(format_rows(table))
+    result_files.write(args.json, table)
 
 
 if __name__ == '__main__':

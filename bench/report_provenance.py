@@ -1,5 +1,6 @@
-"""Where a report comes from: the machine, the versions, the date and the commit it was made on."""
+"""Where a report or a benchmark's result comes from: the machine, versions, date, commit, load."""
 
+import os
 from pathlib import Path
 import platform
 import subprocess
@@ -8,11 +9,12 @@ import time
 import machine as bench_machine
 from report_format import format_utc
 
-__all__ = ['VERSIONED', 'provenance']
+__all__ = ['OUTPUTS', 'VERSIONED', 'provenance']
 
 ROOT = Path(__file__).resolve().parents[1]
 VERSIONED = ('numpy', 'scipy', 'numba', 'ros-jazzy-rclpy', 'python-fcl', 'coal', 'trimesh',
              'rosbags', 'matplotlib')
+OUTPUTS = ('report', 'bench/results')  # what the runs write: not the code they ran
 
 
 def _git(*args: str) -> str:
@@ -25,11 +27,13 @@ def _git(*args: str) -> str:
 
 
 def provenance() -> dict:
-    """Describe the machine, the versions, the date and the commit the report is made on."""
+    """Describe the machine, the versions, the date, the commit and the load average now."""
     machine = bench_machine.describe(*VERSIONED)
     commit = _git('rev-parse', 'HEAD') or 'unknown'
-    dirty = _git('status', '--porcelain', '--untracked-files=no')
+    dirty = _git('status', '--porcelain', '--untracked-files=no', '--', '.',
+                 *(f':!{output}' for output in OUTPUTS))
     return {'date': format_utc(time.time()), 'cpu': machine['cpu'], 'cores': machine['cores'],
             'python': machine['python'], 'platform': platform.platform(),
             'commit': commit + (' (with uncommitted changes)' if dirty else ''),
+            'load': list(os.getloadavg()),
             'versions': {package: machine[package] for package in VERSIONED}}

@@ -23,7 +23,7 @@ from haptic_bringup.contacts import contact_intervals, MIN_FORCE
 
 __all__ = ['DEFINITIONS', 'counts_section', 'error_time_section', 'experiment_section',
            'extreme_section', 'force_effect_section', 'headline_section', 'identical_modes',
-           'interval_table', 'loop_section', 'provenance_section', 'servo_section', 'skipped',
+           'interval_table', 'loop_section', 'provenance_section', 'servo_section',
            'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'teleop_section',
            'tradeoff_section']
 
@@ -36,7 +36,7 @@ def provenance_section(info: dict, recordings: dict, argv: list) -> str:
         f'- **Made** {info["date"]} by `python bench/report.py {" ".join(argv)}`, commit '
         f'`{info["commit"]}`',
         f'- **Machine** {info["cpu"]}, {info["cores"]} cores, {info["platform"]}; Python '
-        f'{info["python"]}',
+        f'{info["python"]}; load average {" / ".join(f"{v:.1f}" for v in info["load"])}',
         f'- **Versions** {versions}',
         f'- **Bags** (demo over ROS 2, recorded) {bags}',
     ])
@@ -346,8 +346,11 @@ def _strong_line(angles: np.ndarray) -> str:
 
 
 def servo_section(rows: list) -> str:
-    """Tabulate the servo rate's cost, the stiffest clean wall and the felt latency."""
-    stiffnesses = list(rows[0]['local_contacts'])
+    """Tabulate the servo rate's cost, the stiffest clean wall and the felt latency.
+
+    The contacts are keyed by stiffness, N/m (as text, read back from a stored run).
+    """
+    stiffnesses = [float(k) for k in rows[0]['local_contacts']]
     return markdown_table(
         ['servo rate (Hz)', 'period p50 (µs)', 'period p99 (µs)', 'stiffest clean wall (N/m)',
          'felt (ms)', 'contacts per tap, local / remote, at K = '
@@ -388,11 +391,6 @@ def force_effect_section(cuboid: Recording, without: list | None, demo_dir: Path
             'with it held at zero. The hand aims 10 mm inside the face; the force stops it a '
             'few millimetres in.\n\n' + markdown_table(
                 ['cuboid taps', 'contacts', 'deepest (mm)', 'median deepest per tap (mm)'], rows))
-
-
-def skipped(what: str) -> str:
-    """Say that a stage was left out with ``--skip``."""
-    return f'*Skipped in this run ({what}); run without `--skip` to include it.*'
 
 
 def teleop_section(rows: list) -> str:

@@ -10,6 +10,10 @@ the exit code is 1 if any failed. ``--quick`` gives each script its own smaller 
 points, repeats, runs or seconds: ``Benchmark.quick``); none of the scripts has a ``--quick``
 of its own. ``BENCHMARKS`` must list every script in ``bench/`` that runs as a benchmark
 (``tests/bench/test_run_all.py`` checks it), so a new one cannot be left out.
+
+The benchmarks the report shows are ``stored``: a full run (not ``--quick``, whose sizes give no
+figures) passes them ``--json bench/results/<name>.json``, and the report is built from those
+files (``result_files``), each section saying when and where its file was measured.
 """
 
 import argparse
@@ -20,6 +24,8 @@ import subprocess
 import sys
 import time
 
+import result_files
+
 __all__ = ['BENCHMARKS', 'Benchmark', 'Outcome', 'main', 'run', 'summary']
 
 BENCH = Path(__file__).resolve().parent
@@ -27,11 +33,22 @@ BENCH = Path(__file__).resolve().parent
 
 @dataclass(frozen=True)
 class Benchmark:
-    """One benchmark script in ``bench/``, and the arguments that make it quick."""
+    """One benchmark script in ``bench/``, the arguments that make it quick, whether it is stored.
+
+    A ``stored`` one's full run writes ``result_files.RESULTS / <name>.json``, which the report
+    reads.
+    """
 
     name: str
     script: str
     quick: tuple[str, ...] = ()
+    stored: bool = False
+
+    def arguments(self, quick: bool, results: Path) -> tuple[str, ...]:
+        """Return the script's arguments: quick sizes, or where to store a full run."""
+        if quick:
+            return self.quick
+        return ('--json', str(results / f'{self.name}.json')) if self.stored else ()
 
 
 @dataclass(frozen=True)
@@ -49,33 +66,40 @@ BENCHMARKS = (
     Benchmark('cross_validation', 'bench_cross_validation.py', ('--seconds', '1')),
     Benchmark('mesh_load', 'bench_mesh_load.py', ('--rounds', '1')),
     Benchmark('model_error', 'model_error.py', ('--contacts', '100')),
+    Benchmark('error_time', 'error_time.py', ('--random', '100', '--near', '100', '--tapping',
+                                              '0.4', '--slow-points', '60'), stored=True),
+    Benchmark('gjk_tradeoff', 'gjk_tradeoff.py', ('--points', '200'), stored=True),
     Benchmark('wand_driver', 'bench_wand_driver.py', ('--repeats', '2', '--seconds', '2')),
-    Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3')),
+    Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3'), stored=True),
     Benchmark('bridge', 'bench_bridge.py', ('--runs', '1', '--seconds', '3')),
     Benchmark('loop_stats', 'bench_loop_stats.py', ('--hours', '0.1', '1')),
     Benchmark('stream_cost', 'stream_cost.py', ('--seconds', '2', '--runs', '1')),
-    Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5')),
+    Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5'), stored=True),
     Benchmark('servo_rate', 'servo_rate.py',
-              ('--rates', '1000', '4000', '--stiffness', '5000', '100000')),
-    Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4')),
-    Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60')),
+              ('--rates', '1000', '4000', '--stiffness', '5000', '100000'), stored=True),
+    Benchmark('stiff_wall', 'stiff_wall_loop.py', ('--duration', '4'), stored=True),
+    Benchmark('extreme_cases', 'extreme_cases.py', ('--points', '60'), stored=True),
     Benchmark('tool', 'bench_tool.py', ('--near', '300', '--tapping', '1')),
     Benchmark('probe', 'bench_probe.py', ('--poses', '300')),
-    Benchmark('teleop_lockstep', 'teleop_lockstep.py', ('--delays', '0.05')),
-    Benchmark('teleop_scan', 'teleop_scan.py', ('--delays', '0.05')),
+    Benchmark('teleop_lockstep', 'teleop_lockstep.py', ('--delays', '0.05'), stored=True),
+    Benchmark('teleop_scan', 'teleop_scan.py', ('--delays', '0.05'), stored=True),
     Benchmark('link_door', 'bench_link_door.py', ('--messages', '2000', '--repeats', '1')),
     Benchmark('image', 'bench_image.py', ('--frames', '100', '--no-simus')),
 )
 
 
-def run(benchmarks, *, quick: bool = False, folder: Path = BENCH) -> list[Outcome]:
-    """Run each benchmark's script from ``folder`` in turn; one failure does not stop the rest."""
+def run(benchmarks, *, quick: bool = False, folder: Path = BENCH,
+        results: Path = result_files.RESULTS) -> list[Outcome]:
+    """Run each benchmark's script from ``folder`` in turn; one failure does not stop the rest.
+
+    A stored benchmark's full run writes its results into ``results``.
+    """
     environment = dict(os.environ)
     environment.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     outcomes = []
     for count, benchmark in enumerate(benchmarks, 1):
         command = [sys.executable, str(folder / benchmark.script),
-                   *(benchmark.quick if quick else ())]
+                   *benchmark.arguments(quick, results)]
         print(f'[bench] {count}/{len(benchmarks)} {benchmark.name}: {" ".join(command)}',
               flush=True)
         started = time.monotonic()
@@ -109,6 +133,9 @@ def main(argv=None) -> int:
     chosen = [b for b in BENCHMARKS if not args.only or b.name in args.only]
     outcomes = run(chosen, quick=args.quick)
     print('[bench] summary:', summary(outcomes), sep='\n', flush=True)
+    if not args.quick and any(o.benchmark.stored for o in outcomes):
+        print(f'[bench] the report\'s results are in {result_files.RESULTS}; `make report` '
+              '(or `make demo`) builds the report from them', flush=True)
     return 0 if all(o.returncode == 0 for o in outcomes) else 1
 
 

@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/servo_rate.py [--rates 1000 2000 4000 10000]
                                          [--stiffness 160 1000 5000 20000 100000 500000]
+                                         [--json PATH]
 
 The simulated wand taps a wall (``tests/haptic_wand_driver/taps.py``: pushed 10 mm in, held,
 lifted), the model of each pose reaching the device one 1 ms tick later. Per servo rate, with the
@@ -19,6 +20,7 @@ import sys
 
 import machine
 import numpy as np
+import result_files
 sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests' / 'haptic_wand_driver'))
 from taps import servo_cost, tap  # noqa: E402 -- the harness the tests use
 
@@ -53,19 +55,22 @@ def main(argv=None) -> int:
     parser.add_argument('--rates', nargs='+', type=float, default=[1e3, 2e3, 4e3, 1e4])
     parser.add_argument('--stiffness', nargs='+', type=float,
                         default=[1e3, 1e4, 1e5, 2e5, 5e5, 1e6])
+    result_files.add_option(parser)
     args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")}')
     print(f'{"servo Hz":>9} {"Python p50 us":>13} {"p99 us":>7} {"compiled p50":>12} '
           f'{"p99":>5} {"stiffest clean N/m":>18} '
           f'{"felt ms":>8}  contacts per tap, local | remote, at K = '
           f'{", ".join(f"{k:g}" for k in args.stiffness)}')
-    for row in rows(args.rates, args.stiffness):
+    table = rows(args.rates, args.stiffness)
+    for row in table:
         local = ' '.join(str(c) for c in row['local_contacts'].values())
         remote = ' '.join(str(c) for c in row['remote_contacts'].values())
         print(f'{row["rate"]:9.0f} {row["cost_p50_us"]:13.1f} {row["cost_p99_us"]:7.1f} '
               f'{row["compiled_p50_us"]:12.1f} {row["compiled_p99_us"]:5.1f} '
               f'{row["stiffest_clean"]:18g} {row["latency_ms"]:8.3f}  {local} | {remote} '
               f'(remote felt {row["remote_latency_ms"]:.2f} ms)', flush=True)
+    result_files.write(args.json, table)
     return 0
 
 

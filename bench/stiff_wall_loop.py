@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/stiff_wall_loop.py [--stiffness 160 1000 5000 20000 100000]
                                               [--duration 6] [--rendering local remote]
+                                              [--json PATH]
 
 The virtual-wall sweep (``stiffness_sweep.py``) checks the force law against a simulated device
 with a zero-order hold. Here the whole loop runs, three processes over ROS 2: the simulated
@@ -23,6 +24,7 @@ import tempfile
 
 import machine
 import numpy as np
+import result_files
 
 from collision_engine import load_scene
 from force_renderer.params import ForceRendererParams
@@ -129,19 +131,23 @@ def main(argv=None) -> int:
                         choices=['local', 'remote'])
     parser.add_argument('--duration', type=float, default=6.0)
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    result_files.add_option(parser)
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     print(f'machine: {machine.line("ros-jazzy-rclpy", "numba")}')
     print(f'{"K N/m":>8} {"rendering":>9} {"contacts/tap":>12} {"net work mJ":>11} '
           f'{"depth mm":>8} {"/ ideal":>7} {"peak N":>7} {"answered":>8}')
+    rows = []
     for stiffness in args.stiffness:
-        for r in compare(stiffness, args.rendering, duration=args.duration,
-                         domain_id=args.domain_id):
+        rows += compare(stiffness, args.rendering, duration=args.duration,
+                        domain_id=args.domain_id)
+        for r in rows[-len(args.rendering):]:
             print(f'{stiffness:8.0f} {r["rendering"]:>9} {r["contacts_per_tap"]:12.1f} '
                   f'{1e3 * r["net_work_j"]:11.2f} {1e3 * r["max_depth_m"]:8.2f} '
                   f'{r["max_depth_m"] / r["ideal_depth_m"]:7.2f} {r["peak_force_n"]:7.2f} '
                   f'{r["answered_percent"]:8.2f}', flush=True)
+    result_files.write(args.json, rows)
     return 0
 
 

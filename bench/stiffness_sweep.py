@@ -16,7 +16,7 @@ Modes: `off` (no passivity layer), `on` (this package's `PassivityController`), 
 comparison only). The results are deterministic; the machine is printed for the record, and
 `--timing` adds the per-step cost of the default pipeline (median and p99 over many calls).
 
-Usage: .venv/bin/python bench/stiffness_sweep.py [--points 13] [--timing]
+Usage: .venv/bin/python bench/stiffness_sweep.py [--points 13] [--timing] [--json PATH]
 """
 
 import argparse
@@ -27,6 +27,7 @@ import time
 
 import machine
 import numpy as np
+import result_files
 
 from force_renderer import (Contact, ForcePipeline, GodObjectProxy, passivity_bound,
                             PipelineConfig, SpringDamper)
@@ -164,6 +165,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--points', type=int, default=13, help='stiffnesses from 1e2 to 1e5')
     parser.add_argument('--timing', action='store_true', help='also time ForcePipeline.step')
+    result_files.add_option(parser)
     args = parser.parse_args()
     print(f'machine: {machine.line("numpy", "scipy")}')
     bound = passivity_bound(DEVICE.damping, PipelineConfig().servo_period, WALL_DAMPING)
@@ -172,10 +174,12 @@ def main() -> None:
           f'Colgate bound K_max = {bound:.0f} N/m')
     print(f'{"K N/m":>9} {"mode":>13} {"generated J":>12} {"early mm":>9} {"late mm":>9} '
           f'{"late/early":>10} {"max F N":>8} {"max pen mm":>10}')
-    for row in sweep(np.logspace(2, 5, args.points)):
+    rows = sweep(np.logspace(2, 5, args.points))
+    for row in rows:
         print(f'{row.stiffness:9.0f} {row.mode:>13} {row.generated_energy:+12.3e} '
               f'{row.early_amplitude * 1e3:9.4f} {row.late_amplitude * 1e3:9.4f} '
               f'{row.decay_ratio:10.3g} {row.max_force:8.2f} {row.max_penetration * 1e3:10.3f}')
+    result_files.write(args.json, {'colgate_bound': bound, 'rows': rows})
     if args.timing:
         for name, times in time_step().items():
             print(f'{name}: median {np.median(times) * 1e6:.1f} us, '

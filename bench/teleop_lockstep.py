@@ -1,6 +1,6 @@
 """The telerobotic scan in lockstep, without ROS: the schemes' physics alone, reproducibly.
 
-    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.025 0.05 0.1 0.25]
+    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.025 0.05 0.1 0.25] [--json PATH]
 
 The same pieces as the ROS run, driven by one clock at 1 kHz: the simulated wand with its
 scripted hand (the driver's ``SimulatedWand`` at 4 kHz, rendering the model locally or holding
@@ -17,6 +17,7 @@ import sys
 
 import machine
 import numpy as np
+import result_files
 import teleop_scan
 
 from haptic_bringup.launcher import SCAN_DURATION
@@ -146,14 +147,17 @@ def main(argv=None) -> int:
                         default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
     parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
     parser.add_argument('--loss', type=float, default=0.01)
+    result_files.add_option(parser)
     args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")} (no ROS: one clock, lockstep)')
     teleop_scan.print_header()
+    rows = []
     for delay in args.delays:
         for scheme in args.schemes:
             run = scan(scheme, delay, jitter=args.jitter * delay, loss=args.loss)
-            teleop_scan.print_row({'scheme': scheme,
-                                   **teleop_scan.figures(as_series(run), delay)})
+            rows.append({'scheme': scheme, **teleop_scan.figures(as_series(run), delay)})
+            teleop_scan.print_row(rows[-1])
+    result_files.write(args.json, rows)
     return 0
 
 

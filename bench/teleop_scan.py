@@ -2,7 +2,7 @@
 
     .venv/bin/python bench/teleop_scan.py [--schemes direct tdpa model]
         [--delays 0 0.01 0.025 0.05 0.1 0.25] [--jitter 0.1] [--loss 0.01]
-        [--site-streams in-process dds]
+        [--site-streams in-process dds] [--json PATH]
 
 Both sites run as real processes in two DDS domains, with the link bridge between them
 (``haptic_loop --teleop``): the scripted sonographer approaches the patient phantom, presses,
@@ -21,7 +21,8 @@ applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor
 The jitter is given as a fraction of the delay (10 %, as the issue asks). Each site is one
 process; its nodes hand their streams over in the process (``in-process``, the default) or
 through DDS (``dds``: the sites before intra-process delivery, their CPU's baseline). With both,
-each case runs once per way, one after the other.
+each case runs once per way, one after the other. With ``--json`` the figure of the felt and
+the patient's force against time at 100 ms, one panel per scheme, is drawn beside the file (.png).
 """
 import argparse
 import os
@@ -34,6 +35,7 @@ import time
 import machine
 import numpy as np
 import psutil
+import result_files
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
@@ -48,6 +50,7 @@ GRID = 1e-3  # [s]
 MEAN_WINDOW = 0.25  # [s] the felt force's own slow part
 STABLE_OSCILLATION = 10.0  # [%] of the mean felt force
 LAG_MARGIN = 0.2  # [s] the robot's own lag behind its target (its impedance, its speed limit)
+FIGURE_DELAY = 0.1  # [s] the delay whose runs are drawn with --json
 CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the sweep
 SITE_STREAMS = ('in-process', 'dds')
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
@@ -171,18 +174,25 @@ def main(argv=None) -> int:
     parser.add_argument('--site-streams', nargs='+', default=['in-process'],
                         choices=SITE_STREAMS, help="how each site's nodes pass their streams")
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    result_files.add_option(parser)
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     print_header()
-    rows = []
-    for delay in args.delays:
-        for scheme in args.schemes:
-            for site_streams in args.site_streams:
-                rows.append(run(scheme, delay, jitter=args.jitter, loss=args.loss,
-                                domain_id=args.domain_id, site_streams=site_streams))
-                print_row(rows[-1])
+    rows, traces = [], {}
+    with tempfile.TemporaryDirectory() as kept:
+        for delay in args.delays:
+            for scheme in args.schemes:
+                for site_streams in args.site_streams:
+                    drawn = args.json and delay == FIGURE_DELAY and site_streams == 'in-process'
+                    folder = pathlib.Path(kept) / scheme if drawn else None
+                    rows.append(run(scheme, delay, jitter=args.jitter, loss=args.loss,
+                                    domain_id=args.domain_id, site_streams=site_streams,
+                                    keep=folder))
+                    print_row(rows[-1])
+                    if folder:
+                        traces[scheme] = read_scan(folder / 'bag')
     print('\nCPU, % of one core, over the press and the sweep (the machine has '
           f'{psutil.cpu_count()} cores):')
     names = list(rows[0]['cpu'])
@@ -192,6 +202,11 @@ def main(argv=None) -> int:
         print(f'{r["scheme"]:>6} {1e3 * r["delay"]:6.0f} {r["site_streams"]:>10} '
               + ' '.join(f'{r["cpu"][n]:9.1f}' for n in names)
               + f' {sum(r["cpu"].values()):7.1f}')
+    result_files.write(args.json, rows)
+    if traces:
+        from report_figures import teleop_figure
+
+        teleop_figure(traces, FORCE_SCALE, FIGURE_DELAY, args.json.with_suffix('.png'))
     return 0
 
 

@@ -1,13 +1,18 @@
-"""The committed ``report/README.md``: every image it links is in ``report/``, tracked by git.
+"""The committed ``report/README.md``: its images, and the stored benchmark results it shows.
 
 The report's PNGs are committed so that the report shows its figures on the repository page;
-a figure left untracked (or ignored) would be a broken picture there.
+a figure left untracked (or ignored) would be a broken picture there. Its benchmarks' sections
+come from the results ``make bench`` stored in ``bench/results/``: those are committed too, and
+each section must cite the very file it was built from (a result measured again without the
+report rebuilt, or the other way round, fails here).
 """
 from pathlib import Path
 import re
 import subprocess
 
 import pytest
+from report_benchmarks import STORED, TELEOP_FIGURE
+from result_files import describe, read, RESULTS
 
 ROOT = Path(__file__).resolve().parents[2]
 REPORT = ROOT / 'report'
@@ -19,9 +24,9 @@ def linked_images() -> list[str]:
     return IMAGE_LINK.findall((REPORT / 'README.md').read_text())
 
 
-def tracked_files() -> set[str]:
+def tracked_files(folder: str = 'report') -> set[str]:
     try:
-        done = subprocess.run(['git', 'ls-files', '--', 'report'], cwd=ROOT, capture_output=True,
+        done = subprocess.run(['git', 'ls-files', '--', folder], cwd=ROOT, capture_output=True,
                               text=True, timeout=30)
     except OSError as error:
         pytest.skip(f'no git here: {error}')
@@ -49,3 +54,19 @@ def test_the_committed_figures_are_small():
     for link in linked_images():
         size = (REPORT / link).stat().st_size
         assert size < LARGEST_IMAGE, f'{link}: {size} bytes'
+
+
+def test_each_benchmark_section_cites_the_committed_result_it_was_built_from():
+    text = (REPORT / 'README.md').read_text()
+    tracked = tracked_files('bench/results')
+    for name in STORED:
+        stored = read(name)
+        assert stored is not None, f'{name}: no stored result (make bench ARGS=\'--only {name}\')'
+        assert f'bench/results/{name}.json' in tracked, f'{name}: stored, but not tracked by git'
+        assert describe(stored) in text, f'{name}: the report is not built from it (make report)'
+
+
+def test_the_telerobotic_figure_is_the_stored_scans():
+    stored = RESULTS / TELEOP_FIGURE
+    assert f'bench/results/{TELEOP_FIGURE}' in tracked_files('bench/results')
+    assert (REPORT / 'teleop_forces.png').read_bytes() == stored.read_bytes()

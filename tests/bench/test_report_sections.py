@@ -1,7 +1,7 @@
 """The report's Markdown sections that decide what to say, on rows made by hand."""
 from pathlib import Path
 
-from report_sections import force_effect_section, identical_modes, skipped
+from report_sections import force_effect_section, identical_modes
 from stiffness_sweep import SweepRow
 
 
@@ -28,8 +28,3 @@ def test_identical_modes_counts_the_stiffnesses_where_two_modes_agree_exactly():
 def test_without_the_control_run_the_force_section_says_where_it_looked():
     text = force_effect_section(None, None, Path('/nowhere/demo'))
     assert text == '*The demo\'s control run (cuboid-no-force) was not found in /nowhere/demo.*'
-
-
-def test_a_skipped_stage_says_how_to_include_it():
-    assert skipped('loop latency') == (
-        '*Skipped in this run (loop latency); run without `--skip` to include it.*')

@@ -1,7 +1,7 @@
 """``bench/run_all.py``: it lists every benchmark, and a failing one does not stop the rest.
 
 No real benchmark runs here: the list is checked against the files in ``bench/``, and the
-runner is driven on two throw-away scripts.
+runner is driven on throw-away scripts.
 """
 from pathlib import Path
 import re
@@ -49,3 +49,20 @@ def test_without_quick_the_script_gets_no_arguments(tmp_path: Path, capfd):
     (tmp_path / 'works.py').write_text('import sys\nprint("argv", sys.argv[1:])\n')
     run([Benchmark('works', 'works.py', ('--n', '2'))], folder=tmp_path)
     assert 'argv []' in capfd.readouterr().out
+
+
+def test_a_stored_benchmark_writes_its_results_on_a_full_run_only(tmp_path: Path, capfd):
+    (tmp_path / 'works.py').write_text('import sys\nprint("argv", sys.argv[1:])\n')
+    stored = Benchmark('works', 'works.py', ('--n', '2'), stored=True)
+    run([stored], folder=tmp_path, results=tmp_path / 'results')
+    assert f"argv ['--json', '{tmp_path / 'results' / 'works.json'}']" in capfd.readouterr().out
+    run([stored], quick=True, folder=tmp_path, results=tmp_path / 'results')
+    assert "argv ['--n', '2']" in capfd.readouterr().out
+
+
+def test_every_stored_benchmark_takes_json_and_writes_its_results():
+    for benchmark in BENCHMARKS:
+        source = (BENCH / benchmark.script).read_text()
+        takes = 'result_files.add_option(parser)' in source
+        writes = 'result_files.write(args.json' in source
+        assert takes == writes == benchmark.stored, benchmark.script

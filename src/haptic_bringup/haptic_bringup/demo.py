@@ -135,23 +135,30 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     add_venv_prefix()
     started = time.monotonic()
-    for name in args.experiments:
+    for count, name in enumerate(args.experiments, 1):
+        step = time.monotonic()
+        print(f'[demo] {count}/{len(args.experiments)} {name}: {_what(name)} ...', flush=True)
         try:
-            if name == TELEOP:
-                print(f'[demo] {name}: scanning the patient phantom through the remote robot '
-                      f'for {SCAN_DURATION:g} s ...', flush=True)
-                print(summarise_teleop(run_teleop(args.out, domain_id=args.domain_id)),
-                      flush=True)
-                continue
-            print(f'[demo] {name}: tapping for {DURATION:g} s over ROS 2 ...', flush=True)
-            files = run_experiment(name, args.out, composed=not args.separate,
-                                   domain_id=args.domain_id)
+            print(_run_and_summarise(name, args), flush=True)
         except RuntimeError as error:
             print(f'[demo] {error}', file=sys.stderr)
             return 1
-        print(summarise(name, files), flush=True)
+        print(f'[demo]     {name}: done in {time.monotonic() - step:.0f} s', flush=True)
     print(f'[demo] done in {time.monotonic() - started:.0f} s; bags in {args.out}')
     return 0
+
+
+def _what(name: str) -> str:
+    if name == TELEOP:
+        return f'scanning the patient phantom through the remote robot for {SCAN_DURATION:g} s'
+    return f'tapping for {DURATION:g} s over ROS 2'
+
+
+def _run_and_summarise(name: str, args) -> str:
+    if name == TELEOP:
+        return summarise_teleop(run_teleop(args.out, domain_id=args.domain_id))
+    return summarise(name, run_experiment(name, args.out, composed=not args.separate,
+                                          domain_id=args.domain_id))
 
 
 if __name__ == '__main__':
