@@ -33,8 +33,10 @@ PERIOD = 1e-3  # [s]
 
 
 def _follower() -> Follower:
-    """A follower whose session is never given up, nor its link learnt again: every message of
-    a kind meets the same door, however long the run."""
+    """Return a follower that never gives its session up, nor learns its link again.
+
+    So every message of a kind meets the same door, however long the run.
+    """
     limits = CommandLimits(np.full(3, -0.4), np.full(3, 0.4), HAND_SPEED)
     return Follower(FollowerConfig('direct', 1500.0),
                     PatientSafety(SafetyConfig(robot_stiffness=1500.0)), limits,
