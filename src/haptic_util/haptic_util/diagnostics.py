@@ -2,18 +2,30 @@
 
 The last report of a node that stops cleanly carries its final counts (messages published,
 inputs refused), so a recorded session documents its own completeness: a reader compares what each
-node says it published with what the bag holds.
+node says it published with what the bag holds. A recorder in the node's own process
+(``listen``) is handed each report as it is published, the last one too: that one is written as
+the node is destroyed, when its process no longer takes anything over DDS.
 """
 from typing import Callable
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.node import Node
 
-__all__ = ['Diagnostics', 'Report', 'OK', 'WARN', 'ERROR']
+__all__ = ['Diagnostics', 'Report', 'listen', 'stop_listening', 'OK', 'WARN', 'ERROR']
 
 OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
 DIAGNOSTICS_TOPIC = '/diagnostics'
 DIAGNOSTICS_DEPTH = 10
+_listeners: list = []  # callables handed every report this process publishes
+
+
+def listen(callback: Callable[[DiagnosticArray], None]) -> None:
+    """Hand ``callback`` every report of this process's nodes, before it goes out over DDS."""
+    _listeners.append(callback)
+
+
+def stop_listening(callback: Callable[[DiagnosticArray], None]) -> None:
+    _listeners.remove(callback)
 
 
 class Report:
@@ -41,6 +53,8 @@ class Diagnostics:
             values=[KeyValue(key=key, value=str(value)) for key, value in report.values.items()])
         array = DiagnosticArray(status=[status])
         array.header.stamp = self._node.get_clock().now().to_msg()
+        for listener in _listeners:
+            listener(array)
         self._publisher.publish(array)
 
     def final(self) -> None:
