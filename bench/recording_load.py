@@ -17,7 +17,9 @@ alternate.
 Published counts are what each node says in its final ``/diagnostics`` report; recorded, what
 the bag holds (the site's bag for a telerobotic site's own streams). Per run: the totals, every
 topic that lost any, what the recorders said they dropped (a full queue) and lost (DDS, a
-recorder process), and the load average at the end.
+recorder process), the CPU of all the session's processes per pose over the middle third of
+a run that ends by itself (its recorder's included, wherever it runs) with the driver's tick
+period over it (p50, p99, max, from the poses' stamps), and the load average.
 """
 import argparse
 import os
@@ -29,12 +31,14 @@ import tempfile
 import time
 
 import machine
+import numpy as np
+import psutil
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import (published_counts, PUBLISHERS, reported, SITE_PUBLISHERS,
-                                    topic_counts)
+from haptic_bringup.session import (published_counts, PUBLISHERS, read_vectors, reported,
+                                    SITE_PUBLISHERS, topic_counts)
 
 LAYOUTS = ('composed', 'separate', 'teleop', 'composed-rp')
 STOPS = ('end', 'launcher', 'all')
@@ -61,6 +65,7 @@ def run(layout: str, stop: str, hogs: int, seconds: float, domain_id: int) -> di
         try:
             with Loop(config(layout, seconds, folder, domain_id)) as loop:
                 if stop == 'end':
+                    window = cpu_window(loop, seconds)
                     loop.wait(seconds + 60.0)
                 else:
                     time.sleep(seconds / 2)
@@ -77,9 +82,31 @@ def run(layout: str, stop: str, hogs: int, seconds: float, domain_id: int) -> di
         said = {key: {name: int(values[-1]) for name, values
                       in reported(folder / 'bag', typestore, key).items()}
                 for key in ('dropped', 'lost')}
+        if stop == 'end':
+            start, end, cpu = window
+            received = read_vectors(folder / 'bag', typestore, {'/wand/pose': 'pose'})
+            inside = (received['/wand/pose'][0] >= start) & (received['/wand/pose'][0] < end)
+            said['cpu_per_pose'] = cpu / np.count_nonzero(inside)
+            ticks = np.diff(read_vectors(folder / 'bag', typestore, {'/wand/pose': 'pose'},
+                                         stamped=True)['/wand/pose'][0][inside])
+            said['ticks'] = np.percentile(ticks, [50, 99]).tolist() + [float(ticks.max())]
     return {'published': published, 'unreported': sorted(set(publishers) - set(published)),
             'recorded': {topic: recorded.get(topic, 0) for topic in publishers}, **said,
             'load': os.getloadavg()[0]}
+
+
+def cpu_window(loop: Loop, seconds: float) -> tuple:
+    """CPU of every process of the session over its middle third: (start s, end s, CPU s)."""
+    processes = [psutil.Process(child.pid) for child in loop.children]
+    time.sleep(seconds / 3)
+    before, start = sum(_cpu(p) for p in processes), time.time()
+    time.sleep(seconds / 3)
+    return start, time.time(), sum(_cpu(p) for p in processes) - before
+
+
+def _cpu(process: psutil.Process) -> float:
+    times = process.cpu_times()
+    return times.user + times.system
 
 
 def interrupt_all(loop: Loop) -> None:
@@ -100,6 +127,9 @@ def line(layout: str, stop: str, hogs: int, result: dict) -> str:
             f'{sum(recorded[t] for t in published):>10}  lost {lost or "none"}'
             + (f'  no final report: {result["unreported"]}' if result['unreported'] else '')
             + f'  recorders: dropped {result["dropped"]}, lost {result["lost"]}'
+            + (f'  CPU {1e6 * result["cpu_per_pose"]:.0f} us a pose, tick p50/p99/max '
+               + '/'.join(f'{1e3 * t:.2f}' for t in result['ticks']) + ' ms'
+               if 'cpu_per_pose' in result else '')
             + f'  load {result["load"]:.1f}')
 
 
