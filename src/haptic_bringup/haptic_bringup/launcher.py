@@ -218,18 +218,21 @@ def teleop_endpoints(config: LoopConfig) -> dict:
 
     Each site is one process: a stream between its nodes is a DDS endpoint only without
     intra-process delivery. So is each site's recorder, which is in its process and, with that
-    delivery, takes what crossed the link through the reader of the node that uses it.
+    delivery, takes what crossed the link through the reader of the node that uses it. The
+    recorder's reader of ``/diagnostics`` says it exists: a site builds it last, so its nodes
+    then spin (a remote site still starting would miss the operator's short session).
     """
     site = 0 if config.intra_process else 1  # a subscriber in the publisher's process
     recording = site if config.record else 0
+    reports = {'/diagnostics': (0, 1)} if config.record else {}
     return {
         config.domain_id: {'/wand/pose': (1, site + recording), '/teleop/command': (1, 1),
-                           '/teleop/feedback': (1, 1 + recording)},
+                           '/teleop/feedback': (1, 1 + recording), **reports},
         config.remote_domain_id: {'/teleop/command': (1, 1 + recording),
                                   '/teleop/feedback': (1, 1),
                                   '/robot/target_pose': (1, site),
                                   '/robot/tcp_pose': (1, site + recording),
-                                  '/robot/ft_sensor/wrench': (1, site + recording)},
+                                  '/robot/ft_sensor/wrench': (1, site + recording), **reports},
     }
 
 
@@ -305,7 +308,7 @@ class Loop:
             for name in config.nodes:
                 self.children.append(start_child(
                     name, [config.python, '-m', NODES[name][1], *ros_args], env))
-        self._wait_for_discovery()
+        self._wait_for_discovery(config.domain_id)
         self.startup_time = time.monotonic() - started
 
     def _composed(self, nodes, ros_args: list) -> list:
@@ -315,32 +318,37 @@ class Loop:
                 *([] if config.intra_process else [NO_INTRA_PROCESS]), *ros_args]
 
     def _start_teleop(self, env: dict, ros_args: list) -> None:
-        """Start the two sites, each one process in its own domain, and the bridge."""
+        """Start the two sites, each one process in its own domain, and the bridge.
+
+        The operator's site starts its scan as soon as its own loop closes, robot or not, so it
+        starts once the remote site is up (under load, the remote site took seconds longer).
+        """
         config = self.config
         remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
         bridge = self.run_dir / 'bridge.yaml'
         bridge.write_text(yaml.safe_dump(bridge_parameters(config), sort_keys=False))
-        for site, site_env in (('operator', env), ('remote', remote_env)):
-            self.children.append(start_child(
-                site, self._composed(site_nodes(config, site), ros_args), site_env))
+        self.children.append(start_child(
+            'remote', self._composed(site_nodes(config, 'remote'), ros_args), remote_env))
         # The bridge stands for the network between the sites, so it talks to them over UDP,
         # as a remote peer would: over Fast DDS's shared memory, a bridge that stopped (SIGSTOP,
         # a link down for a second) stalled the sites' processes that publish to it.
         self.children.append(start_child(
             'bridge', [config.python, '-m', BRIDGE_MODULE, '--ros-args', '--params-file',
                        str(bridge)], {**env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}))
+        self._wait_for_discovery(config.remote_domain_id)
+        self.children.insert(0, start_child(  # the operator's stops first
+            'operator', self._composed(site_nodes(config, 'operator'), ros_args), env))
 
-    def _wait_for_discovery(self) -> None:
-        endpoints = (teleop_endpoints(self.config) if self.config.teleop
-                     else {self.config.domain_id: expected_endpoints(self.config)})
-        missing = []
-        for domain_id, expected in endpoints.items():
-            watcher = GraphWatcher(domain_id)
-            try:
-                missing += watcher.wait(expected, DISCOVERY_TIMEOUT,
-                                        abort=lambda: self.exited() is not None)
-            finally:
-                watcher.close()
+    def _wait_for_discovery(self, domain_id: int) -> None:
+        """Wait until ``domain_id``'s endpoints of the loop or the session are discovered."""
+        expected = (teleop_endpoints(self.config)[domain_id] if self.config.teleop
+                    else expected_endpoints(self.config))
+        watcher = GraphWatcher(domain_id)
+        try:
+            missing = watcher.wait(expected, DISCOVERY_TIMEOUT,
+                                   abort=lambda: self.exited() is not None)
+        finally:
+            watcher.close()
         dead = self.exited()
         if dead is not None and _finished(dead):
             return  # a short experiment ran to its end before this watcher saw every endpoint
