@@ -10,6 +10,8 @@ a whole queue behind, what is dropped is counted in the recorder's report rather
 unseen. A stream that reaches the process over DDS (what crossed the link, at a telerobotic
 site) is taken by the one reader that feeds the node using it: the bag holds exactly what that
 node received. The process's reports, the last ones included, are handed over as published.
+(In a process whose streams go through DDS, ``--no-intra-process``, a benchmark's baseline, it
+takes them over DDS as its nodes do.)
 
 The process builds this node last (``haptic_bringup.composed``), so it is destroyed last, after
 every other node has said its last words. Each telerobotic site runs one and writes its own bag
