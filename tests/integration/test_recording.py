@@ -93,11 +93,12 @@ def test_with_a_core_hogged_the_bag_holds_every_message_each_node_published(tmp_
     # An independent reader decodes the bag from its own schemas.
     own = bag / 'operator' if layout == 'teleop' else bag
     poses = stamps(decoded(own, '/wand/pose'))
-    assert len(poses) == published['/wand/pose']
+    assert len(poses) == recorded['/wand/pose']
     assert (poses[-1] - poses[0]) * 1e-9 >= 0.95 * DURATION  # the whole session
     if layout != 'teleop':
         states = decoded(bag, '/collision/state')
         assert min(s.distance for s in states) < 0.0  # the taps went into the cuboid
+        assert recorded['/scene/description'] == 1  # latched: published once, at start-up
 
 
 def test_a_loop_killed_with_sigkill_leaves_a_bag_recovered_without_a_hole(tmp_path, capsys):
