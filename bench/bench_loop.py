@@ -11,7 +11,10 @@ per hop), alternating floor and loop runs, in each layout: ``separate`` (three p
 and ``composed-dds`` (one process, its streams through DDS: the composed layout before that, its
 baseline; the floor of both is the bare chain in one process). Each run has one outside
 observer (a separate process subscribed to the poses and wrenches, as ``ros2 topic echo`` or RViz
-would be), without and with the recorder. Per run: CPU of every process over the window (100 %
+would be), without and with the recorder. The floor is recorded by a recorder process; so is the
+loop, but for ``composed``, which records itself (``haptic_bringup.process_recorder``): its CPU
+includes its recording. ``--layouts composed-rp`` runs the composed loop with a recorder process
+instead, as before the recorder moved in. Per run: CPU of every process over the window (100 %
 = one core), and, seen by the observer, the pose rate, the share of poses answered by a wrench,
 and pose -> wrench p50 and p99. Then the loop's figures as ratios to the floor's (medians over
 the runs), and whether each target of the CPU issue holds.
@@ -49,7 +52,9 @@ WARM_UP = 3.0  # [s] from start to the window: discovery, the driver's probe, fi
 TAIL = 3.0  # [s] of experiment after the window: the cuboid's 10 s script ended inside it
 OBSERVER_SETTLE = 0.5  # [s] after the observer first hears both streams (see _observed)
 LAYOUTS = ('separate', 'composed', 'composed-dds')
-COMPOSED = ('composed', 'composed-dds')  # one process; its streams through DDS in the second
+# One process; its streams through DDS in the second; the third records with a recorder process
+# (the composed layout's recording before it moved in: --layouts composed-rp).
+COMPOSED = ('composed', 'composed-dds', 'composed-rp')
 TARGETS = {'cpu': 1.25, 'p99': 1.5, 'rate': 0.99, 'answered': 99.9}  # the CPU issue's
 
 
@@ -66,7 +71,7 @@ def run_once(layout: str, rate: float, duration: float, domain_id: int) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         stats = pathlib.Path(tmp) / 'stats.npz'
         config = LoopConfig(
-            composed=layout in COMPOSED, intra_process=layout == 'composed', scene=SCENE,
+            composed=layout in COMPOSED, intra_process=layout != 'composed-dds', scene=SCENE,
             experiment='cuboid', duration=duration,
             domain_id=domain_id, run_dir=pathlib.Path(tmp) / 'launch',
             overrides={'wand_driver': {'rate': float(rate), 'stats_file': str(stats)},
@@ -117,7 +122,8 @@ def session(kind: str, layout: str, recorder: bool, seconds: float, domain_id: i
         loop = None
         if kind == 'loop':
             loop = Loop(LoopConfig(
-                composed=layout in COMPOSED, intra_process=layout == 'composed', scene=scene,
+                composed=layout in COMPOSED, intra_process=layout != 'composed-dds',
+                record_in_process=layout == 'composed', scene=scene,
                 experiment=experiment,
                 duration=WARM_UP + seconds + TAIL,
                 record=str(folder / 'bag') if recorder else None, domain_id=domain_id,
@@ -227,7 +233,8 @@ def verdicts(comparison: dict) -> list:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--layouts', nargs='+', default=list(LAYOUTS), choices=LAYOUTS)
+    parser.add_argument('--layouts', nargs='+', default=list(LAYOUTS),
+                        choices=[*LAYOUTS, 'composed-rp'])
     parser.add_argument('--recorder', nargs='+', default=['off', 'on'], choices=['off', 'on'])
     parser.add_argument('--runs', type=int, default=3, help='floor/loop pairs per case')
     parser.add_argument('--seconds', type=float, default=8.0, help='measured window per run')

@@ -111,3 +111,25 @@ def test_a_bag_killed_with_sigkill_is_recovered_up_to_its_last_flush(tmp_path):
     # Every message of every flushed chunk, in order, and at most ~0.5 s (the flush period) lost.
     assert stamps == list(range(len(stamps)))
     assert len(stamps) >= written - 0.5 * written / 2.0 - 50
+
+
+def test_a_session_with_a_killed_site_is_refused_until_recovered_then_read_as_one(
+        tmp_path, capsys):
+    """A session folder holds a bag per site; one whose recorder was killed has no metadata."""
+    from haptic_bringup.bag import main
+    from haptic_bringup.session import bags, topic_counts
+    write_bag(tmp_path / 'scan' / 'operator', 3)
+    typestore = store()
+    killed = BagWriter(tmp_path / 'scan' / 'remote', typestore)
+    killed.add_topic('/remote/wand/pose', POSE)
+    for index in range(4):
+        killed.write('/remote/wand/pose', 1_000_000 * (index + 1), pose_cdr(typestore, index))
+    killed._writer.storage.flush_period = 0.0  # what FLUSH_PERIOD later would have flushed
+    killed.flush_if_due()  # and then the recorder was killed: never closed
+    with pytest.raises(ValueError, match='haptic_bag recover'):
+        bags(tmp_path / 'scan')
+    assert main(['recover', str(tmp_path / 'scan')]) == 0
+    assert 'recovered' in capsys.readouterr().out
+    assert [bag.name for bag in bags(tmp_path / 'scan')] == ['operator', 'remote-recovered']
+    counts = {'/wand/pose': 3, '/probe': 3, '/remote/wand/pose': 4}
+    assert topic_counts(tmp_path / 'scan') == counts

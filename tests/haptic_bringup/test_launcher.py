@@ -6,7 +6,7 @@ import sys
 import yaml
 
 from haptic_bringup.launcher import (expected_endpoints, loop_environment, LoopConfig,
-                                     node_parameters)
+                                     node_parameters, site_nodes)
 
 
 def test_children_discover_on_localhost_only_in_the_chosen_domain(tmp_path, monkeypatch):
@@ -50,3 +50,20 @@ def test_the_loop_is_closed_when_every_stream_has_its_publisher_and_subscribers(
     assert full['/wand/wrench'] == full['/wand/contact_model'] == (1, 1)  # the recorder
     partial = expected_endpoints(LoopConfig(nodes=('collision_engine', 'force_renderer')))
     assert partial['/wand/pose'] == (0, 1) and partial['/collision/state'] == (1, 1)
+    composed = expected_endpoints(LoopConfig(record='bag', composed=True))  # records itself
+    assert set(composed.values()) == {(1, 0)}
+
+
+def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_path):
+    loop = node_parameters(LoopConfig(record=str(tmp_path / 'bag'), composed=True))
+    assert loop['recorder']['ros__parameters']['output'] == str(tmp_path / 'bag')
+    assert loop['wand_driver']['ros__parameters']['wait_for_recorder'] is False  # no need
+    config = LoopConfig(teleop='model', record=str(tmp_path / 'scan'))
+    sites = node_parameters(config)
+    assert 'recorder' not in sites
+    operator = sites['operator_recorder']['ros__parameters']
+    remote = sites['remote_recorder']['ros__parameters']
+    assert operator['output'] == str(tmp_path / 'scan' / 'operator')
+    assert remote['output'] == str(tmp_path / 'scan' / 'remote') and remote['prefix'] == '/remote'
+    assert site_nodes(config, 'operator') == ('wand_driver', 'teleop_leader', 'operator_recorder')
+    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')

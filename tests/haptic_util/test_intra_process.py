@@ -148,6 +148,26 @@ def test_dds_carries_a_message_only_while_a_reader_of_another_process_matches(co
         rclpy.try_shutdown(context=outside)
 
 
+def test_a_topic_published_outside_is_taken_once_for_all_its_subscriptions_here(context, bus):
+    """The process's recorder gets exactly what its node got, and DDS carries it once."""
+    leader, recorder = node(context, 'leader'), node(context, 'recorder')
+    got = {'leader': [], 'recorder': []}
+    for each in (leader, recorder):
+        stream_subscription(each, POSE, 'teleop/feedback', got[each.get_name()].append,
+                            refused=Tally())
+    assert len([*leader.subscriptions, *recorder.subscriptions]) == 1
+    outside = Context()
+    rclpy.init(context=outside, domain_id=session_domain_id())
+    bridge = node(outside, 'bridge')
+    publisher = bridge.create_publisher(PoseStamped, 'teleop/feedback', HAPTIC_STREAM_QOS)
+    try:
+        assert spin_until([leader, recorder, bridge], lambda: (
+            publisher.publish(POSE.message_class()) or len(got['leader']) >= 3))
+    finally:
+        rclpy.try_shutdown(context=outside)
+    assert got['leader'] and got['recorder'] == got['leader']
+
+
 def test_without_it_a_stream_is_cdr_over_dds_and_parsed_for_the_callback(context):
     got = []
     driver = node(context, 'driver')

@@ -172,30 +172,61 @@ sys.exit(service.run())
 """
 
 
-def test_the_teleop_launch_file_runs_both_sites_and_records_them(build, tmp_path):
-    """On a full ROS 2 install (launch, launch_ros and composition_interfaces importable): the
-    PyPI set-up has none of them, and this is skipped there (checked by hand against their
-    jazzy branches, built beside the install)."""
+def launched(build, launch_file: str, *arguments: str) -> None:
+    """Run ``ros2 launch haptic_bringup <launch_file> <arguments>`` on the install; it must exit 0.
+
+    On a full ROS 2 install only (launch, launch_ros and composition_interfaces importable): the
+    PyPI set-up has none of them, and the test is skipped there (checked by hand against their
+    jazzy branches, built beside the install).
+    """
     from domains import session_domain_id
-    from rosbags.highlevel import AnyReader
     needed = ('launch_ros', 'composition_interfaces', 'launch')  # launch_ros: launch is real
     modules = [pytest.importorskip(name) for name in needed]
     # The sourced shell starts without PYTHONPATH; give it where this one found launch.
     found = [str(pathlib.Path(m.__file__).parents[1]) for m in modules]
-    bag = tmp_path / 'bag'
-    launch_file = build.share('haptic_bringup') / 'launch' / 'teleop.launch.py'
     script = ('export PYTHONPATH="$1:$PYTHONPATH" ROS_DOMAIN_ID="$2" && shift 2 && '
               'source "$INSTALL/setup.bash" && exec "$@"')
     result = subprocess.run(
         ['bash', '-c', script, 'bash', os.pathsep.join(found), str(session_domain_id()),
-         sys.executable, '-c', LAUNCH, str(launch_file), 'scheme:=model', 'delay:=0.02',
-         'duration:=4.0', f'remote_domain:={session_domain_id(second=True)}',
-         f'record:={bag}'],
+         sys.executable, '-c', LAUNCH, str(build.share('haptic_bringup') / 'launch' / launch_file),
+         *arguments],
         env={**build.env, 'INSTALL': str(build.install)}, capture_output=True, text=True,
         timeout=180)
     assert result.returncode == 0, result.stderr[-3000:]
-    with AnyReader([bag]) as reader:
-        counts = {c.topic: c.msgcount for c in reader.connections}
-    for topic in ('/wand/applied_wrench', '/teleop/feedback', '/remote/robot/tcp_pose',
-                  '/remote/teleop/command'):
+
+
+def recorded_as_published(bag, publishers: dict) -> None:
+    """The bag holds every message of ``publishers``' topics that each node says it published."""
+    from haptic_bringup.bag import typestore_with
+    from haptic_bringup.recorder import custom_definitions
+    from haptic_bringup.session import published_counts, topic_counts
+    published = published_counts(bag, typestore_with(custom_definitions()), publishers)
+    recorded = topic_counts(bag)
+    assert set(published) == set(publishers) and all(published.values()), published
+    assert {topic: recorded.get(topic, 0) for topic in publishers} == published
+
+
+def test_the_loop_launch_file_records_the_loop_with_the_projects_recorder(build, tmp_path):
+    from haptic_bringup.session import PUBLISHERS
+    launched(build, 'haptic_loop.launch.py', 'experiment:=cuboid',
+             f'record:={tmp_path / "bag"}', 'params_file:=' + str(_duration(tmp_path, 3.0)))
+    recorded_as_published(tmp_path / 'bag', PUBLISHERS)
+
+
+def test_the_teleop_launch_file_runs_both_sites_and_each_records_itself(build, tmp_path):
+    from domains import session_domain_id
+    from haptic_bringup.session import SITE_PUBLISHERS, topic_counts
+    launched(build, 'teleop.launch.py', 'scheme:=model', 'delay:=0.02',
+             'duration:=4.0', f'remote_domain:={session_domain_id(second=True)}',
+             f'record:={tmp_path / "bag"}')
+    recorded_as_published(tmp_path / 'bag', SITE_PUBLISHERS)
+    counts = topic_counts(tmp_path / 'bag')
+    for topic in ('/teleop/feedback', '/remote/teleop/command'):
         assert counts.get(topic, 0) > 100, counts
+
+
+def _duration(folder: pathlib.Path, seconds: float) -> pathlib.Path:
+    """Write a parameters file that ends the driver's experiment after ``seconds``."""
+    path = folder / 'duration.yaml'
+    path.write_text(f'wand_driver:\n  ros__parameters:\n    duration: {seconds}\n')
+    return path

@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from haptic_bringup.bag import typestore_with
+from haptic_bringup.bag import recover, typestore_with
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import read_vectors, reported
+from haptic_bringup.session import (bags, published_counts, read_vectors, reported,
+                                    SITE_PUBLISHERS, topic_counts)
 
 DELAY = 0.05  # [s] one way
 FORCE_SCALE = 0.3  # the leader's default
@@ -41,7 +42,7 @@ def streams(folder: pathlib.Path) -> dict:
     typestore = typestore_with(custom_definitions())
     topics = {topic: kind for topic, kind in STREAMS.items() if topic != '/teleop/feedback'}
     series = read_vectors(folder / 'bag', typestore, topics)
-    with AnyReader([folder / 'bag'], default_typestore=typestore) as reader:
+    with AnyReader(bags(folder / 'bag'), default_typestore=typestore) as reader:
         connections = [c for c in reader.connections if c.topic == '/teleop/feedback']
         series['/teleop/feedback'] = np.array(
             [stamp * 1e-9 for _, stamp, _ in reader.messages(connections=connections)])
@@ -103,11 +104,19 @@ def test_the_operator_measures_the_round_trip_from_echoed_stamps(scan):
     assert np.median(round_trips) == pytest.approx(2 * DELAY, abs=0.02)
 
 
-def test_the_bag_holds_both_sites_the_remote_one_under_remote(scan):
+def test_each_site_records_itself_into_the_session_and_loses_nothing(scan):
     folder, series = scan
+    assert bags(folder / 'bag') == [folder / 'bag' / 'operator', folder / 'bag' / 'remote']
     assert len(series['/remote/robot/tcp_pose'][0]) > 1000
     assert len(series['/wand/pose'][0]) > 1000
     assert reports(folder, 'teleop_follower', 'published')  # its /diagnostics, from /remote
+    published = published_counts(folder / 'bag', typestore_with(custom_definitions()),
+                                 SITE_PUBLISHERS)
+    recorded = topic_counts(folder / 'bag')
+    assert set(published) == set(SITE_PUBLISHERS)
+    assert {topic: recorded[topic] for topic in SITE_PUBLISHERS} == published
+    for recorder in ('operator_recorder', 'remote_recorder'):
+        assert reports(folder, recorder, 'dropped')[-1] == '0'
 
 
 def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_meet_again(
@@ -166,6 +175,10 @@ def test_a_killed_remote_site_zeroes_the_force_and_a_restarted_one_follows_again
         assert loop.exited().name == 'remote'  # nothing else went down
         loop.restart('remote')
         assert loop.wait(60.0).name == 'operator'
+    # The killed site's bag is recovered; the restarted one wrote its own beside it.
+    assert recover(tmp_path / 'bag' / 'remote', typestore_with(custom_definitions())).is_dir()
+    assert [bag.name for bag in bags(tmp_path / 'bag')] == [
+        'operator', 'remote-2', 'remote-recovered']
     series = streams(tmp_path)
     feedback = series['/teleop/feedback']
     last = feedback[feedback < killed + 0.5][-1]

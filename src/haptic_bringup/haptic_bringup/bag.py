@@ -16,7 +16,7 @@ from rosbags.rosbag2.storage_mcap import McapWriter
 from rosbags.typesys import get_types_from_msg, get_typestore, Stores
 from rosbags.typesys.store import Typestore
 
-__all__ = ['BagWriter', 'typestore_with', 'recover', 'FLUSH_PERIOD']
+__all__ = ['BagWriter', 'typestore_with', 'recover', 'killed_bags', 'FLUSH_PERIOD']
 
 FLUSH_PERIOD = 0.5  # [s] the most a kill -9 can lose
 
@@ -32,9 +32,14 @@ class _FlushingMcapWriter(McapWriter):
 
     def write(self, connection, timestamp, data) -> None:
         super().write(connection, timestamp, data)
+        self.flush_if_due()
+
+    def flush_if_due(self) -> None:
+        """Close the chunk and hand the file to the OS if FLUSH_PERIOD has passed since last."""
         now = time.monotonic()
         if now - self._last_flush >= self.flush_period:
-            self.close_chunk()
+            if self.chunk.msgs:
+                self.close_chunk()
             self.bio.flush()
             self._last_flush = now
 
@@ -77,6 +82,10 @@ class BagWriter:
         self._writer.write(self._connections[topic], timestamp_ns, data)
         self.counts[topic] += 1
 
+    def flush_if_due(self) -> None:
+        """Flush what was written if FLUSH_PERIOD has passed (a writer calls it while idle)."""
+        self._writer.storage.flush_if_due()
+
     def close(self) -> None:
         """Write the mcap summary and metadata.yaml; the bag is then complete."""
         self._writer.close()
@@ -118,22 +127,39 @@ def recover(path: pathlib.Path, typestore: Typestore) -> pathlib.Path:
     return target
 
 
+def killed_bags(path: pathlib.Path) -> list:
+    """Return the bags a killed recorder left without metadata: ``path``, or those in it."""
+    path = pathlib.Path(path)
+    folders = [path, *sorted(f for f in path.iterdir() if f.is_dir())] if path.is_dir() else []
+    return [folder for folder in folders
+            if any(folder.glob('*.mcap')) and not (folder / 'metadata.yaml').exists()]
+
+
 def main(argv=None) -> int:
-    """``haptic_bag info|recover DIR``: bag tools for machines without ``ros2 bag``."""
+    """``haptic_bag info|recover DIR``: bag tools for machines without ``ros2 bag``.
+
+    DIR is a bag, or a session's folder of bags (a telerobotic session's ``operator`` and
+    ``remote``): ``recover`` rebuilds each bag in it that a killed recorder left.
+    """
     import argparse
     import sys
 
     from haptic_bringup.recorder import custom_definitions
     from haptic_bringup.session import topic_counts
 
-    parser = argparse.ArgumentParser(prog='haptic_bag', description=main.__doc__)
+    parser = argparse.ArgumentParser(prog='haptic_bag', description=main.__doc__.split('\n')[0])
     parser.add_argument('command', choices=['info', 'recover'])
     parser.add_argument('bag', type=pathlib.Path)
     args = parser.parse_args(argv)
     try:
         if args.command == 'recover':
-            args.bag = recover(args.bag, typestore_with(custom_definitions()))
-            print(f'recovered into {args.bag}')
+            killed = killed_bags(args.bag)
+            if not killed:
+                raise ValueError('no bag without metadata.yaml to recover')
+            for bag in killed:
+                recovered = recover(bag, typestore_with(custom_definitions()))
+                print(f'recovered {bag} into {recovered}')
+            args.bag = recovered if killed == [args.bag] else args.bag
         for topic, count in sorted(topic_counts(args.bag).items()):
             print(f'{topic}: {count} messages')
     except (ValueError, OSError) as error:

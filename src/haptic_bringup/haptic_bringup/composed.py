@@ -9,12 +9,17 @@ benchmark compares it with. Usage, as for the separate nodes::
         [force_renderer] --ros-args --params-file params.yaml
 
 and, for telerobotics, ``wand_driver teleop_leader`` (the operator's site) or ``sim_robot
-teleop_follower`` (the remote site).
+teleop_follower`` (the remote site). A recorder among the names (``recorder``,
+``operator_recorder`` or ``remote_recorder``, each with its parameters under that name) records
+the process's streams as they are handed over (``haptic_bringup.process_recorder``); it is built
+last, so that it is destroyed last, once every other node has said its last words.
 """
+import functools
 import importlib
 import sys
 
-from haptic_bringup.launcher import NO_INTRA_PROCESS, NODES, TELEOP_NODES
+from haptic_bringup.launcher import NO_INTRA_PROCESS, NODES, RECORDERS, TELEOP_NODES
+from haptic_bringup.process_recorder import ProcessRecorder
 from haptic_util import intra_process
 from haptic_util.executor import run_nodes
 
@@ -25,17 +30,21 @@ def main(args=None) -> int:
     argv = sys.argv if args is None else args
     ros_start = argv.index('--ros-args') if '--ros-args' in argv else len(argv)
     given = argv[1:ros_start]
-    names = [name for name in given if name != NO_INTRA_PROCESS] or list(NODES)
+    names = [name for name in given if name not in (NO_INTRA_PROCESS, *RECORDERS)]
+    names = names or list(NODES)
     known = {**NODES, **TELEOP_NODES}
     unknown = [n for n in names if n not in known]
     if unknown:
-        print(f'error: unknown node(s) {unknown}; choose from {list(known)}', file=sys.stderr)
+        print(f'error: unknown node(s) {unknown}; choose from {[*known, *RECORDERS]}',
+              file=sys.stderr)
         return 2
-    classes = [getattr(importlib.import_module(module), cls)
-               for _, module, cls in (known[n] for n in names)]
+    factories = [getattr(importlib.import_module(module), cls)
+                 for _, module, cls in (known[n] for n in names)]
+    factories += [functools.partial(ProcessRecorder, name) for name in RECORDERS
+                  if name in given]
     if NO_INTRA_PROCESS not in given:
         intra_process.enable()
-    return run_nodes(classes, argv)
+    return run_nodes(factories, argv)
 
 
 if __name__ == '__main__':

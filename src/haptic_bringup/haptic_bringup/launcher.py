@@ -10,18 +10,22 @@ Nav2's bring-up composes its nodes by default. ``--separate`` starts them as thr
 ``ros2 run`` would: to watch one node's CPU, or to run one elsewhere, at a cost in CPU that
 ``docs/cpu_budget.md`` gives. It sets local-only DDS discovery, a domain id, and ROS logs under
 ``build/``. It waits for the loop's topics to be discovered, runs until the driver's experiment
-ends, ``--duration`` passes or Ctrl-C, then stops every process (the recorder last) and removes
-stale shared memory. On a full ROS 2 install,
-``ros2 launch haptic_bringup haptic_loop.launch.py`` does the same.
+ends, ``--duration`` passes or Ctrl-C, then stops every process and removes stale shared memory.
+``--record DIR`` records the loop to the bag DIR from inside its process
+(``haptic_bringup.process_recorder``: nothing is lost, however busy the machine); with
+``--separate``, a recorder process does (``haptic_bringup.recorder``), stopped last. On a full
+ROS 2 install, ``ros2 launch haptic_bringup haptic_loop.launch.py`` does the same.
 
 With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
 (the wand driver and the leader, one process) in one DDS domain, the remote site (the robot with
 its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and the
-link bridge between them, which delays, jitters and drops what crosses. The recorder writes both
-sites into one bag, the remote one's topics under ``/remote/``.
+link bridge between them, which delays, jitters and drops what crosses. With ``--record DIR``
+each site's process records itself: DIR is the session, holding the bags ``operator`` and
+``remote`` (the remote one's topics under ``/remote/``).
 """
 import argparse
 import dataclasses
+import itertools
 import os
 import pathlib
 import signal
@@ -51,6 +55,10 @@ TELEOP_NODES = {
 }
 OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
+# The recorder in each kind of process (haptic_bringup.process_recorder), by its node name.
+RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
+    'recorder', 'operator_recorder', 'remote_recorder')
+REMOTE_PREFIX = '/remote'  # where the remote site's topics go in its bag
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 BRIDGE_MODULE = 'remote_probe.bridge'
@@ -69,7 +77,6 @@ NO_INTRA_PROCESS = '--no-intra-process'  # the composed process's streams throug
 RECORDER_MODULE = 'haptic_bringup.recorder'
 DEFAULT_DOMAIN_ID = 42
 DISCOVERY_TIMEOUT = 120.0  # [s] includes imports and, on a cold cache, compiling the kernels
-RECORDER_DRAIN = 0.3  # [s] for in-flight messages to reach the recorder before it stops
 DURATION_GRACE = 3.0  # [s] past --duration before the launcher stops a driver that did not
 
 
@@ -92,11 +99,20 @@ class LoopConfig:
     teleop: Optional[str] = None  # a bilateral scheme: a telerobotic session instead
     link: dict = dataclasses.field(default_factory=dict)  # delay, jitter, loss, ... (s)
     remote_domain: Optional[int] = None  # the remote site's DDS domain; None: the next one
+    # Composed, the loop's process records itself; False: a recorder process does, as for three
+    # processes (the baseline the benchmarks compare it with).
+    record_in_process: bool = True
 
     @property
     def remote_domain_id(self) -> int:
         """Return the remote site's DDS domain."""
         return self.domain_id + 1 if self.remote_domain is None else self.remote_domain
+
+    @property
+    def recorder_process(self) -> bool:
+        """Whether a recorder process records the session (three processes), not the loop's."""
+        return bool(self.record) and not self.teleop and not (
+            self.composed and self.record_in_process)
 
 
 def add_venv_prefix() -> None:
@@ -144,9 +160,10 @@ def node_parameters(config: LoopConfig) -> dict:
         options.setdefault('wand_driver', {})['experiment'] = config.experiment
     if config.duration:
         options.setdefault('wand_driver', {})['duration'] = float(config.duration)
-    if config.record:
+    if config.record and not config.teleop:
+        options[LOOP_RECORDER] = {'output': str(pathlib.Path(config.record).resolve())}
+    if config.recorder_process:  # it must hear every topic before the session starts
         options.setdefault('wand_driver', {})['wait_for_recorder'] = True
-        options['recorder'] = {'output': str(pathlib.Path(config.record).resolve())}
     if config.teleop:
         _teleop_options(config, options)
     for node, values in [*options.items(), *config.overrides.items()]:
@@ -175,9 +192,11 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     for node in ('teleop_leader', 'teleop_follower'):
         options.setdefault(node, {})['scheme'] = scheme
     if config.record:
-        options['recorder'].update(topics=list(OPERATOR_RECORDED),
-                                   remote_domain=config.remote_domain_id,
-                                   remote_topics=list(REMOTE_RECORDED))
+        session = pathlib.Path(config.record).resolve()
+        options[OPERATOR_RECORDER] = {'output': str(session / 'operator'),
+                                      'topics': list(OPERATOR_RECORDED)}
+        options[REMOTE_RECORDER] = {'output': str(session / 'remote'),
+                                    'topics': list(REMOTE_RECORDED), 'prefix': REMOTE_PREFIX}
 
 
 def bridge_parameters(config: LoopConfig) -> dict:
@@ -187,22 +206,33 @@ def bridge_parameters(config: LoopConfig) -> dict:
         'to_remote': list(TO_REMOTE), 'to_operator': list(TO_OPERATOR), **config.link}}}
 
 
+def site_nodes(config: LoopConfig, site: str) -> tuple:
+    """Return the node names of a telerobotic site's process: its nodes, and its recorder."""
+    nodes, recorder = ((OPERATOR_SITE, OPERATOR_RECORDER) if site == 'operator'
+                       else (REMOTE_SITE, REMOTE_RECORDER))
+    return (*nodes, recorder) if config.record else nodes
+
+
 def teleop_endpoints(config: LoopConfig) -> dict:
     """Domain → topic → (publishers, subscribers) that make the telerobotic session closed.
 
     Each site is one process: a stream between its nodes is a DDS endpoint only without
-    intra-process delivery.
+    intra-process delivery. So is each site's recorder, which is in its process and, with that
+    delivery, takes what crossed the link through the reader of the node that uses it. The
+    recorder's reader of ``/diagnostics`` says it exists: a site builds it last, so its nodes
+    then spin (a remote site still starting would miss the operator's short session).
     """
-    recording = 1 if config.record else 0
     site = 0 if config.intra_process else 1  # a subscriber in the publisher's process
+    recording = site if config.record else 0
+    reports = {'/diagnostics': (0, 1)} if config.record else {}
     return {
         config.domain_id: {'/wand/pose': (1, site + recording), '/teleop/command': (1, 1),
-                           '/teleop/feedback': (1, 1 + recording)},
+                           '/teleop/feedback': (1, 1 + recording), **reports},
         config.remote_domain_id: {'/teleop/command': (1, 1 + recording),
                                   '/teleop/feedback': (1, 1),
                                   '/robot/target_pose': (1, site),
                                   '/robot/tcp_pose': (1, site + recording),
-                                  '/robot/ft_sensor/wrench': (1, site + recording)},
+                                  '/robot/ft_sensor/wrench': (1, site + recording), **reports},
     }
 
 
@@ -211,11 +241,12 @@ def expected_endpoints(config: LoopConfig) -> dict:
 
     The driver's own subscription is not among them: it takes the model or the wrench, as its
     device can render, and it waits for that answer itself (it probes the loop end to end). Nor
-    is a subscriber that takes its stream in the publisher's process (``intra_process``).
+    is a subscriber that takes its stream in the publisher's process (``intra_process``): the
+    loop's own recorder, composed, is one.
     """
-    recording = 1 if config.record else 0
     running = set(config.nodes)
     over_dds = 0 if config.composed and config.intra_process else 1
+    recording = (1 if config.recorder_process else over_dds) if config.record else 0
 
     def subscribers(node: str) -> int:
         return recording + over_dds * (node in running)
@@ -264,19 +295,20 @@ class Loop:
         params.write_text(yaml.safe_dump(node_parameters(config), sort_keys=False))
         ros_args = ['--ros-args', '--params-file', str(params)]
         started = time.monotonic()
-        if config.record:
+        if config.recorder_process:
             self.children.append(start_child(
                 'recorder', [config.python, '-m', RECORDER_MODULE, *ros_args], env))
         if config.teleop:
             self._start_teleop(env, ros_args)
         elif config.composed:
-            self.children.append(start_child('composed', self._composed(config.nodes, ros_args),
-                                             env))
+            itself = config.record and not config.recorder_process
+            nodes = (*config.nodes, *([LOOP_RECORDER] if itself else []))
+            self.children.append(start_child('composed', self._composed(nodes, ros_args), env))
         else:
             for name in config.nodes:
                 self.children.append(start_child(
                     name, [config.python, '-m', NODES[name][1], *ros_args], env))
-        self._wait_for_discovery()
+        self._wait_for_discovery(config.domain_id)
         self.startup_time = time.monotonic() - started
 
     def _composed(self, nodes, ros_args: list) -> list:
@@ -286,32 +318,37 @@ class Loop:
                 *([] if config.intra_process else [NO_INTRA_PROCESS]), *ros_args]
 
     def _start_teleop(self, env: dict, ros_args: list) -> None:
-        """Start the two sites, each one process in its own domain, and the bridge."""
+        """Start the two sites, each one process in its own domain, and the bridge.
+
+        The operator's site starts its scan as soon as its own loop closes, robot or not, so it
+        starts once the remote site is up (under load, the remote site took seconds longer).
+        """
         config = self.config
         remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
         bridge = self.run_dir / 'bridge.yaml'
         bridge.write_text(yaml.safe_dump(bridge_parameters(config), sort_keys=False))
-        for name, nodes, site_env in (('operator', OPERATOR_SITE, env),
-                                      ('remote', REMOTE_SITE, remote_env)):
-            self.children.append(start_child(name, self._composed(nodes, ros_args), site_env))
+        self.children.append(start_child(
+            'remote', self._composed(site_nodes(config, 'remote'), ros_args), remote_env))
         # The bridge stands for the network between the sites, so it talks to them over UDP,
         # as a remote peer would: over Fast DDS's shared memory, a bridge that stopped (SIGSTOP,
         # a link down for a second) stalled the sites' processes that publish to it.
         self.children.append(start_child(
             'bridge', [config.python, '-m', BRIDGE_MODULE, '--ros-args', '--params-file',
                        str(bridge)], {**env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}))
+        self._wait_for_discovery(config.remote_domain_id)
+        self.children.insert(0, start_child(  # the operator's stops first
+            'operator', self._composed(site_nodes(config, 'operator'), ros_args), env))
 
-    def _wait_for_discovery(self) -> None:
-        endpoints = (teleop_endpoints(self.config) if self.config.teleop
-                     else {self.config.domain_id: expected_endpoints(self.config)})
-        missing = []
-        for domain_id, expected in endpoints.items():
-            watcher = GraphWatcher(domain_id)
-            try:
-                missing += watcher.wait(expected, DISCOVERY_TIMEOUT,
-                                        abort=lambda: self.exited() is not None)
-            finally:
-                watcher.close()
+    def _wait_for_discovery(self, domain_id: int) -> None:
+        """Wait until ``domain_id``'s endpoints of the loop or the session are discovered."""
+        expected = (teleop_endpoints(self.config)[domain_id] if self.config.teleop
+                    else expected_endpoints(self.config))
+        watcher = GraphWatcher(domain_id)
+        try:
+            missing = watcher.wait(expected, DISCOVERY_TIMEOUT,
+                                   abort=lambda: self.exited() is not None)
+        finally:
+            watcher.close()
         dead = self.exited()
         if dead is not None and _finished(dead):
             return  # a short experiment ran to its end before this watcher saw every endpoint
@@ -335,14 +372,28 @@ class Loop:
     def restart(self, name: str):
         """Start child ``name`` again as it was started (after it died); return it.
 
-        The dead child's shared memory goes first (Fast DDS leaves it behind a SIGKILL).
+        The dead child's shared memory goes first (Fast DDS leaves it behind a SIGKILL). A
+        process that records itself writes a new bag beside the one it left (``<bag>-2``, ...):
+        that one stays for ``haptic_bag recover``.
         """
         old = self.child(name)
         old.process.wait()
         clean_stale_shm(domains=self._domains(), existing=self._segments_before)
-        new = start_child(name, old.argv, old.env)
+        new = start_child(name, self._argv_again(old), old.env)
         self.children[self.children.index(old)] = new
         return new
+
+    def _argv_again(self, child) -> list:
+        """Return ``child``'s command line, with a new bag if its process records itself."""
+        recorder = next((r for r in RECORDERS if r in child.argv), None)
+        if recorder is None:
+            return child.argv
+        output = node_parameters(self.config)[recorder]['ros__parameters']['output']
+        again = next(f'{output}-{n}' for n in itertools.count(2)
+                     if not pathlib.Path(f'{output}-{n}').exists())
+        params = self.run_dir / f'{recorder}-{pathlib.Path(again).name}.yaml'
+        params.write_text(yaml.safe_dump({recorder: {'ros__parameters': {'output': again}}}))
+        return [*child.argv, '--params-file', str(params)]
 
     def pids(self) -> dict:
         return {child.name: child.pid for child in self.children}
@@ -352,16 +403,14 @@ class Loop:
         return wait_any_exit(self.children, float('inf') if timeout is None else timeout)
 
     def stop(self, *, gently: bool = True) -> dict:
-        """Stop every child (the recorder last, after a drain) and clean shared memory.
+        """Stop every child (a recorder process last) and clean shared memory.
 
         ``gently=False`` for children that may still be starting (see ``stop_children``).
         """
         recorder = [c for c in self.children if c.name == 'recorder']
         others = [c for c in self.children if c.name != 'recorder']
         codes = stop_children(others, gently=gently)
-        if recorder:
-            time.sleep(RECORDER_DRAIN)
-            codes.update(stop_children(recorder, gently=gently))
+        codes.update(stop_children(recorder, gently=gently))
         self.children = []
         clean_stale_shm(domains=self._domains(), existing=self._segments_before)
         return codes

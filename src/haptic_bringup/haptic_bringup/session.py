@@ -2,6 +2,11 @@
 
 Read from a rosbag2 bag with rosbags (no ROS needed), and joined on the pose stamp that every
 state and wrench carries, so each row is one pose with its answer.
+
+A session is one bag, or a folder of bags read as one (rosbags' ``AnyReader`` merges them in
+time): a telerobotic session records each site in its own process, so its folder holds the bags
+``operator`` and ``remote``. Both sites run on one machine for now, so the receive times of both
+bags are on one clock; aligning the bags of two machines is issue 27's.
 """
 import dataclasses
 import pathlib
@@ -9,16 +14,20 @@ import pathlib
 import numpy as np
 from rosbags.highlevel import AnyReader
 
+from haptic_bringup.bag import killed_bags
 from haptic_util.stamps import to_nanoseconds
 
-__all__ = ['Session', 'read_session', 'read_vectors', 'reported', 'topic_counts',
-           'published_counts', 'applied_work', 'PUBLISHERS']
+__all__ = ['Session', 'bags', 'read_session', 'read_vectors', 'reported', 'topic_counts',
+           'published_counts', 'applied_work', 'PUBLISHERS', 'SITE_PUBLISHERS']
 
 # Which node publishes each stream, by its name in /diagnostics reports (a node publishes each
-# of its streams once per count).
+# of its streams once per count): the loop's, and a telerobotic site's own measurements.
 PUBLISHERS = {'/wand/pose': 'wand_driver', '/wand/twist': 'wand_driver',
               '/wand/applied_wrench': 'wand_driver', '/collision/state': 'collision_engine',
               '/wand/wrench': 'force_renderer', '/wand/contact_model': 'force_renderer'}
+SITE_PUBLISHERS = {'/wand/pose': 'wand_driver', '/wand/applied_wrench': 'wand_driver',
+                   '/remote/robot/tcp_pose': 'sim_robot',
+                   '/remote/robot/ft_sensor/wrench': 'sim_robot'}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -62,26 +71,50 @@ class Session:
     scene: str
 
 
+def bags(path: pathlib.Path) -> list:
+    """Return a session's bags: ``path`` if it is a bag, else the bags in it (see above).
+
+    A bag without its metadata (its recorder was killed) is refused with what to do, unless its
+    recovered copy is there too (``haptic_bag recover``).
+    """
+    path = pathlib.Path(path)
+    if (path / 'metadata.yaml').exists():
+        return [path]
+    complete = sorted(metadata.parent for metadata in path.glob('*/metadata.yaml'))
+    killed = [bag for bag in killed_bags(path)
+              if bag.with_name(bag.name + '-recovered') not in complete]
+    if killed:
+        raise ValueError(f'{killed[0]}: a bag without metadata.yaml (was its recorder killed?); '
+                         f'`haptic_bag recover {path}` rebuilds it')
+    if not complete:
+        raise ValueError(f'{path}: no bag there')
+    return complete
+
+
 def topic_counts(path: pathlib.Path) -> dict:
-    """Messages per topic in a bag, from its metadata."""
-    with AnyReader([pathlib.Path(path)]) as reader:
-        return {c.topic: c.msgcount for c in reader.connections}
+    """Messages per topic in a session, from its bags' metadata."""
+    counts = {}
+    with AnyReader(bags(path)) as reader:
+        for connection in reader.connections:
+            counts[connection.topic] = counts.get(connection.topic, 0) + connection.msgcount
+    return counts
 
 
-def published_counts(path: pathlib.Path, typestore) -> dict:
+def published_counts(path: pathlib.Path, typestore, publishers: dict = PUBLISHERS) -> dict:
     """Topic → how many messages its node says it published, from its last /diagnostics report.
 
+    ``publishers`` maps each topic to its node (``SITE_PUBLISHERS`` for a telerobotic session).
     Topics whose node left no report (it was killed, or not recorded) are missing.
     """
     counts = reported(path, typestore, 'published')
     said = {node: int(values[-1]) for node, values in counts.items()}
-    return {topic: said[node] for topic, node in PUBLISHERS.items() if node in said}
+    return {topic: said[node] for topic, node in publishers.items() if node in said}
 
 
 def reported(path: pathlib.Path, typestore, key: str) -> dict:
     """Node → every value it reported for ``key`` on /diagnostics (either site's), in order."""
     said = {}
-    with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
+    with AnyReader(bags(path), default_typestore=typestore) as reader:
         connections = [c for c in reader.connections if c.topic.endswith('/diagnostics')]
         for connection, _, raw in reader.messages(connections=connections):
             for status in reader.deserialize(raw, connection.msgtype).status:
@@ -93,7 +126,7 @@ def reported(path: pathlib.Path, typestore, key: str) -> dict:
 def read_session(path: pathlib.Path, typestore) -> Session:
     """Join a bag's collision states and wrenches on their stamps."""
     states, wrenches, applied, scene = {}, {}, {}, ''
-    with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
+    with AnyReader(bags(path), default_typestore=typestore) as reader:
         for connection, _, raw in reader.messages():
             msg = reader.deserialize(raw, connection.msgtype)
             if connection.topic == '/collision/state':
@@ -141,7 +174,7 @@ def read_vectors(path: pathlib.Path, typestore, topics: dict, stamped: bool = Fa
     its header's stamp: when its publisher says it happened, which a busy recorder cannot delay.
     """
     series = {topic: ([], []) for topic in topics}
-    with AnyReader([pathlib.Path(path)], default_typestore=typestore) as reader:
+    with AnyReader(bags(path), default_typestore=typestore) as reader:
         connections = [c for c in reader.connections if c.topic in topics]
         for connection, stamp, raw in reader.messages(connections=connections):
             msg = reader.deserialize(raw, connection.msgtype)

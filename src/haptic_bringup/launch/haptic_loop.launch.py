@@ -4,9 +4,12 @@
 
 Arguments: ``scene:=<path or package://...>``, ``experiment:=cuboid|cylinder|hand|hold|<file>``,
 ``composed:=false`` (three processes; by default one, whose nodes hand their streams to each
-other in it: the layout that fits two cores), ``record:=<bag dir>`` (rosbag2 mcap via
-``ros2 bag record``), ``params_file:=<yaml>`` (overrides on top of each package's config/). The
-local launcher (``haptic_loop``) does the same where launch and ros2cli are not installed.
+other in it: the layout that fits two cores), ``record:=<bag dir>`` (rosbag2 mcap, with the
+project's recorder, as ``haptic_loop --record`` does: inside the loop's process, or with
+``composed:=false`` a recorder process that the driver waits for; ``ros2 bag`` is not needed,
+and a bag that cannot be written fails the launch), ``params_file:=<yaml>`` (overrides on top of
+each package's config/). The local launcher (``haptic_loop``) does the same where launch and
+ros2cli are not installed.
 
 DDS discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``) unless the user
 exported another range. The loop is all or nothing: when one of its nodes exits, the launch
@@ -19,13 +22,13 @@ import tempfile
 
 from ament_index_python.packages import get_package_share_directory
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, ExecuteProcess, OpaqueFunction
+from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
-from haptic_bringup.params import LOOP_TOPICS
+from haptic_bringup.launcher import LOOP_RECORDER
 
 NODES = (('haptic_wand_driver', 'wand_driver', 'wand_driver'),
          ('collision_engine', 'collision_node', 'collision_engine'),
@@ -52,29 +55,34 @@ def _nodes(context):
     experiment = LaunchConfiguration('experiment').perform(context)
     user = LaunchConfiguration('params_file').perform(context)
     record = LaunchConfiguration('record').perform(context)
+    composed = LaunchConfiguration('composed').perform(context).lower() == 'true'
     overrides = {'scene_file': scene} if scene else {}
-    driver_overrides = dict(overrides, **({'experiment': experiment} if experiment else {}))
+    driver_values = {'experiment': experiment} if experiment else {}
+    recorder = [_parameters_of(LOOP_RECORDER, {'output': os.path.abspath(record)})] \
+        if record else []
+    if record and not composed:  # a recorder process must hear every topic before the start
+        driver_values['wait_for_recorder'] = True
     extra = [user] if user else []
     loop = AllOrNothing()
     actions = []
-    if LaunchConfiguration('composed').perform(context).lower() == 'true':
+    if composed:
         # No name: a name given here would rename all three nodes of the process.
-        driver = [_parameters_of('wand_driver', {'experiment': experiment})] if experiment else []
+        driver = [_parameters_of('wand_driver', driver_values)] if driver_values else []
         actions += loop.add('composed', Node(
             package='haptic_bringup', executable='composed', output='screen',
-            parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides] + driver))
+            arguments=[name for _, _, name in NODES] + ([LOOP_RECORDER] if record else []),
+            parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides] + driver
+            + recorder))
     else:
         for package, executable, name in NODES:
-            values = driver_overrides if name == 'wand_driver' else overrides
+            values = dict(overrides, **driver_values) if name == 'wand_driver' else overrides
             actions += loop.add(name, Node(
                 package=package, executable=executable, name=name, output='screen',
                 parameters=[_config(package), *extra, values]))
-    if record:
-        actions.append(ExecuteProcess(
-            cmd=['ros2', 'bag', 'record', '-s', 'mcap', '-o', record, *LOOP_TOPICS],
-            # (ros2 bag starts recording when it sees each topic: the first samples may be lost;
-            # the local launcher's recorder holds the session until it hears every topic.)
-            output='screen'))
+        if record:
+            actions += loop.add(LOOP_RECORDER, Node(
+                package='haptic_bringup', executable='recorder', output='screen',
+                parameters=recorder))
     return actions
 
 

@@ -8,8 +8,9 @@
 The operator's site (``wand_driver`` and ``teleop_leader``, one process) runs in the launch's
 ``ROS_DOMAIN_ID``; the remote site (``sim_robot`` and ``teleop_follower``, one process) in
 ``remote_domain`` (default: the next domain); ``link_bridge`` joins both and emulates the link.
-``record:=`` writes both sites into one bag with the project's recorder (the remote site's
-topics under ``/remote/``): ``ros2 bag record`` joins one domain only. Parameters come from each
+``record:=DIR`` has each site's process record itself with the project's recorder, into the
+session folder DIR (the bags ``operator`` and ``remote``, the remote site's topics under
+``/remote/``), so a Ctrl-C to the whole launch loses nothing. Parameters come from each
 package's config/, then ``params_file``, then these arguments, exactly as the local launcher
 (``haptic_loop --teleop ...``) sets them. The session stands or falls together, as the loop
 does: when one process exits, the launch stops the others.
@@ -24,8 +25,7 @@ from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
-from haptic_bringup.launcher import (bridge_parameters, LoopConfig, node_parameters,
-                                     OPERATOR_SITE, REMOTE_SITE)
+from haptic_bringup.launcher import bridge_parameters, LoopConfig, node_parameters, site_nodes
 
 ARGUMENTS = (  # name, default, description
     ('scheme', 'model', 'bilateral scheme: direct | tdpa | model'),
@@ -75,22 +75,17 @@ def _processes(context):
     operator_env = {'ROS_DOMAIN_ID': str(config.domain_id)}
     session = AllOrNothing()
     actions = []
-    for name, nodes, domain in (('operator', OPERATOR_SITE, config.domain_id),
-                                ('remote', REMOTE_SITE, config.remote_domain_id)):
-        actions += session.add(name, Node(
-            package='haptic_bringup', executable='composed', arguments=list(nodes),
-            parameters=[parameters], additional_env={'ROS_DOMAIN_ID': str(domain)},
-            output='screen'))
+    for site, domain in (('operator', config.domain_id), ('remote', config.remote_domain_id)):
+        actions += session.add(site, Node(
+            package='haptic_bringup', executable='composed',
+            arguments=list(site_nodes(config, site)), parameters=[parameters],
+            additional_env={'ROS_DOMAIN_ID': str(domain)}, output='screen'))
     # Over UDP, as the network it stands for: over shared memory, a stopped bridge stalled the
     # sites' processes that publish to it.
     actions += session.add('bridge', Node(
         package='remote_probe', executable='link_bridge',
         parameters=[_written(bridge_parameters(config))],
         additional_env={**operator_env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}, output='screen'))
-    if config.record:
-        actions += session.add('recorder', Node(
-            package='haptic_bringup', executable='recorder', parameters=[parameters],
-            additional_env=operator_env, output='screen'))
     return actions
 
 

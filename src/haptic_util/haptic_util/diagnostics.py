@@ -2,21 +2,36 @@
 
 The last report of a node that stops cleanly carries its final counts (messages published,
 inputs refused), so a recorded session documents its own completeness: a reader compares what each
-node says it published with what the bag holds. Every report also says how many callbacks of its
-process raised (``callback_errors``): a bad input must be refused, never raise.
+node says it published with what the bag holds. A recorder in the node's own process
+(``listen``) is handed each report as it is published, the last one too: that one is written as
+the node is destroyed, when its process no longer takes anything over DDS. Every report also
+says how many callbacks of its process raised (``callback_errors``): a bad input must be
+refused, never raise.
 """
 from typing import Callable
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy.duration import Duration
 from rclpy.node import Node
 
 from haptic_util.callback_errors import callback_errors
 
-__all__ = ['Diagnostics', 'Report', 'OK', 'WARN', 'ERROR']
+__all__ = ['Diagnostics', 'Report', 'listen', 'stop_listening', 'OK', 'WARN', 'ERROR']
 
 OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
 DIAGNOSTICS_TOPIC = '/diagnostics'
 DIAGNOSTICS_DEPTH = 10
+FINAL_ACK_TIMEOUT = 0.5  # [s] the longest the last report waits for its readers' receipts
+_listeners: list = []  # callables handed every report this process publishes
+
+
+def listen(callback: Callable[[DiagnosticArray], None]) -> None:
+    """Hand ``callback`` every report of this process's nodes, before it goes out over DDS."""
+    _listeners.append(callback)
+
+
+def stop_listening(callback: Callable[[DiagnosticArray], None]) -> None:
+    _listeners.remove(callback)
 
 
 class Report:
@@ -45,9 +60,17 @@ class Diagnostics:
                     {**report.values, 'callback_errors': callback_errors()}.items()])
         array = DiagnosticArray(status=[status])
         array.header.stamp = self._node.get_clock().now().to_msg()
+        for listener in _listeners:
+            listener(array)
         self._publisher.publish(array)
 
     def final(self) -> None:
-        """Publish the last report (call from ``destroy_node``, before the node goes)."""
+        """Publish the last report (call from ``destroy_node``, before the node goes).
+
+        It waits, a moment at most, for every reader to acknowledge the report: the node is
+        destroyed next, and a report still queued in its writer then never leaves (a recorder
+        process missed the last reports of two nodes of three in 3 of 4 loaded runs).
+        """
         self._timer.cancel()
         self.publish()
+        self._publisher.wait_for_all_acked(Duration(seconds=FINAL_ACK_TIMEOUT))

@@ -7,8 +7,10 @@ intra-process delivery on (``enable``, as the composed process does), a message 
 the process is handed to the process's own subscriptions of its topic as its leaf values (what
 ``haptic_util.cdr`` would have parsed), and serialized and written to DDS only while a reader of
 another process matches it (a recorder, RViz, ``ros2 topic echo``): a stream nobody outside
-reads costs no DDS at all. A subscription takes its topic over DDS only while no node of the
-process publishes it, so nothing arrives twice.
+reads costs no DDS at all. A topic no node of the process publishes is taken over DDS once for
+the whole process, by one reader that hands each message to every subscription of the topic in
+the process (the node that uses it and the process's recorder get the same messages); once a
+node of the process publishes it, that reader goes, so nothing arrives twice.
 
 Order: messages are delivered in the order they were published in the process (one first-in
 first-out queue). A ``publish`` from outside any delivery (a timer, a DDS callback) delivers
@@ -60,12 +62,39 @@ def close() -> None:
 
 
 class _Topic:
-    """A topic's local publishers and subscriptions, and its message type."""
+    """A topic's local publishers and subscriptions, its message type, and its DDS reader."""
 
     def __init__(self, msg_type) -> None:
         self.msg_type = msg_type
         self.publishers: list = []
         self.subscriptions: list = []
+        self.reader = None  # (node, subscription) taking it over DDS while nobody here publishes
+
+    def take_over_dds(self, node: Node, codec: MessageCodec, topic: str, *, refused: Tally,
+                      qos: QoSProfile) -> None:
+        """Take the topic over DDS for every subscription of the process, unless it does.
+
+        The first subscription's node reads it, with that subscription's QoS, and counts what
+        is malformed in its ``refused``.
+        """
+        if self.reader is None and not self.publishers:
+            self.reader = (node, node.create_subscription(
+                codec.message_class, topic, _decoding(codec, topic, refused, self.deliver), qos,
+                raw=True))
+
+    def deliver(self, values: Sequence) -> None:
+        _pending.extend((subscription, values) for subscription in self.subscriptions)
+        _drain()
+
+    def served_locally(self) -> None:
+        """Stop taking the topic over DDS: a node of this process publishes it."""
+        if self.reader is not None:
+            node, subscription = self.reader
+            node.destroy_subscription(subscription)
+            self.reader = None
+
+    def dds_publisher_count(self) -> int:
+        return self.reader[1].get_publisher_count() if self.reader is not None else 0
 
 
 def _topic(node: Node, msg_type, topic: str) -> _Topic | None:
@@ -93,8 +122,7 @@ class StreamPublisher:
         self._local = self._topic.subscriptions if self._topic is not None else []
         if self._topic is not None:
             self._topic.publishers.append(self)
-            for subscription in self._topic.subscriptions:
-                subscription.served_locally()
+            self._topic.served_locally()
 
     @property
     def topic_name(self) -> str:
@@ -133,36 +161,36 @@ class StreamSubscription:
                  callback: Callable[[Sequence], None], *, refused: Tally,
                  qos: QoSProfile = HAPTIC_STREAM_QOS) -> None:
         self.callback = callback
-        self._codec = codec
-        self._refused = refused
-        self._malformed = f'malformed {topic}'
-        self._node = node
         self._topic = _topic(node, codec.message_class, topic)
-        self._dds = None
+        self._dds = None  # its own DDS reader, while intra-process delivery is off
         if self._topic is not None:
             self._topic.subscriptions.append(self)
-        if self._topic is None or not self._topic.publishers:
-            self._dds = node.create_subscription(codec.message_class, topic, self._take, qos,
-                                                 raw=True)
-
-    def _take(self, data: bytes) -> None:
-        try:
-            values = self._codec.decode(data)
-        except MalformedMessage as error:
-            self._refused.add(self._malformed, str(error))
-            return
-        self.callback(values)
-
-    def served_locally(self) -> None:
-        """Stop taking the topic over DDS: a node of this process publishes it."""
-        if self._dds is not None:
-            self._node.destroy_subscription(self._dds)
-            self._dds = None
+            self._topic.take_over_dds(node, codec, topic, refused=refused, qos=qos)
+        else:
+            self._dds = node.create_subscription(
+                codec.message_class, topic, _decoding(codec, topic, refused, callback), qos,
+                raw=True)
 
     def get_publisher_count(self) -> int:
         """Return how many publishers match: of this process, and over DDS."""
-        local = len(self._topic.publishers) if self._topic is not None else 0
-        return local + (self._dds.get_publisher_count() if self._dds is not None else 0)
+        if self._topic is None:
+            return self._dds.get_publisher_count()
+        return len(self._topic.publishers) + self._topic.dds_publisher_count()
+
+
+def _decoding(codec: MessageCodec, topic: str, refused: Tally,
+              deliver: Callable[[Sequence], None]) -> Callable[[bytes], None]:
+    """Return a DDS callback that decodes, hands on what is a message, and counts what is not."""
+    kind = f'malformed {topic}'
+
+    def take(data: bytes) -> None:
+        try:
+            values = codec.decode(data)
+        except MalformedMessage as error:
+            refused.add(kind, str(error))
+            return
+        deliver(values)
+    return take
 
 
 def _drain() -> None:
