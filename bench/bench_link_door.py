@@ -5,7 +5,8 @@
 A site under attack must shed what it refuses at about the cost of what it takes, or a flood
 buys the attacker the site's CPU. Per kind of message, the time (median over repeats, µs per
 message) of what the remote site does with one ``teleop/command`` from its bytes: decode it
-(``haptic_util.cdr``), read it (``link_messages``), check it and admit it (``Follower.receive``).
+(``haptic_util.cdr``), then what the node does with its fields (``follower_node.take_command``:
+a stranger's refused on its session alone, any other read, checked and admitted).
 Beside each refused kind, its ratio to the good command measured in the same run: a command of
 another session, one stamped in the future, one at an absurd speed, and malformed bytes that
 claim a string longer than the message (which the decoder refuses before reading further).
@@ -21,7 +22,8 @@ import numpy as np
 from haptic_util.cdr import MalformedMessage
 from remote_probe.admission import Admission, AdmissionConfig
 from remote_probe.follower import Follower, FollowerConfig
-from remote_probe.link_messages import COMMAND, command_fields, command_from_fields
+from remote_probe.follower_node import take_command
+from remote_probe.link_messages import COMMAND, command_fields
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.teleop import Command, CommandLimits, HAND_SPEED
 
@@ -69,11 +71,11 @@ def _time(follower: Follower, messages: list, first: int) -> tuple[float, dict]:
     start = time.perf_counter()
     for k, data in enumerate(messages, first):
         try:
-            _, command = command_from_fields(COMMAND.decode(data))
+            fields = COMMAND.decode(data)
         except MalformedMessage:
             outcome = 'malformed'
         else:
-            refusal = follower.receive(START + k * PERIOD + 0.05, command)
+            refusal = take_command(follower, START + k * PERIOD + 0.05, fields, 'base_link')
             outcome = 'taken' if refusal is None else refusal.kind
         outcomes[outcome] = outcomes.get(outcome, 0) + 1
     return 1e6 * (time.perf_counter() - start) / len(messages), outcomes

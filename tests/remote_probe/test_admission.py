@@ -69,11 +69,17 @@ def test_a_stamp_from_the_future_is_refused_and_moves_nothing():
 
 
 def test_a_few_forged_stamps_do_not_move_the_baseline():
+    """Stamps a little ahead, each under the lead allowed, each a step further: had the
+    baseline been the least lateness, each would have moved it, and the next one further."""
     admission = Admission()
-    stream(admission, 0.0, 500)
-    for k in range(20):  # 4 % of the history, each a little ahead, each a step further
-        admission.admit(0.5 + k * 1e-3, SESSION, 501 + k, 0.5 + k * 1e-3 + 0.04 + OFFSET)
-    assert stream(admission, 0.6, 100, first=600) == [None] * 100
+    stream(admission, 0.0, 5000)
+    for k in range(40):  # 0.8 % of the history, under the 1 % quantile
+        lead = 0.04 * (k + 1)
+        refusal = admission.admit(5.0 + k * 1e-3 + DELAY, SESSION, 5001 + k,
+                                  5.0 + k * 1e-3 + lead + OFFSET)
+        assert k == 0 or refusal.kind == 'stamped in the future'
+    assert admission.admit(5.05 + DELAY, SESSION, 5100, 5.05 + 0.06 + OFFSET).kind == \
+        'stamped in the future'  # 60 ms ahead of the true link still is
 
 
 def test_after_a_stall_the_queued_commands_are_dropped_and_the_fresh_ones_taken():

@@ -287,3 +287,28 @@ def test_a_command_of_another_session_or_out_of_the_robots_reach_is_refused_and_
     sent = end.feedback(0.007)
     assert np.isfinite(sent.energy_in) and sent.echo == 1.0 and sent.echo_sequence == \
         command(1.0).sequence
+
+
+def test_a_silence_gives_back_only_the_shift_it_added():
+    """The first contact's estimate came a round trip late, with the wand 10 mm in: a passive
+    update shows it there. A silence later must not undo that shift, only its own."""
+    config = LeaderConfig('model', force_scale=1.0, position_scale=1.0, rejoin_speed=0.03)
+    leader = Leader(config, np.zeros(3), np.zeros(3))
+    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
+    wand = np.array([0.0, 0.0, -0.02])  # 10 mm below the skin when its first estimate comes
+
+    def heights(start, duration):
+        shown = []
+        for k in range(round(duration / 0.001)):
+            now = start + 0.001 * k
+            if k % 10 == 0:
+                leader.receive(now, feedback(now + 1.0, plane=skin))
+            shown.append(leader.plane(now, wand).point[2])
+        return shown
+    before = heights(0.0, 0.5)
+    assert before[0] == pytest.approx(-0.02) and before[-1] == pytest.approx(-0.02)
+    assert leader.plane(0.7, wand) is None  # silent
+    wand = np.array([0.0, 0.0, -0.05])  # the hand sank 30 mm more meanwhile
+    after = heights(1.0, 1.5)
+    assert after[0] == pytest.approx(-0.05)
+    assert after[-1] == pytest.approx(-0.02)  # back where it was shown: the 10 mm shift kept

@@ -75,8 +75,8 @@ class AdmissionConfig:
     session_timeout: float = 1.0
     max_rate: float = 2000.0
     burst: float = 0.05
-    history: int = 500
-    quantile: float = 0.05
+    history: int = 5000
+    quantile: float = 0.01
     relearn: float = 1.0
 
     def __post_init__(self):
@@ -115,18 +115,29 @@ class Admission:
         self._tokens = 0.0
         self._filled = None  # [s] when the bucket was last filled
 
+    def stranger(self, now: float, session: int) -> Refusal | None:
+        """Return why a message of ``session`` arriving at ``now`` is not followed, if it is not.
+
+        The cheap first question, asked before anything else is read of a message: a flood of
+        strangers is refused by this alone.
+        """
+        if session == 0:
+            return Refusal('no session')
+        if session != self.session and self._last_heard is not None and \
+                now - self._last_heard <= self.config.session_timeout:
+            return Refusal('another session', f'session {session:#x}, following '
+                           f'{self.session:#x}')
+        return None
+
     def admit(self, now: float, session: int, sequence: int, stamp: float) -> Refusal | None:
         """Return None if the message sent at ``stamp`` (s, their clock) is taken, or why not.
 
         ``now`` is our clock (s) at its arrival; ``session`` and ``sequence`` are its own.
         """
-        if session == 0:
-            return Refusal('no session', f'sequence {sequence}')
+        refusal = self.stranger(now, session)
+        if refusal is not None:
+            return refusal
         if session != self.session:
-            if self._last_heard is not None and \
-                    now - self._last_heard <= self.config.session_timeout:
-                return Refusal('another session', f'session {session:#x}, following '
-                               f'{self.session:#x}')
             self._follow(session)
         if sequence <= self._sequence or (self._stamp is not None and stamp <= self._stamp):
             return Refusal('not newer than the last taken', f'sequence {sequence} stamped '

@@ -31,15 +31,15 @@ from haptic_util.qos import LATCHED_QOS, LINK_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.experiments import surface_projection
-from remote_probe.admission import Admission, AdmissionConfig
+from remote_probe.admission import Admission, AdmissionConfig, Refusal
 from remote_probe.follower import Follower, FollowerConfig
-from remote_probe.link_messages import (COMMAND, command_from_fields, FEEDBACK, feedback_fields,
-                                        impedance_report)
+from remote_probe.link_messages import (COMMAND, command_from_fields, command_session, FEEDBACK,
+                                        feedback_fields, impedance_report)
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import FollowerParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 
-__all__ = ['FollowerNode', 'main']
+__all__ = ['FollowerNode', 'main', 'take_command']
 
 POSE = MessageCodec(PoseStamped)
 WRENCH = MessageCodec(WrenchStamped)
@@ -102,15 +102,12 @@ class FollowerNode(Node):
         return clock_ns(self.get_clock()) * 1e-9
 
     def on_command(self, fields: Sequence) -> None:
-        frame, command = command_from_fields(fields)
-        if frame != self.params.frame_id:
-            self._refused.add('command in another frame', repr(frame))
-        elif self.follower is None:
+        if self.follower is None:
             self._refused.add('command before the robot is known', self._robot_problem[1])
-        else:
-            refusal = self.follower.receive(self._now(), command)
-            if refusal is not None:
-                self._refused.add(f'command {refusal.kind}', refusal.detail)
+            return
+        refusal = take_command(self.follower, self._now(), fields, self.params.frame_id)
+        if refusal is not None:
+            self._refused.add(f'command {refusal.kind}', refusal.detail)
 
     def on_impedance(self, message: RobotImpedance) -> None:
         """Follow once the robot says it is the one the force bound was set for; else stop."""
@@ -181,6 +178,22 @@ class FollowerNode(Node):
     def destroy_node(self) -> bool:
         self.diagnostics.final()
         return super().destroy_node()
+
+
+def take_command(follower: Follower, now: float, fields: Sequence,
+                 frame_id: str) -> Refusal | None:
+    """Give ``follower`` a TeleopCommand's fields arrived at ``now`` (s); return why not taken.
+
+    A stranger's is refused on its session alone, before anything else of it is read: a flood
+    then costs the site the least it can.
+    """
+    refusal = follower.admission.stranger(now, command_session(fields))
+    if refusal is not None:
+        return refusal
+    frame, command = command_from_fields(fields)
+    if frame != frame_id:
+        return Refusal('in another frame', repr(frame))
+    return follower.receive(now, command)
 
 
 def main(args=None) -> int:

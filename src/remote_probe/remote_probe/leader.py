@@ -25,11 +25,12 @@ every wand pose at once from the newest feedback it holds, never waiting on the 
 
 After a silence the model would come back with the wand deep (nothing resisted the hand), and
 that first update is shown moved out as any other: no jolt, but the operator would go on
-pressing into nothing, the robot held at the skin by the same shift. So the shift that a
-silence left is given back at ``rejoin_speed`` (m/s at the robot): the plane comes back to where
-the remote site sees it, and the robot's target with it, as a ramp of force on both sides. That
-energy, at most half the felt stiffness times the shift squared, is not booked: it is the one
-place the model's updates are not passive, and only after a silence.
+pressing into nothing, the robot held at the skin by the same shift. So what the silence added
+to the shift is given back at ``rejoin_speed`` (m/s at the robot), down to the shift before it:
+the plane comes back to where it was shown, and the robot's target with it, as a ramp of force
+on both sides. That energy, at most half the felt stiffness times the added shift squared, is
+not booked: it is the one place the model's updates are not passive, and only after a
+silence.
 
 Feedback older than ``link_timeout`` (on this site's clock: the sites share none) gives zero
 force and no model, and no command is sent while it lasts: the robot then holds, as it does when
@@ -125,7 +126,8 @@ class Leader:
         self._shown: RemotePlane | None = None  # the plane last shown, shift included
         self._shift = np.zeros(3)  # [m] wand frame: how far it is shown out from the estimate
         self._reserve = 0.0  # [J] energy model updates took out of the wand's spring, net
-        self._rejoining = False  # giving back the shift a silence left
+        self._rejoining = False  # giving back the shift a silence added
+        self._kept = 0.0  # [m] the shift before that silence, which stays
         self._shown_at = 0.0  # [s] when the plane was last shown
         self._coupling: VirtualCoupling | None = None  # tdpa, while the link is live
 
@@ -207,7 +209,8 @@ class Leader:
         None too while the link is silent or the clutch is engaged.
         """
         if not self.live(now) or self.map.clutched or self._feedback.plane is None:
-            self._rejoining = self._rejoining or not self.live(now)
+            if not self.live(now) and not self._rejoining:  # a silence begins
+                self._rejoining, self._kept = True, float(np.linalg.norm(self._shift))
             self._shown, self._shift, self._reserve = None, np.zeros(3), 0.0
             return None
         remote = self._feedback.plane
@@ -229,17 +232,17 @@ class Leader:
         return self._shown
 
     def _given_back(self, passive: float, shown: float, now: float) -> float:
-        """Return the shift (m) after giving back what a silence left, at ``rejoin_speed``.
+        """Return the shift (m) after giving back what a silence added, at ``rejoin_speed``.
 
         An update that needs more than is shown is shown as passivity asks; else the shift
-        shrinks at the rejoin speed, or to what passivity allows if that is less. Once it is
-        all given back, updates are passive again.
+        shrinks at the rejoin speed, or to what passivity allows if that is less, down to what
+        it was before the silence. Once that is given back, updates are passive again.
         """
         if passive > shown + _ROUNDING:
             return passive
         step = self.config.rejoin_speed / self.map.position_scale * (now - self._shown_at)
-        shift = min(passive, max(shown - step, 0.0))
-        self._rejoining = shift > 0.0
+        shift = min(passive, max(shown - step, self._kept))
+        self._rejoining = shift > self._kept + _ROUNDING
         return shift
 
 

@@ -15,6 +15,7 @@ from haptic_util.cdr import MessageCodec
 from remote_probe.teleop import Command, CommandLimits, Feedback, RemotePlane
 
 __all__ = ['COMMAND', 'FEEDBACK', 'RobotReport', 'command_fields', 'command_from_fields',
+           'command_session',
            'feedback_fields', 'feedback_from_fields', 'impedance_message', 'impedance_report']
 
 COMMAND = MessageCodec(TeleopCommand)
@@ -49,6 +50,11 @@ def _time(stamp: float) -> tuple:
 
 def _header(stamp: float, frame: str) -> tuple:
     return (*_time(stamp), frame)
+
+
+def command_session(fields) -> int:
+    """Return the session of a TeleopCommand's fields, before anything else is read of it."""
+    return fields[_COMMAND_IDS.start]
 
 
 def command_from_fields(fields) -> tuple[str, Command]:
