@@ -41,7 +41,7 @@ make -C build/haptic_msgs -j2 install >build/haptic_msgs.make.log 2>&1 \
   || { tail -50 build/haptic_msgs.make.log; exit 1; }
 
 for pkg in haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup \
-    remote_probe; do
+    remote_probe site_gateway; do
   step "installing $pkg"
   # compat mode puts src/<pkg> on sys.path, so a tests/<pkg>/ folder can never shadow it.
   "${pip[@]}" install -q --no-deps --no-build-isolation --use-pep517 -e "src/$pkg" \
@@ -53,7 +53,7 @@ for pkg in haptic_util collision_engine force_renderer haptic_wand_driver haptic
 done
 
 "$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, collision_engine, force_renderer, \
-haptic_wand_driver, haptic_bringup, remote_probe" || { echo "[setup] import check failed"; exit 1; }
+haptic_wand_driver, haptic_bringup, remote_probe, site_gateway, zenoh" || { echo "[setup] import check failed"; exit 1; }
 step "compiling the collision kernels once (numba caches them for every later start)"
 "$venv/bin/python" -c "
 import pathlib
