@@ -39,7 +39,7 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.qos import HAPTIC_STREAM_QOS, LINK_QOS
 from remote_probe.bridge import emulated_link, LinkStageParams, ReleaseTimer
 from remote_probe.relay import message_class, Relay
 from site_gateway.inbound import Inbound
@@ -127,8 +127,15 @@ def _open(config: dict, name: str) -> zenoh.Session:
         raise StartupError(f'{name}: the Zenoh session did not open: {error}') from None
 
 
-def _qos(kind: str) -> QoSProfile:
-    return RELIABLE_QOS if kind == RELIABLE else HAPTIC_STREAM_QOS
+def _qos(kind: str, reading: bool = False) -> QoSProfile:
+    """Return the QoS of a crossing's kind: reliable for what must arrive, else a stream.
+
+    A stream is read with a deep history (``LINK_QOS``), so that a gateway descheduled for a few
+    milliseconds forwards what came meanwhile.
+    """
+    if kind == RELIABLE:
+        return RELIABLE_QOS
+    return LINK_QOS if reading else HAPTIC_STREAM_QOS
 
 
 class GatewayNode(Node):
@@ -157,7 +164,7 @@ class GatewayNode(Node):
             self.create_subscription(message_class(crossing.route.type_name),
                                      crossing.route.topic,
                                      functools.partial(stage.on_message, index),
-                                     _qos(crossing.kind), raw=True)
+                                     _qos(crossing.kind, reading=True), raw=True)
         self._into_dds = [self.create_publisher(message_class(c.route.type_name), c.route.topic,
                                                 _qos(c.kind)) for c in routes.incoming]
         self._listeners = [

@@ -17,7 +17,9 @@ Why these settings (``../shared/zenoh-link.md``):
 - Streams are ``express`` (no batching: at 1 kHz Zenoh's batching loses rate), at real-time
   priority, and dropped when the link is congested: a late pose is worthless, and a blocked
   publisher would stall the DDS callback that feeds it. What must arrive is reliable and
-  blocks.
+  blocks. An express message takes a batch of its priority's queue until it is written, and
+  a full queue drops it: with Zenoh's default of 2 batches, a sender descheduled for 2 ms
+  loses messages (0.5-3.3 % of a 1 kHz stream over 10 s here at load 16, none with 16).
 """
 from dataclasses import dataclass
 import os
@@ -34,6 +36,7 @@ __all__ = ['Credentials', 'LEASE', 'RETRY', 'access_control', 'check_endpoints',
 LEASE = 1.0  # [s]
 KEEP_ALIVES_PER_LEASE = 4
 RETRY = (0.1, 0.5)  # [s] first and longest wait between tries to connect
+QUEUE_BATCHES = 16  # per priority; Zenoh's most (its default, 2, drops express messages)
 SECURE = ('tls', 'quic')  # transports with mutual TLS
 PLAIN = ('tcp', 'udp')  # what --insecure allows instead
 
@@ -105,7 +108,9 @@ def session_config(routes: SiteRoutes, *, listen, connect, credentials: Credenti
         'scouting': {'multicast': {'enabled': False}, 'gossip': {'enabled': False}},
         'timestamping': {'enabled': False},
         'transport': {'link': {'tx': {'lease': round(lease * 1e3),
-                                      'keep_alive': KEEP_ALIVES_PER_LEASE}}},
+                                      'keep_alive': KEEP_ALIVES_PER_LEASE,
+                                      'queue': {'size': {'real_time': QUEUE_BATCHES,
+                                                         'interactive_high': QUEUE_BATCHES}}}}},
     }
     if credentials is not None:
         files = {'root_ca_certificate': credentials.ca,
