@@ -302,8 +302,11 @@ class Loop:
                        str(bridge)], {**env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}))
 
     def _wait_for_discovery(self) -> None:
-        endpoints = (teleop_endpoints(self.config) if self.config.teleop
-                     else {self.config.domain_id: expected_endpoints(self.config)})
+        self._wait_for(teleop_endpoints(self.config) if self.config.teleop
+                       else {self.config.domain_id: expected_endpoints(self.config)})
+
+    def _wait_for(self, endpoints: dict) -> None:
+        """Wait until each domain's endpoints are there; stop everything if they never are."""
         missing = []
         for domain_id, expected in endpoints.items():
             watcher = GraphWatcher(domain_id)
