@@ -33,14 +33,12 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.serialization import serialize_message
-import yaml
 
 from haptic_bringup.launcher import add_venv_prefix, loop_environment
 from haptic_bringup.processes import start_child, stop_children
-from haptic_bringup.site import GATEWAY_MODULE, gateway_parameters
+from haptic_bringup.site import loopback_gateways
 from haptic_util.executor import run_nodes
 from haptic_util.qos import LINK_QOS
-from site_gateway.certs import init_ca, issue
 
 PING, PONG = 'bench/ping', 'bench/pong'
 POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
@@ -164,30 +162,10 @@ class UdpEnd:
         self.socket.close()
 
 
-def free_port(kind: int = socket.SOCK_STREAM) -> int:
-    with socket.socket(socket.AF_INET, kind) as probe:
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(('127.0.0.1', 0))
         return probe.getsockname()[1]
-
-
-def start_gateways(folder: pathlib.Path, domain: int) -> dict:
-    """Start the remote gateway listening on loopback TLS, and the operator's dialling it."""
-    init_ca(folder / 'certs')
-    for role in ('remote', 'operator'):
-        issue(folder / 'certs', role)
-    endpoint = [f'tls/127.0.0.1:{free_port()}']
-    routes = {'to_remote': [f'{PING}:{POSE_TYPE}'], 'to_operator': [f'{PONG}:{POSE_TYPE}']}
-    gateways = {}
-    for role, offset, side in (('remote', 1, 'listen'), ('operator', 0, 'connect')):
-        parameters = {**gateway_parameters(role, certs=str(folder / 'certs'),
-                                           **{side: endpoint}), **routes}
-        path = folder / f'{role}.yaml'
-        path.write_text(yaml.safe_dump({f'{role}_gateway': {'ros__parameters': parameters}}))
-        gateways[role] = start_child(
-            f'{role}_gateway', [sys.executable, '-m', GATEWAY_MODULE, '--ros-args', '-r',
-                                f'__node:={role}_gateway', '--params-file', str(path)],
-            loop_environment(domain + offset, folder / 'log'))
-    return gateways
 
 
 def cpu_seconds(pid: int) -> float:
@@ -245,10 +223,13 @@ def main(argv=None) -> int:
     results = {'floor': [], 'gateways': []}
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
-        udp_port = free_port(socket.SOCK_DGRAM)
+        udp_port = free_udp_port()
         echo = start_child('echo', [sys.executable, __file__, 'echo', str(udp_port), '--ros-args'],
                            loop_environment(args.domain_id + 1, folder / 'log'))
-        gateways = start_gateways(folder, args.domain_id)
+        routes = {'to_remote': [f'{PING}:{POSE_TYPE}'], 'to_operator': [f'{PONG}:{POSE_TYPE}']}
+        gateways = {child.name.split('_')[0]: child for child in loopback_gateways(
+            folder, sys.executable, loop_environment(args.domain_id, folder / 'log'),
+            loop_environment(args.domain_id + 1, folder / 'log'), routes=routes)}
         pinger = Pinger()
         dds, udp = DdsEnd(args.domain_id, pinger), UdpEnd(udp_port, pinger)
         pids = {f'{role} gateway': child.pid for role, child in gateways.items()}

@@ -24,6 +24,7 @@ import dataclasses
 import os
 import pathlib
 import signal
+import socket
 import sys
 import time
 from typing import Optional
@@ -35,9 +36,10 @@ from haptic_bringup.launcher import (link_parameters, Loop, loop_environment, Lo
                                      RECORDER_MODULE, REMOTE_RECORDED, REMOTE_SITE,
                                      teleop_endpoints, TO_OPERATOR, TO_REMOTE)
 from haptic_bringup.processes import start_child
+from site_gateway.certs import init_ca, issue
 
-__all__ = ['GATEWAY_MODULE', 'SiteConfig', 'Site', 'gateway_parameters', 'main',
-           'site_parameters']
+__all__ = ['GATEWAY_MODULE', 'SiteConfig', 'Site', 'gateway_argv', 'gateway_parameters',
+           'loopback_gateways', 'main', 'site_parameters']
 
 GATEWAY_MODULE = 'site_gateway.gateway'
 ROLES = ('operator', 'remote')
@@ -81,6 +83,40 @@ def site_parameters(site: SiteConfig) -> dict:
     return merged
 
 
+def loopback_gateways(run_dir: pathlib.Path, python: str, env: dict, remote_env: dict, *,
+                      link: Optional[dict] = None, routes: Optional[dict] = None) -> list:
+    """Start both sites' gateways on this machine, over loopback mutual TLS; return them.
+
+    The single-machine session takes the deployed path: a CA and both sites' certificates made
+    for the run (``run_dir/certs``), the remote gateway listening on a free loopback port, the
+    operator's dialling it, each applying the emulated ``link`` to what it sends. ``routes``
+    (``to_remote``, ``to_operator``) replace the session's crossing topics.
+    """
+    certs = run_dir / 'certs'
+    init_ca(certs)
+    for role in ROLES:
+        issue(certs, role)
+    with socket.socket() as probe:
+        probe.bind(('127.0.0.1', 0))
+        endpoint = [f'tls/127.0.0.1:{probe.getsockname()[1]}']
+    gateways = []
+    for role, side, role_env in (('remote', 'listen', remote_env),
+                                 ('operator', 'connect', env)):
+        params = run_dir / f'{role}_gateway.yaml'
+        values = {**gateway_parameters(role, certs=str(certs), link=link, **{side: endpoint}),
+                  **(routes or {})}
+        params.write_text(yaml.safe_dump({f'{role}_gateway': {'ros__parameters': values}}))
+        gateways.append(start_child(f'{role}_gateway', gateway_argv(python, role, params),
+                                    role_env))
+    return gateways
+
+
+def gateway_argv(python: str, role: str, params: pathlib.Path) -> list:
+    """Return the command line of ``role``'s gateway with the parameters file ``params``."""
+    return [python, '-m', GATEWAY_MODULE, '--ros-args', '-r', f'__node:={role}_gateway',
+            '--params-file', str(params)]
+
+
 class Site(Loop):
     """Start one site, wait until its own part is up, and stop it cleanly (a context manager)."""
 
@@ -101,9 +137,8 @@ class Site(Loop):
                 'recorder', [config.python, '-m', RECORDER_MODULE, *ros_args], env))
         self.children.append(start_child(site.role, self._composed(NODES[site.role], ros_args),
                                          env))
-        self.children.append(start_child(
-            'gateway', [config.python, '-m', GATEWAY_MODULE, '--ros-args', '-r',
-                        f'__node:={site.role}_gateway', '--params-file', str(params)], env))
+        self.children.append(start_child('gateway', gateway_argv(config.python, site.role, params),
+                                         env))
         self._wait_for_discovery()
         self.startup_time = time.monotonic() - started
 
