@@ -47,6 +47,7 @@ WARM_UP = 1.0  # [s] of pongs coming back before a window is measured
 DRAIN = 0.5  # [s] after a window, for the last pongs
 CONNECT_LIMIT = 60.0  # [s] for the path to carry a first pong, on a busy machine
 PERCENTILES = (50.0, 99.0, 99.9)
+SOCKET_BUFFER = 4 << 20  # [bytes] seconds of pings, for a receiver descheduled on a busy machine
 
 
 def ping(sequence: int) -> bytes:
@@ -57,6 +58,13 @@ def ping(sequence: int) -> bytes:
     return serialize_message(message)
 
 
+def udp_socket() -> socket.socket:
+    """Return a UDP socket whose receive buffer holds what DDS's deep history would."""
+    udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    udp.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, SOCKET_BUFFER)
+    return udp
+
+
 class Echo(Node):
     """The remote end: each ping, from DDS or from UDP, sent straight back the way it came."""
 
@@ -64,7 +72,7 @@ class Echo(Node):
         super().__init__('bench_link_echo')
         self._pong = self.create_publisher(PoseStamped, PONG, LINK_QOS)
         self.create_subscription(PoseStamped, PING, self._pong.publish, LINK_QOS, raw=True)
-        self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self._socket = udp_socket()
         self._socket.bind(('127.0.0.1', udp_port))
         threading.Thread(target=self._echo_udp, daemon=True).start()
 
@@ -138,7 +146,7 @@ class UdpEnd:
     """This process's UDP socket to the echo's: the floor."""
 
     def __init__(self, port: int, pinger: Pinger) -> None:
-        self.socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.socket = udp_socket()
         self.socket.bind(('127.0.0.1', 0))
         self.socket.settimeout(0.1)
         self._echo = ('127.0.0.1', port)

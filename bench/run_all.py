@@ -64,6 +64,7 @@ BENCHMARKS = (
     Benchmark('teleop_lockstep', 'teleop_lockstep.py', ('--delays', '0.05')),
     Benchmark('teleop_scan', 'teleop_scan.py', ('--delays', '0.05')),
     Benchmark('link_door', 'bench_link_door.py', ('--messages', '2000', '--repeats', '1')),
+    Benchmark('link', 'bench_link.py', ('--seconds', '5')),
 )
 
 
