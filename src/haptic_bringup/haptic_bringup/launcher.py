@@ -16,9 +16,10 @@ stale shared memory. On a full ROS 2 install,
 
 With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
 (the wand driver and the leader, one process) in one DDS domain, the remote site (the robot with
-its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and the
-link bridge between them, which delays, jitters and drops what crosses. The recorder writes both
-sites into one bag, the remote one's topics under ``/remote/``.
+its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and
+both sites' gateways between them (``haptic_bringup.site.loopback_gateways``): the deployed path,
+over loopback mutual TLS, each gateway delaying, jittering and dropping what it sends. The
+recorder writes both sites into one bag, the remote one's topics under ``/remote/``.
 """
 import argparse
 import dataclasses
@@ -53,7 +54,6 @@ OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
-BRIDGE_MODULE = 'remote_probe.bridge'
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
 # A session's bag holds what each site measured and what crossed the link, recorded where it
@@ -180,13 +180,6 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
                                    remote_topics=list(REMOTE_RECORDED))
 
 
-def bridge_parameters(config: LoopConfig) -> dict:
-    """Return the link bridge's parameters: the two domains, what crosses, and the link."""
-    return {'/**': {'ros__parameters': {
-        'operator_domain': config.domain_id, 'remote_domain': config.remote_domain_id,
-        'to_remote': list(TO_REMOTE), 'to_operator': list(TO_OPERATOR), **config.link}}}
-
-
 def teleop_endpoints(config: LoopConfig) -> dict:
     """Domain → topic → (publishers, subscribers) that make the telerobotic session closed.
 
@@ -286,20 +279,15 @@ class Loop:
                 *([] if config.intra_process else [NO_INTRA_PROCESS]), *ros_args]
 
     def _start_teleop(self, env: dict, ros_args: list) -> None:
-        """Start the two sites, each one process in its own domain, and the bridge."""
+        """Start the two sites, each one process in its own domain, and their gateways."""
+        from haptic_bringup.site import loopback_gateways  # site.py builds on this module
         config = self.config
         remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
-        bridge = self.run_dir / 'bridge.yaml'
-        bridge.write_text(yaml.safe_dump(bridge_parameters(config), sort_keys=False))
         for name, nodes, site_env in (('operator', OPERATOR_SITE, env),
                                       ('remote', REMOTE_SITE, remote_env)):
             self.children.append(start_child(name, self._composed(nodes, ros_args), site_env))
-        # The bridge stands for the network between the sites, so it talks to them over UDP,
-        # as a remote peer would: over Fast DDS's shared memory, a bridge that stopped (SIGSTOP,
-        # a link down for a second) stalled the sites' processes that publish to it.
-        self.children.append(start_child(
-            'bridge', [config.python, '-m', BRIDGE_MODULE, '--ros-args', '--params-file',
-                       str(bridge)], {**env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}))
+        self.children += loopback_gateways(self.run_dir, config.python, env, remote_env,
+                                           link=config.link)
 
     def _wait_for_discovery(self) -> None:
         self._wait_for(teleop_endpoints(self.config) if self.config.teleop

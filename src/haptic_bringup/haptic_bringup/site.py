@@ -39,7 +39,7 @@ from haptic_bringup.processes import start_child
 from site_gateway.certs import init_ca, issue
 
 __all__ = ['GATEWAY_MODULE', 'SiteConfig', 'Site', 'gateway_argv', 'gateway_parameters',
-           'loopback_gateways', 'main', 'site_parameters']
+           'loopback_gateway_parameters', 'loopback_gateways', 'main', 'site_parameters']
 
 GATEWAY_MODULE = 'site_gateway.gateway'
 ROLES = ('operator', 'remote')
@@ -83,29 +83,36 @@ def site_parameters(site: SiteConfig) -> dict:
     return merged
 
 
-def loopback_gateways(run_dir: pathlib.Path, python: str, env: dict, remote_env: dict, *,
-                      link: Optional[dict] = None, routes: Optional[dict] = None) -> list:
-    """Start both sites' gateways on this machine, over loopback mutual TLS; return them.
+def loopback_gateway_parameters(folder: pathlib.Path, *, link: Optional[dict] = None,
+                                routes: Optional[dict] = None) -> dict:
+    """Return both sites' gateway parameters for one machine, over loopback mutual TLS.
 
     The single-machine session takes the deployed path: a CA and both sites' certificates made
-    for the run (``run_dir/certs``), the remote gateway listening on a free loopback port, the
+    for the run in ``folder/certs``, the remote gateway listening on a free loopback port, the
     operator's dialling it, each applying the emulated ``link`` to what it sends. ``routes``
     (``to_remote``, ``to_operator``) replace the session's crossing topics.
     """
-    certs = run_dir / 'certs'
+    certs = folder / 'certs'
     init_ca(certs)
     for role in ROLES:
         issue(certs, role)
     with socket.socket() as probe:
         probe.bind(('127.0.0.1', 0))
         endpoint = [f'tls/127.0.0.1:{probe.getsockname()[1]}']
+    return {role: {**gateway_parameters(role, certs=str(certs), link=link, **{side: endpoint}),
+                   **(routes or {})}
+            for role, side in (('remote', 'listen'), ('operator', 'connect'))}
+
+
+def loopback_gateways(run_dir: pathlib.Path, python: str, env: dict, remote_env: dict, *,
+                      link: Optional[dict] = None, routes: Optional[dict] = None) -> list:
+    """Start both sites' gateways on this machine (``loopback_gateway_parameters``)."""
     gateways = []
-    for role, side, role_env in (('remote', 'listen', remote_env),
-                                 ('operator', 'connect', env)):
+    parameters = loopback_gateway_parameters(run_dir, link=link, routes=routes)
+    for role, role_env in (('remote', remote_env), ('operator', env)):
         params = run_dir / f'{role}_gateway.yaml'
-        values = {**gateway_parameters(role, certs=str(certs), link=link, **{side: endpoint}),
-                  **(routes or {})}
-        params.write_text(yaml.safe_dump({f'{role}_gateway': {'ros__parameters': values}}))
+        params.write_text(yaml.safe_dump({f'{role}_gateway': {
+            'ros__parameters': parameters[role]}}))
         gateways.append(start_child(f'{role}_gateway', gateway_argv(python, role, params),
                                     role_env))
     return gateways

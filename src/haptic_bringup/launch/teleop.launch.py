@@ -7,7 +7,9 @@
 
 The operator's site (``wand_driver`` and ``teleop_leader``, one process) runs in the launch's
 ``ROS_DOMAIN_ID``; the remote site (``sim_robot`` and ``teleop_follower``, one process) in
-``remote_domain`` (default: the next domain); ``link_bridge`` joins both and emulates the link.
+``remote_domain`` (default: the next domain); both sites' gateways join them over loopback mutual
+TLS with certificates made for the launch, the deployed path, each emulating the link on what it
+sends (``haptic_bringup.site.loopback_gateway_parameters``).
 ``record:=`` writes both sites into one bag with the project's recorder (the remote site's
 topics under ``/remote/``): ``ros2 bag record`` joins one domain only. Parameters come from each
 package's config/, then ``params_file``, then these arguments, exactly as the local launcher
@@ -15,6 +17,7 @@ package's config/, then ``params_file``, then these arguments, exactly as the lo
 does: when one process exits, the launch stops the others.
 """
 import os
+import pathlib
 import tempfile
 
 from launch import LaunchDescription
@@ -24,8 +27,8 @@ from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
-from haptic_bringup.launcher import (bridge_parameters, LoopConfig, node_parameters,
-                                     OPERATOR_SITE, REMOTE_SITE)
+from haptic_bringup.launcher import LoopConfig, node_parameters, OPERATOR_SITE, REMOTE_SITE
+from haptic_bringup.site import loopback_gateway_parameters
 
 ARGUMENTS = (  # name, default, description
     ('scheme', 'model', 'bilateral scheme: direct | tdpa | model'),
@@ -81,12 +84,13 @@ def _processes(context):
             package='haptic_bringup', executable='composed', arguments=list(nodes),
             parameters=[parameters], additional_env={'ROS_DOMAIN_ID': str(domain)},
             output='screen'))
-    # Over UDP, as the network it stands for: over shared memory, a stopped bridge stalled the
-    # sites' processes that publish to it.
-    actions += session.add('bridge', Node(
-        package='remote_probe', executable='link_bridge',
-        parameters=[_written(bridge_parameters(config))],
-        additional_env={**operator_env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}, output='screen'))
+    gateways = loopback_gateway_parameters(pathlib.Path(tempfile.mkdtemp(prefix='teleop_')),
+                                           link=config.link)
+    for role, domain in (('remote', config.remote_domain_id), ('operator', config.domain_id)):
+        actions += session.add(f'{role}_gateway', Node(
+            package='site_gateway', executable='site_gateway', name=f'{role}_gateway',
+            parameters=[_written({f'{role}_gateway': {'ros__parameters': gateways[role]}})],
+            additional_env={'ROS_DOMAIN_ID': str(domain)}, output='screen'))
     if config.record:
         actions += session.add('recorder', Node(
             package='haptic_bringup', executable='recorder', parameters=[parameters],

@@ -257,8 +257,12 @@ class GatewayNode(Node):
 def main(args=None) -> int:
     """Run the gateway until SIGINT, SIGTERM or the other site's goodbye (exit 0).
 
-    A bad configuration exits 2.
+    A bad configuration exits 2. The gateway stands for the network between the sites, so it
+    talks to its site over UDP, as a remote peer would: over Fast DDS's shared memory, a relay
+    that stopped (SIGSTOP, a link down for a second) stalled the site's processes publishing to
+    it.
     """
+    os.environ.setdefault('FASTDDS_BUILTIN_TRANSPORTS', 'UDPv4')
     return run_nodes([GatewayNode], args)
 
 
