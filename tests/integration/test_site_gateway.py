@@ -60,18 +60,22 @@ def start_gateway(folder: pathlib.Path, role: str, domain: int, **parameters) ->
 
 
 class Watched(Sites):
-    """Both sites, and the remote gateway's reports as they come."""
+    """Both sites, and the gateways' reports as they come."""
 
     def __init__(self, operator: int, remote: int) -> None:
         super().__init__(operator, remote)
         self.reports = []  # (time, {key: value}) of the remote gateway
-        self.nodes[1].create_subscription(DiagnosticArray, '/diagnostics', self._on_gateway, 10)
+        self.operator_report = {}  # the operator gateway's latest
+        for node in self.nodes:
+            node.create_subscription(DiagnosticArray, '/diagnostics', self._on_gateway, 10)
 
     def _on_gateway(self, array: DiagnosticArray) -> None:
         for status in array.status:
+            values = {value.key: value.value for value in status.values}
             if status.name == '/remote_gateway':
-                self.reports.append((time.monotonic(),
-                                     {value.key: value.value for value in status.values}))
+                self.reports.append((time.monotonic(), values))
+            elif status.name == '/operator_gateway':
+                self.operator_report = values
 
     def latest(self, key: str, default: str = '0') -> str:
         return self.reports[-1][1].get(key, default) if self.reports else default
@@ -152,12 +156,20 @@ def test_poses_cross_both_ways_in_order_over_mutual_tls(site):
     count = 1000
     sites.run([(publish_out, 1), (publish_back, 10)], count, 1e-3)  # 1 kHz out, 100 Hz back
     sites.spin(0.3)
+    remote = sites.next_report()  # after the run: both gateways' counts are final
     xs, delays = np.array(out).T
     back_xs = np.array(back)[:, 0]
     p50, p99 = np.percentile(delays, [50, 99])
+    put = int(sites.operator_report['out relayed'])
     print(f'\n{len(xs)} of {count} out, {len(back_xs)} of {count // 10} back; one way through '
-          f'both gateways p50 {p50 * 1e3:.2f} ms, p99 {p99 * 1e3:.2f} ms')
-    assert count - len(xs) <= 5 and count // 10 - len(back_xs) <= 2  # DDS at 1 kHz, loaded
+          f'both gateways p50 {p50 * 1e3:.2f} ms, p99 {p99 * 1e3:.2f} ms; the operator '
+          f'gateway put {put}, the remote one received {remote[f"in {TO_REMOTE} received"]}')
+    # Between the gateways nothing is lost; the DDS hops at each end, best effort at 1 kHz
+    # with the haptic depth of 10, may drop a few on a loaded machine (36 of 1000 at load 17).
+    assert int(remote[f'in {TO_REMOTE} received']) == put
+    assert int(sites.operator_report[f'in {TO_OPERATOR} received']) == int(
+        remote['out relayed'])
+    assert len(xs) >= 0.95 * count and len(back_xs) >= 0.95 * count // 10
     assert np.all(np.diff(xs) > 0) and np.all(np.diff(back_xs) > 0)
     log = (site['folder'] / 'remote.log').read_text()
     assert "mutual TLS as 'remote'" in log and 'connected: tls/' in log

@@ -39,7 +39,7 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
-from haptic_util.qos import HAPTIC_STREAM_QOS, LINK_QOS
+from haptic_util.qos import HAPTIC_STREAM_QOS
 from remote_probe.bridge import emulated_link, LinkStageParams, ReleaseTimer
 from remote_probe.relay import message_class, Relay
 from site_gateway.inbound import Inbound
@@ -127,15 +127,15 @@ def _open(config: dict, name: str) -> zenoh.Session:
         raise StartupError(f'{name}: the Zenoh session did not open: {error}') from None
 
 
-def _qos(kind: str, reading: bool = False) -> QoSProfile:
+def _qos(kind: str) -> QoSProfile:
     """Return the QoS of a crossing's kind: reliable for what must arrive, else a stream.
 
-    A stream is read with a deep history (``LINK_QOS``), so that a gateway descheduled for a few
-    milliseconds forwards what came meanwhile.
+    A stream is read with the haptic streams' shallow history, as link_bridge read it: after a
+    stall only the newest go on. Read with ``LINK_QOS`` (1000 deep), the operator's gateway
+    stopped taking commands altogether a few seconds into the attacked session, in 2 runs of 2
+    (its timers and its other direction went on); with this depth it relayed to the end.
     """
-    if kind == RELIABLE:
-        return RELIABLE_QOS
-    return LINK_QOS if reading else HAPTIC_STREAM_QOS
+    return RELIABLE_QOS if kind == RELIABLE else HAPTIC_STREAM_QOS
 
 
 class GatewayNode(Node):
@@ -168,7 +168,7 @@ class GatewayNode(Node):
         for index, crossing in enumerate(routes.outgoing):
             self.create_subscription(message_class(crossing.route.type_name),
                                      crossing.route.topic, functools.partial(on_message, index),
-                                     _qos(crossing.kind, reading=True), raw=True)
+                                     _qos(crossing.kind), raw=True)
         self._into_dds = [self.create_publisher(message_class(c.route.type_name), c.route.topic,
                                                 _qos(c.kind)) for c in routes.incoming]
         self._listeners = [
