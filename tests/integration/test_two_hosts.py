@@ -43,6 +43,32 @@ CUT = 1.5  # [s] the veth is down: past the gateways' 1 s lease
 RESUME_LIMIT = 2.0  # [s] from the link's return to the session going on
 START_LIMIT = 180.0  # [s] both sites up and the loop closed, on a busy machine
 PRIVATE_SHM = 'mount -t tmpfs -o mode=1777 tmpfs /dev/shm && exec "$@"'
+FLOOD_AT = 10.5  # [s] after the experiment started: the scan sweeps, pressing
+FLOOD = """
+import json, sys, time, zenoh
+from rclpy.serialization import serialize_message
+from haptic_msgs.msg import TeleopCommand
+certs, endpoint = sys.argv[1:3]
+tls = {'root_ca_certificate': f'{certs}/ca.pem', 'enable_mtls': True}
+for side in ('listen', 'connect'):
+    tls.update({f'{side}_certificate': f'{certs}/operator.pem',
+                f'{side}_private_key': f'{certs}/operator.key'})
+config = {'mode': 'client', 'connect': {'endpoints': [endpoint]},
+          'transport': {'link': {'tls': tls}}}
+session = zenoh.open(zenoh.Config.from_json5(json.dumps(config)))
+publisher = session.declare_publisher('haptic/operator/teleop/command', express=True)
+data = serialize_message(TeleopCommand(session=1, sequence=1))
+time.sleep(1.0)  # the remote gateway's subscription has reached this session
+start, sent = time.time(), 0
+while time.time() - start < 1.0:
+    publisher.put(data)
+    sent += 1
+    lag = start + sent / 20_000 - time.time()
+    if lag > 0:
+        time.sleep(lag)
+print(json.dumps({'start': start, 'end': time.time(), 'sent': sent}))
+session.close()
+"""
 GRAPH = """
 import json, time, rclpy
 from rclpy.node import Node
@@ -147,6 +173,10 @@ def session(tmp_path_factory):
         time.sleep(CUT)
         hosts.link(up=True)
         restored = time.time()
+        time.sleep(max(0.0, started + FLOOD_AT - 1.0 - time.time()))
+        flood = subprocess.run(hosts.command('operator', sys.executable, '-c', FLOOD, str(certs),
+                                             f'tls/{REMOTE_ADDRESS}:{PORT}'),
+                               capture_output=True, text=True, timeout=60)
         codes = {role: process.wait(START_LIMIT) for role, process in sites.items()}
     finally:
         for process in sites.values():
@@ -155,7 +185,7 @@ def session(tmp_path_factory):
                 process.wait(30)
         hosts.close()
     return {'folder': folder, 'codes': codes, 'graph': graph, 'cut': cut,
-            'restored': restored}
+            'restored': restored, 'flood': flood}
 
 
 def series(folder, role: str, topics: dict) -> dict:
@@ -242,3 +272,34 @@ def test_the_session_goes_on_within_2_s_of_the_link_s_return_with_no_node_restar
         assert said and said[-1] == '0', node
     connections = reports(folder / 'operator', 'operator_gateway', 'connections')
     assert int(connections[-1]) >= 2  # the same gateway connected again: nothing restarted
+
+
+def test_a_flood_with_the_operator_s_certificate_is_shed_and_the_remote_site_keeps_its_rate(
+        session):
+    """A holder of the operator's certificate puts 20 kHz of commands of another session for 1 s.
+
+    The remote gateway hands on at most its 2 kHz; the robot goes on at its rate and the patient
+    stays within the limit. The flooder takes a core of the two the machine has, beside both
+    sites: the remote site may lose its share of the time to that, and not more. (The gateway's
+    bucket is per topic, not per publisher: the flood crowds the true operator's commands out
+    with it, and the robot may hold and draw back meanwhile, as on a silent link.)
+    """
+    folder, flood = session['folder'], session['flood']
+    assert flood.returncode == 0, flood.stderr[-2000:]
+    flooding = json.loads(flood.stdout.strip().splitlines()[-1])
+    assert flooding['sent'] > 10_000
+    start, end = flooding['start'], flooding['end']
+    patient = series(folder, 'remote', {'/robot/tcp_pose': 'pose',
+                                        '/robot/ft_sensor/wrench': 'wrench'})
+    tcp_times = patient['/robot/tcp_pose'][0]
+
+    def rate(first, last):
+        return np.count_nonzero((tcp_times >= first) & (tcp_times < last)) / (last - first)
+    quiet, flooded = rate(start - 1.5, start - 0.5), rate(start, end)
+    print(f'\nflood: {flooding["sent"]} put; the robot at {flooded:.0f} Hz against {quiet:.0f} Hz')
+    assert flooded >= 0.5 * quiet
+    force_times, force = patient['/robot/ft_sensor/wrench']
+    assert np.linalg.norm(force[window(force_times, start, end)], axis=1).max() <= (
+        MAX_PATIENT_FORCE)
+    shed = reports(folder / 'remote', 'remote_gateway', 'refused: teleop/command over max_rate')
+    assert shed and int(shed[-1]) > 0
