@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.setup-complete
 DEV_STAMP := $(VENV)/.dev-complete
 PACKAGES := haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup remote_probe \
-	ultrasound_sim
+	ultrasound_sim site_gateway
 SETUP_INPUTS := requirements.txt constraints.txt tools/setup_venv.sh tools/fix_wheel_cmake_paths.py \
 	$(wildcard src/msgs/*.txt src/msgs/*.xml src/msgs/msg/*.msg) \
 	$(foreach p,$(PACKAGES),$(wildcard src/$(p)/setup.py src/$(p)/setup.cfg src/$(p)/package.xml \

@@ -26,6 +26,7 @@ setup(
             'recorder = haptic_bringup.recorder:main',
             'demo = haptic_bringup.demo:main',
             'haptic_bag = haptic_bringup.bag:main',
+            'haptic_site = haptic_bringup.site:main',
         ],
     },
 )

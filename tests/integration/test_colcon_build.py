@@ -130,7 +130,8 @@ def test_config_files_are_installed_as_in_the_sources(build, package):
 
 def test_the_launch_files_scenes_and_meshes_are_installed(build):
     launch = files_under(build.share('haptic_bringup') / 'launch')
-    assert set(launch) == {'haptic_loop.launch.py', 'teleop.launch.py'}
+    assert set(launch) == {'haptic_loop.launch.py', 'teleop.launch.py', 'operator_site.launch.py',
+                           'remote_site.launch.py'}
     assert launch == files_under(SRC / 'haptic_bringup' / 'launch')
     scenes = files_under(SRC / 'collision_engine' / 'scenes')
     assert any(name.startswith('meshes/') for name in scenes)

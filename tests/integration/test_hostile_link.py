@@ -1,6 +1,6 @@
 """A telerobotic session under attack from the remote site's network: the patient stays safe.
 
-Both sites run as real processes over the link bridge, their streams through DDS as a real
+Both sites run as real processes over their gateways, their streams through DDS as a real
 arm's would be. A stranger process joins the remote site's DDS domain and, one after another:
 forges a command of another session stamped 10 s ahead; reads the operator's session and forges
 one in it, 10 s ahead, one numbered 2**63, and one at 1e308 m/s; sends malformed bytes on the

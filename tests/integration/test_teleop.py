@@ -1,4 +1,4 @@
-"""Both sites as real processes, each in its own DDS domain, over the link bridge with a delay.
+"""Both sites as real processes, each in its own DDS domain, over their gateways with a delay.
 
 Every figure comes from the bag (what the device applied to the hand, what the remote sensor
 read) or from the nodes' own reports, never from the schemes' internal books.
@@ -121,20 +121,20 @@ def test_each_site_records_itself_into_the_session_and_loses_nothing(scan):
 
 def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_meet_again(
         tmp_path):
-    """The bridge stops for 0.5 s while the scan presses, then delivers what it held.
+    """The operator's gateway stops for 0.5 s while the scan presses, then sends what it held.
 
     The operator's force is zero within the link timeout; the robot holds its TCP (not the last
     target, which lay further in) and retracts: the patient's force never rises during the
-    stall; what the bridge held is older than the link allows and never executed; and when the
+    stall; what the gateway held is older than the link allows and never executed; and when the
     link is back the robot and the operator's model meet again: the patient is pressed and the
     hand feels it, as before the stall."""
     with teleop(tmp_path, duration=SCAN_DURATION) as loop:
         time.sleep(PRESSING[0] + 0.5)
-        bridge = loop.child('bridge')
+        gateway = loop.child('operator_gateway')
         dropped = time.time()
-        bridge.signal(signal.SIGSTOP)
+        gateway.signal(signal.SIGSTOP)
         time.sleep(0.5)
-        bridge.signal(signal.SIGCONT)
+        gateway.signal(signal.SIGCONT)
         assert loop.wait(60.0) is not None
     series = streams(tmp_path)
     last_feedback = series['/teleop/feedback'][series['/teleop/feedback'] < dropped + 0.25][-1]
@@ -152,7 +152,9 @@ def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_
     held = window(tcp_times, silent, dropped + 0.5)
     assert tcp[held, 2][-1] > tcp[held, 2][0]  # drawn back, out of the patient
     stale = reports(tmp_path, 'teleop_follower', 'refused: command older than the link allows')
-    assert stale and int(stale[-1]) > 50  # what the bridge held over the stall
+    # What the frozen gateway held: its reader's newest 10 (the haptic depth), and what was in
+    # Zenoh's queue (27 in a run; the bridge, 1000 deep, held the whole 0.5 s).
+    assert stale and int(stale[-1]) >= 10
     felt_times, felt = series['/wand/applied_wrench']
     felt_before = np.median(felt[window(felt_times, dropped - 0.5, dropped), 2])
     again = dropped + 3.0  # the shift the stall left, given back at the rejoin speed

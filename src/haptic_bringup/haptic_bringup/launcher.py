@@ -18,10 +18,11 @@ ROS 2 install, ``ros2 launch haptic_bringup haptic_loop.launch.py`` does the sam
 
 With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
 (the wand driver and the leader, one process) in one DDS domain, the remote site (the robot with
-its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and the
-link bridge between them, which delays, jitters and drops what crosses. With ``--record DIR``
-each site's process records itself: DIR is the session, holding the bags ``operator`` and
-``remote`` (the remote one's topics under ``/remote/``).
+its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and
+both sites' gateways between them (``haptic_bringup.site.loopback_gateways``): the deployed path,
+over loopback mutual TLS, each gateway delaying, jittering and dropping what it sends. With
+``--record DIR`` each site's process records itself: DIR is the session, holding the bags
+``operator`` and ``remote`` (the remote one's topics under ``/remote/``).
 """
 import argparse
 import dataclasses
@@ -61,7 +62,6 @@ RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
 REMOTE_PREFIX = '/remote'  # where the remote site's topics go in its bag
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
-BRIDGE_MODULE = 'remote_probe.bridge'
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
 # A session's bag holds what each site measured and what crossed the link, recorded where it
@@ -199,13 +199,6 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
                                     'topics': list(REMOTE_RECORDED), 'prefix': REMOTE_PREFIX}
 
 
-def bridge_parameters(config: LoopConfig) -> dict:
-    """Return the link bridge's parameters: the two domains, what crosses, and the link."""
-    return {'/**': {'ros__parameters': {
-        'operator_domain': config.domain_id, 'remote_domain': config.remote_domain_id,
-        'to_remote': list(TO_REMOTE), 'to_operator': list(TO_OPERATOR), **config.link}}}
-
-
 def site_nodes(config: LoopConfig, site: str) -> tuple:
     """Return the node names of a telerobotic site's process: its nodes, and its recorder."""
     nodes, recorder = ((OPERATOR_SITE, OPERATOR_RECORDER) if site == 'operator'
@@ -318,37 +311,37 @@ class Loop:
                 *([] if config.intra_process else [NO_INTRA_PROCESS]), *ros_args]
 
     def _start_teleop(self, env: dict, ros_args: list) -> None:
-        """Start the two sites, each one process in its own domain, and the bridge.
+        """Start the two sites, each one process in its own domain, and their gateways.
 
         The operator's site starts its scan as soon as its own loop closes, robot or not, so it
         starts once the remote site is up (under load, the remote site took seconds longer).
         """
+        from haptic_bringup.site import loopback_gateways  # site.py builds on this module
         config = self.config
         remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
-        bridge = self.run_dir / 'bridge.yaml'
-        bridge.write_text(yaml.safe_dump(bridge_parameters(config), sort_keys=False))
         self.children.append(start_child(
             'remote', self._composed(site_nodes(config, 'remote'), ros_args), remote_env))
-        # The bridge stands for the network between the sites, so it talks to them over UDP,
-        # as a remote peer would: over Fast DDS's shared memory, a bridge that stopped (SIGSTOP,
-        # a link down for a second) stalled the sites' processes that publish to it.
-        self.children.append(start_child(
-            'bridge', [config.python, '-m', BRIDGE_MODULE, '--ros-args', '--params-file',
-                       str(bridge)], {**env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}))
+        self.children += loopback_gateways(self.run_dir, config.python, env, remote_env,
+                                           link=config.link)
         self._wait_for_discovery(config.remote_domain_id)
         self.children.insert(0, start_child(  # the operator's stops first
             'operator', self._composed(site_nodes(config, 'operator'), ros_args), env))
 
     def _wait_for_discovery(self, domain_id: int) -> None:
         """Wait until ``domain_id``'s endpoints of the loop or the session are discovered."""
-        expected = (teleop_endpoints(self.config)[domain_id] if self.config.teleop
-                    else expected_endpoints(self.config))
-        watcher = GraphWatcher(domain_id)
-        try:
-            missing = watcher.wait(expected, DISCOVERY_TIMEOUT,
-                                   abort=lambda: self.exited() is not None)
-        finally:
-            watcher.close()
+        self._wait_for({domain_id: teleop_endpoints(self.config)[domain_id]
+                        if self.config.teleop else expected_endpoints(self.config)})
+
+    def _wait_for(self, endpoints: dict) -> None:
+        """Wait until each domain's endpoints are there; stop everything if they never are."""
+        missing = []
+        for domain_id, expected in endpoints.items():
+            watcher = GraphWatcher(domain_id)
+            try:
+                missing += watcher.wait(expected, DISCOVERY_TIMEOUT,
+                                        abort=lambda: self.exited() is not None)
+            finally:
+                watcher.close()
         dead = self.exited()
         if dead is not None and _finished(dead):
             return  # a short experiment ran to its end before this watcher saw every endpoint

@@ -7,15 +7,18 @@
 
 The operator's site (``wand_driver`` and ``teleop_leader``, one process) runs in the launch's
 ``ROS_DOMAIN_ID``; the remote site (``sim_robot`` and ``teleop_follower``, one process) in
-``remote_domain`` (default: the next domain); ``link_bridge`` joins both and emulates the link.
-``record:=DIR`` has each site's process record itself with the project's recorder, into the
-session folder DIR (the bags ``operator`` and ``remote``, the remote site's topics under
-``/remote/``), so a Ctrl-C to the whole launch loses nothing. Parameters come from each
+``remote_domain`` (default: the next domain); both sites' gateways join them over loopback mutual
+TLS with certificates made for the launch, the deployed path, each emulating the link on what it
+sends (``haptic_bringup.site.loopback_gateway_parameters``). ``record:=DIR`` has each site's
+process record itself with the project's recorder, into the session folder DIR (the bags
+``operator`` and ``remote``, the remote site's topics under ``/remote/``), so a Ctrl-C to the
+whole launch loses nothing. Parameters come from each
 package's config/, then ``params_file``, then these arguments, exactly as the local launcher
 (``haptic_loop --teleop ...``) sets them. The session stands or falls together, as the loop
 does: when one process exits, the launch stops the others.
 """
 import os
+import pathlib
 import tempfile
 
 from launch import LaunchDescription
@@ -25,7 +28,8 @@ from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
-from haptic_bringup.launcher import bridge_parameters, LoopConfig, node_parameters, site_nodes
+from haptic_bringup.launcher import LoopConfig, node_parameters, site_nodes
+from haptic_bringup.site import loopback_gateway_parameters
 
 ARGUMENTS = (  # name, default, description
     ('scheme', 'model', 'bilateral scheme: direct | tdpa | model'),
@@ -72,7 +76,6 @@ def _processes(context):
     if config.teleop not in ('direct', 'tdpa', 'model'):
         raise ValueError(f"scheme:={config.teleop!r}: choose direct, tdpa or model")
     parameters = _written(node_parameters(config))
-    operator_env = {'ROS_DOMAIN_ID': str(config.domain_id)}
     session = AllOrNothing()
     actions = []
     for site, domain in (('operator', config.domain_id), ('remote', config.remote_domain_id)):
@@ -80,12 +83,13 @@ def _processes(context):
             package='haptic_bringup', executable='composed',
             arguments=list(site_nodes(config, site)), parameters=[parameters],
             additional_env={'ROS_DOMAIN_ID': str(domain)}, output='screen'))
-    # Over UDP, as the network it stands for: over shared memory, a stopped bridge stalled the
-    # sites' processes that publish to it.
-    actions += session.add('bridge', Node(
-        package='remote_probe', executable='link_bridge',
-        parameters=[_written(bridge_parameters(config))],
-        additional_env={**operator_env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}, output='screen'))
+    gateways = loopback_gateway_parameters(pathlib.Path(tempfile.mkdtemp(prefix='teleop_')),
+                                           link=config.link)
+    for role, domain in (('remote', config.remote_domain_id), ('operator', config.domain_id)):
+        actions += session.add(f'{role}_gateway', Node(
+            package='site_gateway', executable='site_gateway', name=f'{role}_gateway',
+            parameters=[_written({f'{role}_gateway': {'ros__parameters': gateways[role]}})],
+            additional_env={'ROS_DOMAIN_ID': str(domain)}, output='screen'))
     return actions
 
 

@@ -22,10 +22,12 @@ HAPTIC_STREAM_QOS = QoSProfile(
 
 # What comes from another site: the same policy, a history deep enough that a flood from any
 # publisher on the topic does not push the followed session's messages out before the node has
-# refused the flood's (it sheds them by content, at a few microseconds each).
+# refused the flood's (it sheds them by content, at a few microseconds each): 100 is 5 ms of a
+# 20 kHz flood, and 100 ms of the link's own 1 kHz. Not deeper: a gateway reading the commands
+# 1000 deep stopped taking them a few seconds into an attacked session (cause not found).
 LINK_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
-    depth=1000,
+    depth=100,
     reliability=ReliabilityPolicy.BEST_EFFORT,
     durability=DurabilityPolicy.VOLATILE,
 )

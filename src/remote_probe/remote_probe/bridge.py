@@ -22,10 +22,11 @@ context in the process's own ``ROS_DOMAIN_ID``, then the two sites' contexts are
 
 Each site's node reports both directions on its domain's ``/diagnostics`` at 1 Hz.
 """
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 import functools
 import math
 import time
+from typing import Callable
 
 import rclpy
 from rclpy.clock import Clock, ClockType
@@ -42,7 +43,8 @@ from haptic_util.qos import HAPTIC_STREAM_QOS
 from remote_probe.link import DelayTrace, EmulatedLink, LinkConfig
 from remote_probe.relay import check_no_loop, message_class, parse_routes, Relay
 
-__all__ = ['LinkBridgeParams', 'join_sites', 'main', 'read_parameters']
+__all__ = ['LinkBridgeParams', 'LinkStageParams', 'ReleaseTimer', 'emulated_link', 'join_sites',
+           'main', 'read_parameters']
 
 NODE_NAME = 'link_bridge'
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -51,7 +53,25 @@ _STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() 
 
 
 @dataclass(frozen=True)
-class LinkBridgeParams:
+class LinkStageParams:
+    """The emulated link's parameters, shared by the bridge and the site gateway."""
+
+    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
+                             high=10.0)
+    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
+                              "message's delay", unit='s', low=0.0, high=10.0)
+    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
+    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
+                              'holds back those behind it)')
+    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
+                          low=0)
+    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
+                                 'from each direction\'s first message, instead of delay; '
+                                 'empty: none')
+
+
+@dataclass(frozen=True)
+class LinkBridgeParams(LinkStageParams):
     """The bridge's parameters (see config/link_bridge.yaml); the link is the same both ways."""
 
     operator_domain: int = parameter(0, 'DDS domain of the operator site (wand, force '
@@ -67,18 +87,23 @@ class LinkBridgeParams:
          'robot/ft_sensor/wrench:geometry_msgs/msg/WrenchStamped'),
         "topics relayed from the remote domain to the operator's, 'topic:pkg/msg/Type'; "
         "[''] for none")
-    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
-                             high=10.0)
-    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
-                              "message's delay", unit='s', low=0.0, high=10.0)
-    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
-    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
-                              'holds back those behind it)')
-    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
-                          low=0)
-    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
-                                 'from each direction\'s first message, instead of delay; '
-                                 'empty: none')
+
+
+def emulated_link(params: LinkStageParams, direction: str, node_name: str) -> EmulatedLink:
+    """Return one direction's emulated link (``to_operator`` draws with ``seed + 1``).
+
+    A bad value or an unreadable trace raises ``StartupError`` naming the node.
+    """
+    seed = params.seed + (1 if direction == 'to_operator' else 0)
+    try:
+        config = LinkConfig(params.delay, params.jitter, params.loss, params.reorder, seed)
+    except ValueError as error:
+        raise StartupError(f'{node_name}: {error}') from None
+    try:
+        trace = DelayTrace.from_csv(params.delay_trace) if params.delay_trace else None
+    except (ValueError, OSError) as error:
+        raise StartupError(f'{node_name}: parameter delay_trace: {error}') from None
+    return EmulatedLink(config, trace=trace)
 
 
 class _Plan:
@@ -92,14 +117,8 @@ class _Plan:
             self.to_remote = parse_routes(params.to_remote, 'to_remote')
             self.to_operator = parse_routes(params.to_operator, 'to_operator')
             check_no_loop(self.to_remote, self.to_operator)
-            config = LinkConfig(params.delay, params.jitter, params.loss, params.reorder,
-                                params.seed)
         except ValueError as error:
             raise StartupError(f'{NODE_NAME}: {error}') from None
-        try:
-            trace = DelayTrace.from_csv(params.delay_trace) if params.delay_trace else None
-        except (ValueError, OSError) as error:
-            raise StartupError(f'{NODE_NAME}: parameter delay_trace: {error}') from None
         for direction, routes in (('to_remote', self.to_remote),
                                   ('to_operator', self.to_operator)):
             for route in routes:
@@ -109,9 +128,8 @@ class _Plan:
                     first = str(error).splitlines()[0]
                     raise StartupError(f'{NODE_NAME}: {direction}: topic {route.topic!r}: '
                                        f'{first}') from None
-        self.links = {'to_remote': EmulatedLink(config, trace=trace),
-                      'to_operator': EmulatedLink(replace(config, seed=params.seed + 1),
-                                                  trace=trace)}
+        self.links = {direction: emulated_link(params, direction, NODE_NAME)
+                      for direction in ('to_remote', 'to_operator')}
 
 
 def read_parameters(args=None) -> LinkBridgeParams:
@@ -129,23 +147,18 @@ def read_parameters(args=None) -> LinkBridgeParams:
         rclpy.try_shutdown(context=context)
 
 
-class _Direction:
-    """One direction's wiring: raw subscriptions at its source, publishers at its destination.
+class ReleaseTimer:
+    """One direction's emulated link in a node: messages in, each out when its time comes.
 
-    The release timer lives in the destination's node; it is armed for the link's next
-    arrival, and a message whose time has come on arrival (no delay) goes out at once.
+    The timer (steady clock) is armed for the link's next arrival, rather than polling at
+    1 kHz; a message whose time has come on arrival (no delay) goes out at once, through
+    ``emit(route, data)``: a DDS publisher here, a Zenoh one in the site gateway.
     """
 
-    def __init__(self, relay: Relay, routes: tuple, source: Node, destination: Node) -> None:
+    def __init__(self, relay: Relay, node: Node, emit: Callable[[int, bytes], None]) -> None:
         self.relay = relay
-        classes = [message_class(route.type_name) for route in routes]
-        self._publishers = [destination.create_publisher(cls, route.topic, HAPTIC_STREAM_QOS)
-                            for cls, route in zip(classes, routes)]
-        for index, (cls, route) in enumerate(zip(classes, routes)):
-            source.create_subscription(cls, route.topic, functools.partial(self.on_message, index),
-                                       HAPTIC_STREAM_QOS, raw=True)
-        self._timer = destination.create_timer(1.0, self.on_timer, clock=_STEADY,
-                                               autostart=False)
+        self._emit = emit
+        self._timer = node.create_timer(1.0, self.on_timer, clock=_STEADY, autostart=False)
         self._armed = None  # [s] the arrival the timer is armed for
 
     def on_message(self, route: int, data: bytes) -> None:
@@ -159,7 +172,7 @@ class _Direction:
     def release(self) -> None:
         now = time.monotonic()
         for route, data in self.relay.release(now):
-            self._publishers[route].publish(data)
+            self._emit(route, data)
         due = self.relay.next_arrival
         if due == self._armed:
             return
@@ -169,6 +182,18 @@ class _Direction:
             return
         self._timer.timer_period_ns = max(1, math.ceil((due - now) * 1e9))
         self._timer.reset()
+
+
+def _wire(relay: Relay, routes: tuple, source: Node, destination: Node) -> None:
+    """Wire one direction: raw subscriptions at its source, publishers and timer at its end."""
+    classes = [message_class(route.type_name) for route in routes]
+    publishers = [destination.create_publisher(cls, route.topic, HAPTIC_STREAM_QOS)
+                  for cls, route in zip(classes, routes)]
+    stage = ReleaseTimer(relay, destination,
+                         lambda route, data: publishers[route].publish(data))
+    for index, (cls, route) in enumerate(zip(classes, routes)):
+        source.create_subscription(cls, route.topic, functools.partial(stage.on_message, index),
+                                   HAPTIC_STREAM_QOS, raw=True)
 
 
 class _SiteNode(Node):
@@ -218,8 +243,8 @@ def join_sites(args, nodes: list, contexts: list) -> None:
                                says_totals=site == 'operator'))
     operator, remote = nodes
     # Each direction lives on in its nodes' subscriptions and timer.
-    _Direction(relays['to_remote'], plan.to_remote, operator, remote)
-    _Direction(relays['to_operator'], plan.to_operator, remote, operator)
+    _wire(relays['to_remote'], plan.to_remote, operator, remote)
+    _wire(relays['to_operator'], plan.to_operator, remote, operator)
     trace = f'trace {params.delay_trace}' if params.delay_trace else f'{params.delay:g} s'
     operator.get_logger().info(
         f'domain {params.operator_domain} <-> {params.remote_domain}: '

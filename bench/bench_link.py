@@ -1,0 +1,296 @@
+"""The round trip the two site gateways add, against plain UDP between the same two processes.
+
+    .venv/bin/python bench/bench_link.py [--seconds 60] [--runs 1] [--rate 1000] [--json PATH]
+
+Why: a command that crosses to the remote site and the feedback that comes back take the path
+that is deployed: DDS in the operator's domain, the operator's gateway, Zenoh over mutual TLS,
+the remote gateway, DDS in the remote domain, and back. Its floor is the same two end processes
+exchanging the same bytes (a stamped PoseStamped's CDR) as UDP datagrams on the same loopback:
+what any transport between them must at least take. This process sends ``--rate`` numbered
+pings; an echo process (``bench_link.py echo``, in the next DDS domain) sends each back at once
+on both paths. The cases alternate within one invocation, so they share the machine's state;
+each figure is given beside its floor, and as the round trip added over it. A ping with no pong
+0.5 s after the window ends is lost. Each gateway's CPU is read from outside (psutil) over the
+measured window, in % of one core. No emulated delay: the stage passes messages straight on.
+"""
+import argparse
+import json
+import os
+import pathlib
+import socket
+import struct
+import sys
+import tempfile
+import threading
+import time
+
+from geometry_msgs.msg import PoseStamped
+import machine
+import numpy as np
+import psutil
+import rclpy
+from rclpy.context import Context
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+from rclpy.serialization import serialize_message
+from rclpy.task import Future
+
+from haptic_bringup.launcher import add_venv_prefix, loop_environment
+from haptic_bringup.processes import start_child, stop_children
+from haptic_bringup.site import loopback_gateways
+from haptic_util.executor import run_nodes
+from haptic_util.qos import LINK_QOS
+
+PING, PONG = 'bench/ping', 'bench/pong'
+POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
+SEQUENCE = struct.Struct('<i')  # the ping's number, in its header's stamp.sec (after CDR's 4)
+WARM_UP = 1.0  # [s] of pongs coming back before a window is measured
+DRAIN = 0.5  # [s] after a window, for the last pongs
+CONNECT_LIMIT = 60.0  # [s] for the path to carry a first pong, on a busy machine
+PERCENTILES = (50.0, 99.0, 99.9)
+SOCKET_BUFFER = 4 << 20  # [bytes] seconds of pings, for a receiver descheduled on a busy machine
+
+
+def ping(sequence: int) -> bytes:
+    """Return the CDR bytes of ping ``sequence``: the same on both paths."""
+    message = PoseStamped()
+    message.header.stamp.sec = sequence
+    message.header.frame_id = 'base_link'
+    return serialize_message(message)
+
+
+def udp_socket() -> socket.socket:
+    """Return a UDP socket whose receive buffer holds what DDS's deep history would."""
+    udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    udp.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, SOCKET_BUFFER)
+    return udp
+
+
+class Echo(Node):
+    """The remote end: each ping, from DDS or from UDP, sent straight back the way it came."""
+
+    def __init__(self, udp_port: int) -> None:
+        super().__init__('bench_link_echo')
+        self._pong = self.create_publisher(PoseStamped, PONG, LINK_QOS)
+        self.create_subscription(PoseStamped, PING, self._pong.publish, LINK_QOS, raw=True)
+        self._socket = udp_socket()
+        self._socket.bind(('127.0.0.1', udp_port))
+        threading.Thread(target=self._echo_udp, daemon=True).start()
+
+    def _echo_udp(self) -> None:
+        while True:
+            data, sender = self._socket.recvfrom(65536)
+            self._socket.sendto(data, sender)
+
+
+class Pinger:
+    """This process's end: pings sent at a rate, each pong's round trip from its send time."""
+
+    def __init__(self) -> None:
+        self.sent, self.round_trips = {}, {}  # sequence -> send time; sequence -> round trip
+
+    def on_pong(self, data: bytes) -> None:
+        now = time.perf_counter()
+        (sequence,) = SEQUENCE.unpack_from(data, 4)
+        sent = self.sent.get(sequence)
+        if sent is not None and sequence not in self.round_trips:
+            self.round_trips[sequence] = now - sent
+
+    def run(self, end, rate: float, seconds: float, first: int) -> range:
+        """Send pings ``first``... at ``rate`` for ``seconds`` through ``end``; their numbers.
+
+        Between two pings, ``end.wait`` takes the pongs that came (an executor's spin for DDS,
+        as the nodes do: a spin in another thread fell behind and its queue stood in the round
+        trips, 200 ms at p99).
+        """
+        count = int(rate * seconds)
+        start = time.perf_counter()
+        for k in range(count):
+            self.sent[first + k] = time.perf_counter()
+            end.send(ping(first + k))
+            lag = start + (k + 1) / rate - time.perf_counter()
+            if lag > 0:
+                end.wait(lag)
+        end.wait(DRAIN)
+        return range(first, first + count)
+
+    def figures(self, sequences: range) -> dict:
+        trips = np.array([self.round_trips[s] for s in sequences if s in self.round_trips])
+        values = np.percentile(trips, PERCENTILES) * 1e3 if len(trips) else [float('nan')] * 3
+        return {**{f'p{q:g}_ms': float(v) for q, v in zip(PERCENTILES, values)},
+                'sent': len(sequences), 'lost': len(sequences) - len(trips)}
+
+
+class DdsEnd:
+    """This process in the operator's domain: pings published, pongs taken raw."""
+
+    def __init__(self, domain: int, pinger: Pinger) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain)
+        self.node = Node('bench_link_pinger', context=self.context)
+        self.publisher = self.node.create_publisher(PoseStamped, PING, LINK_QOS)
+        self.node.create_subscription(PoseStamped, PONG, pinger.on_pong, LINK_QOS, raw=True)
+        self.executor = EventsExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.send = self.publisher.publish
+
+    def wait(self, seconds: float) -> None:
+        self.executor.spin_until_future_complete(Future(), timeout_sec=seconds)
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+class UdpEnd:
+    """This process's UDP socket to the echo's: the floor."""
+
+    def __init__(self, port: int, pinger: Pinger) -> None:
+        self.socket = udp_socket()
+        self.socket.bind(('127.0.0.1', 0))
+        self.socket.settimeout(0.1)
+        self._echo = ('127.0.0.1', port)
+        self._pinger, self._running = pinger, True
+        self._thread = threading.Thread(target=self._receive, daemon=True)
+        self._thread.start()
+
+    def send(self, data: bytes) -> None:
+        self.socket.sendto(data, self._echo)  # unconnected: an echo not up yet is no error
+
+    @staticmethod
+    def wait(seconds: float) -> None:
+        time.sleep(seconds)  # the pongs are taken by the receiving thread
+
+    def _receive(self) -> None:
+        while self._running:
+            try:
+                self._pinger.on_pong(self.socket.recv(65536))
+            except socket.timeout:
+                continue
+
+    def close(self) -> None:
+        self._running = False
+        self._thread.join()
+        self.socket.close()
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(('127.0.0.1', 0))
+        return probe.getsockname()[1]
+
+
+def cpu_seconds(pid: int) -> float:
+    times = psutil.Process(pid).cpu_times()
+    return times.user + times.system
+
+
+def connect(end, pinger: Pinger) -> None:
+    """Ping until pongs come back, then for ``WARM_UP`` s more."""
+    deadline = time.monotonic() + CONNECT_LIMIT
+    first = -1_000_000
+    while not pinger.round_trips:
+        if time.monotonic() > deadline:
+            raise RuntimeError('no pong came back: the path is not up')
+        pinger.run(end, 100.0, 0.1, first)
+        first += 10
+    pinger.run(end, 1000.0, WARM_UP, first)
+
+
+def measure(case: str, end, pinger: Pinger, args, pids: dict, first: int) -> dict:
+    before = {name: cpu_seconds(pid) for name, pid in pids.items()}
+    start = time.monotonic()
+    sequences = pinger.run(end, args.rate, args.seconds, first)
+    wall = time.monotonic() - start - DRAIN
+    figures = pinger.figures(sequences)
+    figures['cpu_pct'] = {name: 100.0 * (cpu_seconds(pid) - before[name]) / wall
+                          for name, pid in pids.items()}
+    print(f'{case:<9} ' + ' '.join(f'{figures[f"p{q:g}_ms"]:8.3f}' for q in PERCENTILES)
+          + f' {figures["lost"]:5d}/{figures["sent"]:<6d} '
+          + ', '.join(f'{name} {cpu:.1f} %' for name, cpu in figures['cpu_pct'].items()),
+          flush=True)
+    return figures
+
+
+def main(argv=None) -> int:
+    argv = sys.argv if argv is None else argv
+    if len(argv) > 1 and argv[1] == 'echo':
+        return run_nodes([lambda: Echo(int(argv[2]))], argv)
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
+    parser.add_argument('--runs', type=int, default=1, help='alternated rounds of both cases')
+    parser.add_argument('--rate', type=float, default=1000.0, help='[Hz] pings')
+    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)),
+                        help="the operator's side; the echo's is the next")
+    parser.add_argument('--json', metavar='PATH', help='also write the figures there')
+    args = parser.parse_args(argv[1:])
+    add_venv_prefix()
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    description = machine.describe('ros-jazzy-rclpy', 'eclipse-zenoh')
+    print(f'machine: {machine.line("ros-jazzy-rclpy", "eclipse-zenoh")}; load average '
+          f'{os.getloadavg()[0]:.2f}')
+    print(f'{args.rate:g} Hz pings for {args.seconds:g} s per case, {args.runs} alternated '
+          f'round(s); round trip in ms; CPU in % of one core over the window')
+    print(f'{"case":<9} {"p50":>8} {"p99":>8} {"p99.9":>8} {"lost/sent":>12} CPU')
+    results = {'floor': [], 'gateways': []}
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = pathlib.Path(tmp)
+        udp_port = free_udp_port()
+        echo = start_child('echo', [sys.executable, __file__, 'echo', str(udp_port), '--ros-args'],
+                           loop_environment(args.domain_id + 1, folder / 'log'))
+        routes = {'to_remote': [f'{PING}:{POSE_TYPE}'], 'to_operator': [f'{PONG}:{POSE_TYPE}']}
+        gateways = {child.name.split('_')[0]: child for child in loopback_gateways(
+            folder, sys.executable, loop_environment(args.domain_id, folder / 'log'),
+            loop_environment(args.domain_id + 1, folder / 'log'), routes=routes)}
+        pinger = Pinger()
+        dds, udp = DdsEnd(args.domain_id, pinger), UdpEnd(udp_port, pinger)
+        pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
+        try:
+            connect(udp, pinger)
+            connect(dds, pinger)
+            first = 0
+            for _ in range(args.runs):
+                for case, end, watched in (('floor', udp, {'echo': echo.pid}),
+                                           ('gateways', dds, {**pids, 'echo': echo.pid})):
+                    results[case].append(measure(case, end, pinger, args, watched, first))
+                    first += int(args.rate * args.seconds)
+        finally:
+            udp.close()
+            dds.close()
+            stop_children([*gateways.values(), echo])
+    summary = summarize(results)
+    print(f'load average after: {os.getloadavg()[0]:.2f}')
+    print('added by the gateways over the floor (median of rounds): ' + ', '.join(
+        f'p{q:g} {summary["added_ms"][f"p{q:g}"]:.3f} ms ({summary["ratio"][f"p{q:g}"]:.1f} x)'
+        for q in PERCENTILES)
+        + f'; lost {summary["lost"]} of {summary["sent"]}; gateways\' CPU '
+        + ', '.join(f'{name} {cpu:.1f} %' for name, cpu in summary['gateway_cpu_pct'].items()))
+    if args.json:
+        pathlib.Path(args.json).write_text(json.dumps(
+            {'machine': description, 'load_average_after': os.getloadavg()[0],
+             'rate_hz': args.rate, 'seconds': args.seconds, 'runs': results,
+             'summary': summary}, indent=2))
+    return 0
+
+
+def summarize(results: dict) -> dict:
+    """Return the round trip added over the floor, its ratio, the loss, each gateway's CPU."""
+    def median(case: str, key: str) -> float:
+        return float(np.median([run[key] for run in results[case]]))
+    added, ratio = {}, {}
+    for q in PERCENTILES:
+        key = f'p{q:g}_ms'
+        added[f'p{q:g}'] = median('gateways', key) - median('floor', key)
+        ratio[f'p{q:g}'] = median('gateways', key) / median('floor', key)
+    gateways = results['gateways']
+    cpu = {name: float(np.median([run['cpu_pct'][name] for run in gateways]))
+           for name in gateways[0]['cpu_pct'] if name.endswith('gateway')}
+    return {'added_ms': added, 'ratio': ratio, 'gateway_cpu_pct': cpu,
+            'lost': sum(run['lost'] for run in gateways),
+            'sent': sum(run['sent'] for run in gateways),
+            'floor_lost': sum(run['lost'] for run in results['floor'])}
+
+
+if __name__ == '__main__':
+    sys.exit(main())

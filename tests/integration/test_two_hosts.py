@@ -1,0 +1,305 @@
+"""Two hosts on one machine: the operator's site and the patient's in two network namespaces.
+
+Each namespace has its own loopback (each site's DDS, local-only discovery, in the same domain
+id on both sides, as two hospitals would have it) and its own ``/dev/shm`` (so Fast DDS's shared
+memory cannot join them either); one veth pair, with addresses this test gives it inside its
+own namespaces (192.0.2.0/30, a documentation range that is routed nowhere), joins them. The
+sites are started with ``haptic_site`` as a user would on two machines, with certificates from
+``haptic_certs``, and run the model-mediated scan across their gateways over mutual TLS. While
+the scan presses, the veth is taken down for ``CUT`` s, longer than the gateways' lease, then
+brought up again.
+
+Every figure is read from the two sites' bags (what the device applied to the hand, what the
+patient's sensor read, when each site received the other's messages) and the sites' output.
+"""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+from domains import session_domain_id
+import numpy as np
+import pytest
+from rosbags.highlevel import AnyReader
+from test_teleop import LINK_TIMEOUT, MAX_PATIENT_FORCE, MODEL_LIFETIME, reports, window, zeroed
+
+from haptic_bringup.bag import typestore_with
+from haptic_bringup.launcher import loop_environment, SCAN_DURATION
+from haptic_bringup.recorder import custom_definitions
+from haptic_bringup.session import read_vectors
+from site_gateway.certs import init_ca, issue
+
+pytestmark = pytest.mark.skipif(
+    os.geteuid() != 0 or shutil.which('ip') is None,
+    reason='network namespaces need root and iproute2 (CI runs as root)')
+
+OPERATOR_ADDRESS, REMOTE_ADDRESS = '192.0.2.1', '192.0.2.2'
+PORT = 7447  # each namespace has its own ports
+CUT_AFTER = 6.5  # [s] after the experiment started: the scan presses from about 4 s
+CUT = 1.5  # [s] the veth is down: past the gateways' 1 s lease
+RESUME_LIMIT = 2.0  # [s] from the link's return to the session going on
+START_LIMIT = 180.0  # [s] both sites up and the loop closed, on a busy machine
+PRIVATE_SHM = 'mount -t tmpfs -o mode=1777 tmpfs /dev/shm && exec "$@"'
+FLOOD_AT = 10.5  # [s] after the experiment started: the scan sweeps, pressing
+FLOOD = """
+import json, sys, time, zenoh
+from rclpy.serialization import serialize_message
+from haptic_msgs.msg import TeleopCommand
+certs, endpoint = sys.argv[1:3]
+tls = {'root_ca_certificate': f'{certs}/ca.pem', 'enable_mtls': True}
+for side in ('listen', 'connect'):
+    tls.update({f'{side}_certificate': f'{certs}/operator.pem',
+                f'{side}_private_key': f'{certs}/operator.key'})
+config = {'mode': 'client', 'connect': {'endpoints': [endpoint]},
+          'transport': {'link': {'tls': tls}}}
+session = zenoh.open(zenoh.Config.from_json5(json.dumps(config)))
+publisher = session.declare_publisher('haptic/operator/teleop/command', express=True)
+data = serialize_message(TeleopCommand(session=1, sequence=1))
+time.sleep(1.0)  # the remote gateway's subscription has reached this session
+start, sent = time.time(), 0
+while time.time() - start < 1.0:
+    publisher.put(data)
+    sent += 1
+    lag = start + sent / 20_000 - time.time()
+    if lag > 0:
+        time.sleep(lag)
+print(json.dumps({'start': start, 'end': time.time(), 'sent': sent}))
+session.close()
+"""
+GRAPH = """
+import json, time, rclpy
+from rclpy.node import Node
+rclpy.init()
+node = Node('graph_probe', start_parameter_services=False, enable_rosout=False)
+deadline = time.monotonic() + 8.0
+while time.monotonic() < deadline and len(node.get_topic_names_and_types()) < 5:
+    time.sleep(0.1)
+time.sleep(2.0)  # whatever else there is to discover
+print(json.dumps(sorted(name for name, _ in node.get_topic_names_and_types())))
+"""
+
+
+def run(*argv: str) -> None:
+    subprocess.run(argv, check=True, capture_output=True, text=True)
+
+
+class Hosts:
+    """Two network namespaces joined by a veth pair; commands run in either."""
+
+    def __init__(self) -> None:
+        tag = f'{os.getpid() % 100000}'
+        self.names = {'operator': f'hop{tag}', 'remote': f'hrm{tag}'}
+        self.veths = {'operator': f'vop{tag}', 'remote': f'vrm{tag}'}
+        addresses = {'operator': OPERATOR_ADDRESS, 'remote': REMOTE_ADDRESS}
+        for name in self.names.values():
+            run('ip', 'netns', 'add', name)
+        run('ip', 'link', 'add', self.veths['operator'], 'type', 'veth', 'peer', 'name',
+            self.veths['remote'])
+        for role, name in self.names.items():
+            veth = self.veths[role]
+            run('ip', 'link', 'set', veth, 'netns', name)
+            self.ip(role, 'addr', 'add', f'{addresses[role]}/30', 'dev', veth)
+            self.ip(role, 'link', 'set', veth, 'up')
+            self.ip(role, 'link', 'set', 'lo', 'up')
+
+    def ip(self, role: str, *argv: str) -> None:
+        run('ip', 'netns', 'exec', self.names[role], 'ip', *argv)
+
+    def command(self, role: str, *argv: str) -> list:
+        """``argv`` run in ``role``'s namespace, with its own /dev/shm."""
+        return ['ip', 'netns', 'exec', self.names[role], 'sh', '-c', PRIVATE_SHM, 'sh', *argv]
+
+    def link(self, up: bool) -> None:
+        self.ip('operator', 'link', 'set', self.veths['operator'], 'up' if up else 'down')
+
+    def close(self) -> None:
+        for name in self.names.values():
+            subprocess.run(['ip', 'netns', 'del', name], capture_output=True)
+
+
+def start_site(hosts: Hosts, role: str, folder, domain: int, certs, *options: str):
+    (folder / role).mkdir()
+    argv = hosts.command(role, sys.executable, '-m', 'haptic_bringup.site', role,
+                         '--certs', str(certs), '--domain-id', str(domain),
+                         '--record', str(folder / role / 'bag'),
+                         '--run-dir', str(folder / role / 'run'), *options)
+    env = loop_environment(domain, folder / role / 'log')
+    with open(folder / f'{role}.log', 'wb') as log:
+        return subprocess.Popen(argv, env=env, stdout=log, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+
+
+def wait_for_text(path, text: str, process, limit: float) -> float:
+    """Wait until ``text`` is in the file at ``path``; return when it was seen."""
+    deadline = time.monotonic() + limit
+    while text not in path.read_text(errors='replace'):
+        assert process.poll() is None, f'{path.name} ended: {path.read_text()[-3000:]}'
+        assert time.monotonic() < deadline, f'no {text!r} in {path.name}'
+        time.sleep(0.05)
+    return time.time()
+
+
+@pytest.fixture(scope='module')
+def session(tmp_path_factory):
+    folder = tmp_path_factory.mktemp('two_hosts')
+    certs = folder / 'certs'
+    init_ca(certs)
+    issue(certs, 'remote', hosts=[REMOTE_ADDRESS])
+    issue(certs, 'operator')
+    domain = session_domain_id()
+    try:
+        hosts = Hosts()
+    except subprocess.CalledProcessError as error:
+        pytest.skip(f'network namespaces cannot be made here: {error.stderr.strip()}')
+    sites = {}
+    try:
+        sites['remote'] = start_site(hosts, 'remote', folder, domain, certs,
+                                     '--listen', f'tls/{REMOTE_ADDRESS}:{PORT}')
+        wait_for_text(folder / 'remote.log', 'remote site up', sites['remote'], START_LIMIT)
+        sites['operator'] = start_site(hosts, 'operator', folder, domain, certs,
+                                       '--connect', f'tls/{REMOTE_ADDRESS}:{PORT}',
+                                       '--duration', str(SCAN_DURATION))
+        started = wait_for_text(folder / 'operator.log', 'loop closed: experiment started',
+                                sites['operator'], START_LIMIT)
+        graph = subprocess.run(hosts.command('operator', sys.executable, '-c', GRAPH),
+                               env=loop_environment(domain, folder / 'log'),
+                               capture_output=True, text=True, timeout=60)
+        time.sleep(max(0.0, started + CUT_AFTER - time.time()))
+        cut = time.time()
+        hosts.link(up=False)
+        time.sleep(CUT)
+        hosts.link(up=True)
+        restored = time.time()
+        time.sleep(max(0.0, started + FLOOD_AT - 1.0 - time.time()))
+        flood = subprocess.run(hosts.command('operator', sys.executable, '-c', FLOOD, str(certs),
+                                             f'tls/{REMOTE_ADDRESS}:{PORT}'),
+                               capture_output=True, text=True, timeout=60)
+        codes = {role: process.wait(START_LIMIT) for role, process in sites.items()}
+    finally:
+        for process in sites.values():
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGINT)
+                process.wait(30)
+        hosts.close()
+    return {'folder': folder, 'codes': codes, 'graph': graph, 'cut': cut,
+            'restored': restored, 'flood': flood}
+
+
+def series(folder, role: str, topics: dict) -> dict:
+    return read_vectors(folder / role / 'bag', typestore_with(custom_definitions()), topics)
+
+
+def received(folder, role: str, topic: str) -> np.ndarray:
+    """When ``role``'s site received each message of ``topic`` (its recorder's clock)."""
+    with AnyReader([folder / role / 'bag'],
+                   default_typestore=typestore_with(custom_definitions())) as reader:
+        connections = [c for c in reader.connections if c.topic == topic]
+        return np.array([stamp * 1e-9 for _, stamp, _ in reader.messages(connections)])
+
+
+def test_both_sites_end_cleanly_the_remote_one_when_the_operator_s_is_gone(session):
+    folder = session['folder']
+    assert session['codes'] == {'remote': 0, 'operator': 0}
+    assert 'the experiment ended (operator: 0, gateway: 0, recorder: 0)' in \
+        (folder / 'operator.log').read_text()
+    assert 'the other site stopped (remote: 0, gateway: 0, recorder: 0)' in \
+        (folder / 'remote.log').read_text()
+    assert 'connection lost' in (folder / 'remote.log').read_text()
+
+
+def test_no_dds_crosses_the_remote_site_s_topics_are_not_seen_from_the_operator_s(session):
+    graph = session['graph']
+    assert graph.returncode == 0, graph.stderr
+    topics = json.loads(graph.stdout.strip().splitlines()[-1])
+    assert '/wand/pose' in topics and '/teleop/command' in topics  # it does see its own site
+    for remote_only in ('/robot/tcp_pose', '/robot/ft_sensor/wrench', '/robot/target_pose'):
+        assert remote_only not in topics, topics
+
+
+def test_the_contact_is_felt_across_the_gateways_and_the_patient_stays_under_the_limit(session):
+    folder, cut = session['folder'], session['cut']
+    felt_times, felt = series(folder, 'operator',
+                              {'/wand/applied_wrench': 'wrench'})['/wand/applied_wrench']
+    patient_times, patient = series(
+        folder, 'remote', {'/robot/ft_sensor/wrench': 'wrench'})['/robot/ft_sensor/wrench']
+    felt_force = np.median(felt[window(felt_times, cut - 1.5, cut - 0.5), 2]) / 0.3
+    patient_force = np.median(patient[window(patient_times, cut - 1.5, cut - 0.5), 2])
+    print(f'\nbefore the cut: felt {felt_force:.2f} N / 0.3, patient {patient_force:.2f} N; '
+          f'patient peak {np.linalg.norm(patient, axis=1).max():.2f} N')
+    assert patient_force > 5.0
+    assert felt_force == pytest.approx(patient_force, rel=0.15)
+    assert np.max(np.linalg.norm(patient, axis=1)) <= MAX_PATIENT_FORCE
+
+
+def test_a_cut_link_zeroes_the_operator_s_force_and_the_robot_holds_then_lets_go(session):
+    folder, cut = session['folder'], session['cut']
+    feedback = received(folder, 'operator', '/teleop/feedback')
+    last_feedback = feedback[feedback < cut + 0.5][-1]  # frames in flight when the veth went
+    # The model is valid until the leader's link timeout, and each lasts its lifetime.
+    assert zeroed(folder / 'operator', last_feedback) - last_feedback <= (
+        LINK_TIMEOUT + MODEL_LIFETIME + 0.010)
+    commands = received(folder, 'remote', '/teleop/command')
+    last_command = commands[commands < cut + 0.5][-1]
+    silent = last_command + LINK_TIMEOUT + 0.02  # the follower's watchdog has fired
+    patient = series(folder, 'remote', {'/robot/ft_sensor/wrench': 'wrench',
+                                        '/robot/tcp_pose': 'pose'})
+    patient_times, force = patient['/robot/ft_sensor/wrench']
+    pressing = np.linalg.norm(force, axis=1)
+    before = pressing[window(patient_times, silent - 0.01, silent)].max()
+    assert before > 3.0
+    assert pressing[window(patient_times, silent, cut + CUT)].max() <= before + 0.5
+    tcp_times, tcp = patient['/robot/tcp_pose']
+    held = window(tcp_times, silent, cut + CUT)
+    assert tcp[held, 2][-1] > tcp[held, 2][0]  # drawn back, out of the patient
+
+
+def test_the_session_goes_on_within_2_s_of_the_link_s_return_with_no_node_restarted(session):
+    folder, restored = session['folder'], session['restored']
+    commands = received(folder, 'remote', '/teleop/command')
+    feedback = received(folder, 'operator', '/teleop/feedback')
+    fresh_command = commands[commands > restored][0] - restored
+    fresh_feedback = feedback[feedback > restored][0] - restored
+    print(f'\nafter the link returned: a command in {fresh_command:.3f} s, feedback in '
+          f'{fresh_feedback:.3f} s')
+    assert fresh_command <= RESUME_LIMIT and fresh_feedback <= RESUME_LIMIT
+    assert len(commands[commands > restored + RESUME_LIMIT]) > 1000  # and it goes on
+    for node in ('teleop_leader', 'teleop_follower'):
+        said = reports(folder / ('operator' if node == 'teleop_leader' else 'remote'), node,
+                       'callback_errors')
+        assert said and said[-1] == '0', node
+    connections = reports(folder / 'operator', 'operator_gateway', 'connections')
+    assert int(connections[-1]) >= 2  # the same gateway connected again: nothing restarted
+
+
+def test_a_flood_with_the_operator_s_certificate_is_shed_and_the_remote_site_keeps_its_rate(
+        session):
+    """A holder of the operator's certificate puts 20 kHz of commands of another session for 1 s.
+
+    The remote gateway hands on at most its 2 kHz; the robot goes on at its rate and the patient
+    stays within the limit. The flooder takes a core of the two the machine has, beside both
+    sites: the remote site may lose its share of the time to that, and not more. (The gateway's
+    bucket is per topic, not per publisher: the flood crowds the true operator's commands out
+    with it, and the robot may hold and draw back meanwhile, as on a silent link.)
+    """
+    folder, flood = session['folder'], session['flood']
+    assert flood.returncode == 0, flood.stderr[-2000:]
+    flooding = json.loads(flood.stdout.strip().splitlines()[-1])
+    assert flooding['sent'] > 10_000
+    start, end = flooding['start'], flooding['end']
+    patient = series(folder, 'remote', {'/robot/tcp_pose': 'pose',
+                                        '/robot/ft_sensor/wrench': 'wrench'})
+    tcp_times = patient['/robot/tcp_pose'][0]
+
+    def rate(first, last):
+        return np.count_nonzero((tcp_times >= first) & (tcp_times < last)) / (last - first)
+    quiet, flooded = rate(start - 1.5, start - 0.5), rate(start, end)
+    print(f'\nflood: {flooding["sent"]} put; the robot at {flooded:.0f} Hz against {quiet:.0f} Hz')
+    assert flooded >= 0.5 * quiet
+    force_times, force = patient['/robot/ft_sensor/wrench']
+    assert np.linalg.norm(force[window(force_times, start, end)], axis=1).max() <= (
+        MAX_PATIENT_FORCE)
+    shed = reports(folder / 'remote', 'remote_gateway', 'refused: teleop/command over max_rate')
+    assert shed and int(shed[-1]) > 0
