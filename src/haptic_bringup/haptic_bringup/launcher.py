@@ -295,12 +295,10 @@ class Loop:
         for name, nodes, site_env in (('operator', OPERATOR_SITE, env),
                                       ('remote', REMOTE_SITE, remote_env)):
             self.children.append(start_child(name, self._composed(nodes, ros_args), site_env))
-        # The bridge stands for the network between the sites, so it talks to them over UDP,
-        # as a remote peer would: over Fast DDS's shared memory, a bridge that stopped (SIGSTOP,
-        # a link down for a second) stalled the sites' processes that publish to it.
+        # It talks to the sites over UDP, as the network it stands for (remote_probe.bridge).
         self.children.append(start_child(
             'bridge', [config.python, '-m', BRIDGE_MODULE, '--ros-args', '--params-file',
-                       str(bridge)], {**env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}))
+                       str(bridge)], env))
 
     def _wait_for_discovery(self) -> None:
         endpoints = (teleop_endpoints(self.config) if self.config.teleop

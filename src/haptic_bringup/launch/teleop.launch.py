@@ -81,12 +81,11 @@ def _processes(context):
             package='haptic_bringup', executable='composed', arguments=list(nodes),
             parameters=[parameters], additional_env={'ROS_DOMAIN_ID': str(domain)},
             output='screen'))
-    # Over UDP, as the network it stands for: over shared memory, a stopped bridge stalled the
-    # sites' processes that publish to it.
+    # It talks to the sites over UDP, as the network it stands for (remote_probe.bridge).
     actions += session.add('bridge', Node(
         package='remote_probe', executable='link_bridge',
         parameters=[_written(bridge_parameters(config))],
-        additional_env={**operator_env, 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}, output='screen'))
+        additional_env=operator_env, output='screen'))
     if config.record:
         actions += session.add('recorder', Node(
             package='haptic_bringup', executable='recorder', parameters=[parameters],
