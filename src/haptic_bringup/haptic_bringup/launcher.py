@@ -39,7 +39,7 @@ from haptic_util.executor import end_process
 
 __all__ = ['LoopConfig', 'Loop', 'main', 'loop_environment', 'NODES']
 
-# node name → (package, module with main(), Node class); the order is the stop order.
+# node name → (package, module with main(), Node class)
 NODES = {
     'wand_driver': ('haptic_wand_driver', 'haptic_wand_driver.node', 'WandDriverNode'),
     'collision_engine': ('collision_engine', 'collision_engine.node', 'CollisionNode'),
