@@ -4,7 +4,10 @@ rclpy's EventsExecutor is the executor that holds a 1 kHz loop here (the SingleT
 misses it, and the MultiThreadedExecutor collapses to ~100 Hz with several nodes). In the Jazzy
 wheel its ``spin()`` never returns and ignores SIGINT, as does ``spin_until_future_complete``
 without a timeout. Spinning in short slices hands control back to Python often enough to notice a
-stop request, at no measurable cost to latency.
+stop request, at no measurable cost to latency. A slice first runs every callback that is ready,
+and those that become ready meanwhile: under a flood (a peer publishing the loop's input as fast
+as it can) it never ended, and the node never saw its SIGINT. So a stop request also completes
+the slice's future, which ends it after the callback in progress.
 
 Stopping. SIGINT and SIGTERM only ever *request* a stop; the handler never raises inside an rclpy
 callback or ``destroy_node`` (a ``KeyboardInterrupt`` there aborted nodes). ``ros2 launch`` sends
@@ -63,11 +66,18 @@ _CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException, NameValid
 # signal lands while the first handler holds it.
 # 'starting' is set while nodes are being built: a signal interrupts that.
 _flags = {'stop': False, 'starting': False}
+_slice = [Future()]  # the spin slice in progress ends when this completes
 
 
 def request_stop(*_) -> None:
     """Ask this process's loop to stop cleanly; safe from any callback, and idempotent."""
     _flags['stop'] = True
+    _end_slice()
+
+
+def _end_slice() -> None:
+    if not _slice[0].done():
+        _slice[0].set_result(None)
 
 
 def stop_requested() -> bool:
@@ -78,6 +88,7 @@ def stop_requested() -> bool:
 def _on_signal(signum, frame) -> None:
     first = not _flags['stop']
     _flags['stop'] = True
+    _end_slice()
     if first and _flags['starting']:
         _flags['starting'] = False
         raise KeyboardInterrupt  # nodes are still being built: no rclpy callback is running
@@ -96,16 +107,15 @@ def make_executor(kind: str = 'events', context: Optional[rclpy.Context] = None)
             f'executor {kind!r} is not one of {sorted(EXECUTORS)}') from None
 
 
-def spin(executor: Executor, stop: Optional[Future] = None) -> None:
-    """Spin until a stop is requested, ``stop`` completes or the context shuts down.
+def spin(executor: Executor) -> None:
+    """Spin until a stop is requested or the context shuts down.
 
     An exception raised by a callback is logged once per place it comes from and counted.
     """
-    stop = stop or Future()
-    while (rclpy.ok(context=executor.context) and not stop.done()
-           and not _flags['stop']):
+    while rclpy.ok(context=executor.context) and not _flags['stop']:
+        _slice[0] = Future()
         try:
-            executor.spin_until_future_complete(stop, timeout_sec=SPIN_SLICE)
+            executor.spin_until_future_complete(_slice[0], timeout_sec=SPIN_SLICE)
         except (KeyboardInterrupt, ExternalShutdownException):
             raise
         except Exception as error:  # any callback's failure is logged, not fatal
