@@ -75,6 +75,29 @@ sys.exit(run_nodes([Busy]))
 """
 
 
+OVERRUN = """
+import sys, time
+from rclpy.node import Node
+from haptic_util.executor import run_nodes
+
+class Overrun(Node):
+    def __init__(self):
+        super().__init__('overrun')
+        self.ticks = 0
+        self.create_timer(0.001, self.tick)
+
+    def tick(self):  # longer than its period: the executor always has a callback ready
+        self.ticks += 1
+        if self.ticks == 10:
+            print('spinning', flush=True)
+        deadline = time.monotonic() + 0.002
+        while time.monotonic() < deadline:
+            pass
+
+sys.exit(run_nodes([Overrun]))
+"""
+
+
 def start(script: str, tmp_path) -> subprocess.Popen:
     return subprocess.Popen([sys.executable, '-c', script], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, start_new_session=True,
@@ -122,3 +145,16 @@ def test_repeated_sigints_are_one_clean_stop(tmp_path, gap):
     assert process.returncode == 0, err
     assert 'destroyed' in out
     assert 'Traceback' not in err and 'FATAL' not in err, err
+
+
+def test_a_node_whose_callbacks_never_catch_up_still_stops_at_sigint(tmp_path):
+    """A flood of input (a peer publishing as fast as it can, callbacks that overrun their
+    period) left the executor's slice always something to run: the node never saw its SIGINT."""
+    process = start(OVERRUN, tmp_path)
+    try:
+        wait_for_line(process, 'spinning')
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=30)
+    finally:
+        process.kill()  # one that did not stop would spin on after the test
+    assert process.returncode == 0, err

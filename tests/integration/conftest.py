@@ -1,4 +1,7 @@
 """Integration fixtures: the loop's nodes as real processes, in a DDS domain of the test's own."""
+import subprocess
+import sys
+
 from domains import session_domain_id
 from loop_client import LoopClient
 import pytest
@@ -20,3 +23,12 @@ def client():
     wand = LoopClient(session_domain_id())
     yield wand
     wand.close()
+
+
+@pytest.fixture
+def hogged_core():
+    """One core kept busy by another process, as on a workstation doing other work."""
+    hog = subprocess.Popen([sys.executable, '-c', 'while True: pass'])
+    yield hog
+    hog.kill()
+    hog.wait()

@@ -7,6 +7,7 @@ lateness and two local DDS hops), its losses within binomial bounds, the order k
 may cross the wrong way.
 """
 import math
+import pathlib
 import subprocess
 import sys
 import time
@@ -15,6 +16,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from domains import session_domain_id
 from geometry_msgs.msg import PoseStamped
 import numpy as np
+import psutil
 import pytest
 import rclpy
 from rclpy.context import Context
@@ -176,6 +178,20 @@ def test_the_bridge_delays_and_loses_as_configured(bridged):
     assert np.all(np.diff(back_xs) > 0) and back_delays.min() >= delay
     assert abs(len(back_xs) - (1 - loss) * count / 10) < 4 * math.sqrt(count / 10 * loss) + 3
     assert float(sites.diagnostics['to_remote lateness_p50_ms']) < 2.0
+
+
+def test_the_bridge_is_a_udp_peer_on_loopback_and_shares_no_memory_with_the_sites(bridged):
+    """The bridge stands for the network: a site must not share memory with it, or a stopped
+    bridge (a link down) stalls the site's own writes (remote_probe.bridge says how)."""
+    sites = bridged()
+    to_remote = sites.listen(1, TO_REMOTE)
+    connect(sites, [(sites.publisher(0, TO_REMOTE), to_remote)])
+    bridge, = [child for child in psutil.Process().children()
+               if 'remote_probe.bridge' in child.cmdline()]
+    maps = pathlib.Path(f'/proc/{bridge.pid}/maps').read_text()
+    assert '/dev/shm/fastrtps' not in maps, 'the bridge maps Fast DDS shared memory'
+    addresses = {connection.laddr.ip for connection in bridge.net_connections(kind='udp')}
+    assert addresses == {'127.0.0.1'}, addresses
 
 
 @pytest.mark.parametrize('reorder', [False, True])

@@ -1,7 +1,7 @@
 """Child processes of the local launcher: started in their own groups, stopped without orphans.
 
 Each node runs in its own session, so a Ctrl-C in the terminal reaches only the launcher, which
-then stops the nodes in a chosen order (the recorder last, so it loses nothing). A child also
+then stops the nodes together and the recorder after them (so it loses nothing). A child also
 receives SIGTERM if the launcher itself dies (``PR_SET_PDEATHSIG``), so even a killed launcher
 leaves no orphans. Fast DDS leaves shared-memory segments behind a SIGKILLed process; those no
 live process holds, among those the launcher's own processes made, are removed at the end.
@@ -61,27 +61,28 @@ def start_child(name: str, argv: list, env: dict) -> Child:
 
 
 def stop_children(children: list, *, timeout: float = 5.0, gently: bool = True) -> dict:
-    """Stop children in order: SIGINT, then SIGTERM, then SIGKILL, each after ``timeout``.
+    """Stop children together: SIGINT to all, then SIGTERM, then SIGKILL to those left.
 
-    ``gently=False`` starts at SIGTERM: for children that may still be importing, where a
-    SIGINT prints a ``KeyboardInterrupt`` traceback and SIGTERM ends them quietly (a started node
-    stops cleanly on either).
+    Each step waits up to ``timeout`` for all of them. Together, so that a session stops within
+    the slowest child's time rather than the sum of all (issue 24: every process within 2 s of
+    a Ctrl-C), as ``ros2 launch`` stops its processes. ``gently=False`` starts at SIGTERM: for
+    children that may still be importing, where a SIGINT prints a ``KeyboardInterrupt``
+    traceback and SIGTERM ends them quietly (a started node stops cleanly on either).
 
-    Returns each child's exit code (negative: the signal that ended it).
+    Returns each child's exit code (negative: the signal that ended it), in their order.
     """
-    codes = {}
     escalation = (signal.SIGINT, signal.SIGTERM, signal.SIGKILL)[0 if gently else 1:]
-    for child in children:
-        for signum in escalation:
-            if child.returncode is not None:
-                break
+    for signum in escalation:
+        running = [child for child in children if child.returncode is None]
+        for child in running:
             child.signal(signum)
+        deadline = time.monotonic() + timeout
+        for child in running:
             try:
-                child.process.wait(timeout)
+                child.process.wait(max(0.0, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
-                continue
-        codes[child.name] = child.process.wait()
-    return codes
+                pass
+    return {child.name: child.process.wait() for child in children}
 
 
 def shm_segments(directory: pathlib.Path = SHM_DIR) -> set:

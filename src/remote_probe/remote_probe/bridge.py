@@ -20,14 +20,27 @@ The domains are parameters, but a context's domain is fixed when it starts and r
 parameters only through a node. So the parameters are read first by a node of a short-lived
 context in the process's own ``ROS_DOMAIN_ID``, then the two sites' contexts are started.
 
-Each site's node reports both directions on its domain's ``/diagnostics`` at 1 Hz.
+It stands for the network between the sites, so it talks to them as a remote peer would: over
+UDP, never Fast DDS's shared memory (``loopback_udp``). Over shared memory, a site stalled while
+the bridge was stopped (SIGSTOP: the link down for a second): a sender that finds a peer's port
+unanswered checks its health, sleeping 333 ms at a time for up to 1 s
+(``healthy_check_timeout_ms``), and it does so holding its participant's one send mutex, so
+every other write of that process waits too, its 1 kHz streams included (Fast DDS 2.14,
+``RTPSParticipantImpl::sendSync``). The site's ticks were lost for that long (a 1.003 s hole in
+a CI run; 0.47 s in a run here). With ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``, rmw_fastrtps
+adds a shared-memory transport of its own, whatever ``FASTDDS_BUILTIN_TRANSPORTS`` says; so the
+bridge leaves the range to Fast DDS and gives its own profile
+(``config/link_bridge_transport.xml``): UDP on 127.0.0.1 only, discovery by unicast to 127.0.0.1.
 """
 from dataclasses import dataclass
 import functools
 import math
+import os
+import pathlib
 import time
 from typing import Callable
 
+from ament_index_python.packages import get_package_share_directory
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import NameValidationException
@@ -50,6 +63,7 @@ NODE_NAME = 'link_bridge'
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 LATE_WARNING = 1e-3  # [s] release lateness p99 above which the bridge itself distorts the link
 _STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() reads
+TRANSPORT_PROFILE = ('remote_probe', 'config/link_bridge_transport.xml')
 
 
 @dataclass(frozen=True)
@@ -253,8 +267,17 @@ def join_sites(args, nodes: list, contexts: list) -> None:
         f'reorder {params.reorder}')
 
 
+def loopback_udp() -> None:
+    """Make the DDS participants this process makes UDP peers on 127.0.0.1 (see above)."""
+    package, relative = TRANSPORT_PROFILE
+    profile = pathlib.Path(get_package_share_directory(package)) / relative
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'SYSTEM_DEFAULT'
+    os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(profile)
+
+
 def main(args=None) -> int:
     """Run the bridge until SIGINT or SIGTERM (exit 0); a bad configuration exits 2."""
+    loopback_udp()
     return run_process(functools.partial(join_sites, args))
 
 
