@@ -9,14 +9,20 @@ import signal
 import time
 
 from domains import session_domain_id
+from geometry_msgs.msg import PoseStamped
 import numpy as np
 import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
 from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_vectors, reported
+from haptic_util.qos import HAPTIC_STREAM_QOS
 
 DELAY = 0.05  # [s] one way
 FORCE_SCALE = 0.3  # the leader's default
@@ -110,9 +116,35 @@ def test_the_bag_holds_both_sites_the_remote_one_under_remote(scan):
     assert reports(folder, 'teleop_follower', 'published')  # its /diagnostics, from /remote
 
 
+def wait_for_the_first_pose(domain_id: int, timeout: float) -> float:
+    """Return when (time.monotonic) the wand's first pose came: the scan's time zero.
+
+    The scan starts once the loop is closed and the recorder ready, which on a busy machine
+    comes seconds after the launcher returns; its phases (``PRESSING``) count from here.
+    """
+    context = Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    node = Node('test_first_pose', context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    came = []
+    node.create_subscription(PoseStamped, 'wand/pose',
+                             lambda _: came or came.append(time.monotonic()), HAPTIC_STREAM_QOS)
+    deadline = time.monotonic() + timeout
+    while not came and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.01)
+    node.destroy_node()
+    rclpy.try_shutdown(context=context)
+    assert came, 'the wand never moved'
+    return came[0]
+
+
 def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_meet_again(
         tmp_path):
     """The bridge stops for 0.5 s while the scan presses, then delivers what it held.
+
+    The stall comes 6.5 s into the scan by its first pose, in its held press, not 6.5 s after
+    the launcher returned: under load the scan started up to seconds later.
 
     The operator's force is zero within the link timeout; the robot holds its TCP (not the last
     target, which lay further in) and retracts: the patient's force never rises during the
@@ -120,7 +152,8 @@ def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_
     link is back the robot and the operator's model meet again: the patient is pressed and the
     hand feels it, as before the stall."""
     with teleop(tmp_path, duration=SCAN_DURATION) as loop:
-        time.sleep(PRESSING[0] + 0.5)
+        start = wait_for_the_first_pose(session_domain_id(), SCAN_DURATION)
+        time.sleep(max(0.0, start + PRESSING[0] + 0.5 - time.monotonic()))
         bridge = loop.child('bridge')
         dropped = time.time()
         bridge.signal(signal.SIGSTOP)
