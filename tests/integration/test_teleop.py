@@ -176,7 +176,11 @@ def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_
     held = window(tcp_times, silent, dropped + 0.5)
     assert tcp[held, 2][-1] > tcp[held, 2][0]  # drawn back, out of the patient
     stale = reports(tmp_path, 'teleop_follower', 'refused: command older than the link allows')
-    assert stale and int(stale[-1]) > 50  # what the bridge held over the stall
+    # Some of what the bridge held over the stall came, stale, and was refused; none was followed
+    # (the patient's force above). How many came is the machine's speed, not a property: of the
+    # ~500 held, the follower takes what its reader (10 deep) still holds when its executor gets
+    # to it as the burst lands (26-103 in 11 runs, the fewest with a core hogged).
+    assert stale and int(stale[-1]) > 0
     felt_times, felt = series['/wand/applied_wrench']
     felt_before = np.median(felt[window(felt_times, dropped - 0.5, dropped), 2])
     again = dropped + 3.0  # the shift the stall left, given back at the rejoin speed
