@@ -20,6 +20,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from domains import session_domain_id
 from geometry_msgs.msg import PoseStamped
 import numpy as np
+import psutil
 import pytest
 from rclpy.serialization import serialize_message
 from test_link_bridge import connect, POSE, Sites, TO_OPERATOR, TO_REMOTE
@@ -326,3 +327,15 @@ def test_plaintext_needs_insecure_and_warns_at_every_start(tmp_path):
         assert stop_children([insecure]) == {'operator_gateway': 0}
     assert (tmp_path / 'operator.log').read_text().count('INSECURE: plaintext') == 2
     assert not os.path.exists(tmp_path / 'ca.pem')
+
+
+def test_a_gateway_is_a_udp_peer_on_loopback_and_shares_no_memory_with_its_site(site):
+    """A gateway stands for the network: its site must not share memory with it, or a stopped
+    gateway (a link down) stalls the site's own writes (``haptic_util.transport`` says how)."""
+    streams(site['sites'])
+    for name, gateway in site['gateways'].items():
+        process = psutil.Process(gateway.pid)
+        maps = pathlib.Path(f'/proc/{gateway.pid}/maps').read_text()
+        assert '/dev/shm/fastrtps' not in maps, f'the {name} gateway maps Fast DDS memory'
+        udp = {connection.laddr.ip for connection in process.net_connections(kind='udp')}
+        assert udp == {'127.0.0.1'}, (name, udp)

@@ -21,26 +21,14 @@ parameters only through a node. So the parameters are read first by a node of a 
 context in the process's own ``ROS_DOMAIN_ID``, then the two sites' contexts are started.
 
 It stands for the network between the sites, so it talks to them as a remote peer would: over
-UDP, never Fast DDS's shared memory (``loopback_udp``). Over shared memory, a site stalled while
-the bridge was stopped (SIGSTOP: the link down for a second): a sender that finds a peer's port
-unanswered checks its health, sleeping 333 ms at a time for up to 1 s
-(``healthy_check_timeout_ms``), and it does so holding its participant's one send mutex, so
-every other write of that process waits too, its 1 kHz streams included (Fast DDS 2.14,
-``RTPSParticipantImpl::sendSync``). The site's ticks were lost for that long (a 1.003 s hole in
-a CI run; 0.47 s in a run here). With ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``, rmw_fastrtps
-adds a shared-memory transport of its own, whatever ``FASTDDS_BUILTIN_TRANSPORTS`` says; so the
-bridge leaves the range to Fast DDS and gives its own profile
-(``config/link_bridge_transport.xml``): UDP on 127.0.0.1 only, discovery by unicast to 127.0.0.1.
+UDP on 127.0.0.1, never Fast DDS's shared memory (``haptic_util.transport`` says why).
 """
 from dataclasses import dataclass
 import functools
 import math
-import os
-import pathlib
 import time
 from typing import Callable
 
-from ament_index_python.packages import get_package_share_directory
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import NameValidationException
@@ -53,6 +41,7 @@ from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_process, StartupError
 from haptic_util.parameters import declare_parameters, parameter
 from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.transport import loopback_udp
 from remote_probe.link import DelayTrace, EmulatedLink, LinkConfig
 from remote_probe.relay import check_no_loop, message_class, parse_routes, Relay
 
@@ -63,7 +52,6 @@ NODE_NAME = 'link_bridge'
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 LATE_WARNING = 1e-3  # [s] release lateness p99 above which the bridge itself distorts the link
 _STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() reads
-TRANSPORT_PROFILE = ('remote_probe', 'config/link_bridge_transport.xml')
 
 
 @dataclass(frozen=True)
@@ -265,14 +253,6 @@ def join_sites(args, nodes: list, contexts: list) -> None:
         f'{len(plan.to_remote)} topics to remote, {len(plan.to_operator)} to operator; '
         f'delay {trace}, jitter {params.jitter:g} s, loss {params.loss:g}, '
         f'reorder {params.reorder}')
-
-
-def loopback_udp() -> None:
-    """Make the DDS participants this process makes UDP peers on 127.0.0.1 (see above)."""
-    package, relative = TRANSPORT_PROFILE
-    profile = pathlib.Path(get_package_share_directory(package)) / relative
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'SYSTEM_DEFAULT'
-    os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(profile)
 
 
 def main(args=None) -> int:

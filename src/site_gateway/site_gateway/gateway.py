@@ -40,6 +40,7 @@ from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
 from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.transport import loopback_udp
 from remote_probe.bridge import emulated_link, LinkStageParams, ReleaseTimer
 from remote_probe.relay import message_class, Relay
 from site_gateway.inbound import Inbound
@@ -258,11 +259,9 @@ def main(args=None) -> int:
     """Run the gateway until SIGINT, SIGTERM or the other site's goodbye (exit 0).
 
     A bad configuration exits 2. The gateway stands for the network between the sites, so it
-    talks to its site over UDP, as a remote peer would: over Fast DDS's shared memory, a relay
-    that stopped (SIGSTOP, a link down for a second) stalled the site's processes publishing to
-    it.
+    talks to its site over UDP on 127.0.0.1, as a remote peer would (``haptic_util.transport``).
     """
-    os.environ.setdefault('FASTDDS_BUILTIN_TRANSPORTS', 'UDPv4')
+    loopback_udp()
     return run_nodes([GatewayNode], args)
 
 

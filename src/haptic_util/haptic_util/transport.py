@@ -1,0 +1,32 @@
+"""A relay between sites talks to its site over UDP on 127.0.0.1, never Fast DDS's shared memory.
+
+Why: a relay (the site gateway, the link bridge) stands for the network between the sites, and
+it may stop: SIGSTOP in a test, a link down, a process descheduled. Over shared memory, a site
+stalled while its relay was stopped: a sender that finds a peer's port unanswered checks its
+health, sleeping 333 ms at a time for up to 1 s (``healthy_check_timeout_ms``), and it does so
+holding its participant's one send mutex, so every other write of that process waits too, its
+1 kHz streams included (Fast DDS 2.14, ``RTPSParticipantImpl::sendSync``). The site's ticks were
+lost for that long (a 1.003 s hole in a CI run; 0.47 s in a run here). Over UDP, a write to a
+stopped peer is a datagram dropped.
+
+With ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``, rmw_fastrtps adds a shared-memory transport of
+its own, whatever ``FASTDDS_BUILTIN_TRANSPORTS`` says; so the relay leaves the range to Fast DDS
+and gives its own profile (``config/loopback_udp.xml``): UDP on 127.0.0.1 only, discovery by
+unicast to 127.0.0.1. No packet leaves loopback, as with the LOCALHOST range.
+"""
+import os
+import pathlib
+
+from ament_index_python.packages import get_package_share_directory
+
+__all__ = ['loopback_udp']
+
+PROFILE = ('haptic_util', 'config/loopback_udp.xml')
+
+
+def loopback_udp() -> None:
+    """Make the DDS participants this process makes next UDP peers on 127.0.0.1 only."""
+    package, relative = PROFILE
+    profile = pathlib.Path(get_package_share_directory(package)) / relative
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'SYSTEM_DEFAULT'
+    os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(profile)
