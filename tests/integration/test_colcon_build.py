@@ -16,7 +16,7 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SRC = ROOT / 'src'
 PYTHON_PACKAGES = ('haptic_util', 'collision_engine', 'force_renderer', 'haptic_wand_driver',
-                   'haptic_bringup', 'remote_probe', 'ultrasound_sim')
+                   'haptic_bringup', 'remote_probe', 'ultrasound_sim', 'site_gateway')
 SOURCES = {'haptic_msgs': SRC / 'msgs', **{name: SRC / name for name in PYTHON_PACKAGES}}
 BUILD_TIMEOUT = 900  # [s] about 40 s here; the margin is for a busy shared machine
 
@@ -59,15 +59,19 @@ def build_environment(work: pathlib.Path) -> dict:
 
 
 class Build:
-    """One colcon build of ``src/``: its install base, environment and the repo's state."""
+    """One colcon build of ``src/``: its install base, environment and the repo's state.
 
-    def __init__(self, work: pathlib.Path):
+    ``selection``: colcon's options choosing what to build (all of ``src/`` without).
+    """
+
+    def __init__(self, work: pathlib.Path, *selection: str):
+        self.work = work
         self.install = work / 'install'
         self.env = build_environment(work)
         repo_before = tree_listing(SRC), tree_listing(ROOT / 'build')
         colcon = pathlib.Path(sys.executable).parent / 'colcon'
         self.result = subprocess.run(
-            [str(colcon), '--log-base', str(work / 'log'), 'build',
+            [str(colcon), '--log-base', str(work / 'log'), 'build', *selection,
              '--base-paths', str(SRC), '--build-base', str(work / 'build'),
              '--install-base', str(self.install),
              '--event-handlers', 'desktop_notification-', 'terminal_title-',
@@ -95,6 +99,18 @@ def build(tmp_path_factory) -> Build:
 
 def test_the_build_leaves_sources_and_the_repository_build_folder_alone(build):
     assert build.repo_unchanged
+
+
+@pytest.mark.parametrize('package', PYTHON_PACKAGES)
+def test_each_python_package_builds_alone(build, package):
+    """As a user rebuilding one package in the workspace does (``--packages-select``): its
+    dependencies are those the manifest declares (tests/test_manifests.py checks that it
+    declares what it imports), found built in the install. haptic_msgs, the one CMake package,
+    is built by the whole build above."""
+    alone = Build(build.work, '--packages-select', package)
+    assert alone.result.returncode == 0, alone.result.stderr[-3000:]
+    assert f'Finished <<< {package}' in alone.result.stdout
+    assert 'Finished <<<' not in alone.result.stdout.replace(f'Finished <<< {package}', '')
 
 
 @pytest.mark.parametrize('package', sorted(SOURCES))
