@@ -25,7 +25,7 @@ setup(
             'composed = haptic_bringup.composed:main',
             'recorder = haptic_bringup.recorder:main',
             'demo = haptic_bringup.demo:main',
-            'haptic_bag = haptic_bringup.bag:main',
+            'haptic_bag = haptic_bringup.bag_tool:main',
             'haptic_site = haptic_bringup.site:main',
         ],
     },

@@ -51,7 +51,6 @@ def test_shipped_scenes_agree_with_fcl(checked_scenes, name):
     results = [scene.query(p) for p in points]
     every = 10  # as the shipped files say; 20 samples fit the queue, so none is dropped
     assert [r.cross_validated for r in results] == [k % every == 0 for k in range(200)]
-    assert all(np.isnan(r.fcl_distance) and np.isnan(r.fcl_discrepancy) for r in results)
     assert scene.wait_for_cross_validation(timeout=60.0)
     stats = scene.cross_validation_stats
     assert (stats.checks, stats.disagreements, stats.errors, stats.dropped) == (20, 0, 0, 0)

@@ -116,7 +116,7 @@ def test_a_bag_killed_with_sigkill_is_recovered_up_to_its_last_flush(tmp_path):
 def test_a_session_with_a_killed_site_is_refused_until_recovered_then_read_as_one(
         tmp_path, capsys):
     """A session folder holds a bag per site; one whose recorder was killed has no metadata."""
-    from haptic_bringup.bag import main
+    from haptic_bringup.bag_tool import main
     from haptic_bringup.session import bags, topic_counts
     write_bag(tmp_path / 'scan' / 'operator', 3)
     typestore = store()

@@ -66,8 +66,8 @@ def state(header: tuple, result, compute_time: float, disagreements: int,
     row = result.row
     return (*header, result.object or '', result.status, row[0], row[0] <= 0.0, *row[1:4],
             *row[4:7], *result.penetration.tolist(), *row[10:13], result.iterations,
-            result.cross_validated, result.fcl_distance, result.fcl_discrepancy,
-            disagreements, compute_time, *orientation, *row[10:13], *_NO_CONTACTS)
+            result.cross_validated, disagreements, compute_time, *orientation, *row[10:13],
+            *_NO_CONTACTS)
 
 
 def tool_state(header: tuple, probe, tip: tuple, orientation: tuple, compute_time: float,
@@ -82,8 +82,8 @@ def tool_state(header: tuple, probe, tip: tuple, orientation: tuple, compute_tim
     penetration = ((-distance * row[4], -distance * row[5], -distance * row[6])
                    if distance <= 0.0 else (0.0, 0.0, 0.0))
     return (*header, probe.tool.object or '', probe.tool.status, distance, distance <= 0.0,
-            *row[1:4], *row[4:7], *penetration, *tip, probe.tool.iterations, False, math.nan,
-            math.nan, disagreements, compute_time, *orientation, *row[10:13],
+            *row[1:4], *row[4:7], *penetration, *tip, probe.tool.iterations, False,
+            disagreements, compute_time, *orientation, *row[10:13],
             tuple(probe.distance.tolist()), tuple(probe.points.ravel().tolist()),
             tuple(probe.normals.ravel().tolist()))
 
@@ -91,5 +91,5 @@ def tool_state(header: tuple, probe, tip: tuple, orientation: tuple, compute_tim
 def invalid_state(header: tuple, disagreements: int) -> tuple:
     """Return the leaf fields of a state marked invalid: the renderer then sends zero force."""
     return (*header, '', CollisionState.STATUS_INVALID_INPUT, math.nan, False, *_NAN3, *_NAN3,
-            *_NAN3, *_NAN3, 0, False, math.nan, math.nan, disagreements, 0.0, *_NAN3, math.nan,
+            *_NAN3, *_NAN3, 0, False, disagreements, 0.0, *_NAN3, math.nan,
             *_NAN3, *_NO_CONTACTS)

@@ -13,8 +13,6 @@ import numpy as np
 
 __all__ = ['QueryResult', 'BatchResult', 'ToolResult']
 
-_NAN = float('nan')
-
 
 class _PackedRow:
     """The fields a point query and a tool query share, read from one packed output row.
@@ -99,19 +97,13 @@ class QueryResult(_PackedRow):
     cross_validated : bool
         True when this query was handed to the FCL cross-check. The check runs afterwards, on
         its own thread: its verdict goes to ``Scene.cross_validation_stats``, not here.
-    fcl_distance, fcl_discrepancy : float, m
-        NaN: FCL's answer for this query comes after the query returns (the totals are in
-        ``CrossValidationStats``). Kept for ``CollisionState``'s fields of the same names.
     """
 
-    __slots__ = ('cross_validated', 'fcl_distance', 'fcl_discrepancy')
+    __slots__ = ('cross_validated',)
 
-    def __init__(self, row: list, names: tuple, cross_validated: bool = False,
-                 fcl_distance: float = _NAN, fcl_discrepancy: float = _NAN) -> None:
+    def __init__(self, row: list, names: tuple, cross_validated: bool = False) -> None:
         super().__init__(row, names)
         self.cross_validated = cross_validated
-        self.fcl_distance = fcl_distance
-        self.fcl_discrepancy = fcl_discrepancy
 
     @property
     def tip(self) -> np.ndarray:

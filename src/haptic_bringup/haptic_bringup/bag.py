@@ -133,36 +133,3 @@ def killed_bags(path: pathlib.Path) -> list:
     folders = [path, *sorted(f for f in path.iterdir() if f.is_dir())] if path.is_dir() else []
     return [folder for folder in folders
             if any(folder.glob('*.mcap')) and not (folder / 'metadata.yaml').exists()]
-
-
-def main(argv=None) -> int:
-    """``haptic_bag info|recover DIR``: bag tools for machines without ``ros2 bag``.
-
-    DIR is a bag, or a session's folder of bags (a telerobotic session's ``operator`` and
-    ``remote``): ``recover`` rebuilds each bag in it that a killed recorder left.
-    """
-    import argparse
-    import sys
-
-    from haptic_bringup.recorder import custom_definitions
-    from haptic_bringup.session import topic_counts
-
-    parser = argparse.ArgumentParser(prog='haptic_bag', description=main.__doc__.split('\n')[0])
-    parser.add_argument('command', choices=['info', 'recover'])
-    parser.add_argument('bag', type=pathlib.Path)
-    args = parser.parse_args(argv)
-    try:
-        if args.command == 'recover':
-            killed = killed_bags(args.bag)
-            if not killed:
-                raise ValueError('no bag without metadata.yaml to recover')
-            for bag in killed:
-                recovered = recover(bag, typestore_with(custom_definitions()))
-                print(f'recovered {bag} into {recovered}')
-            args.bag = recovered if killed == [args.bag] else args.bag
-        for topic, count in sorted(topic_counts(args.bag).items()):
-            print(f'{topic}: {count} messages')
-    except (ValueError, OSError) as error:
-        print(f'haptic_bag: {args.bag}: {error}', file=sys.stderr)
-        return 1
-    return 0

@@ -49,7 +49,6 @@ class Session:
     objects : (n,) str
     status : (n,) int, CollisionState status
     compute_time : (n,) float, s
-    fcl_distance, fcl_discrepancy : (n,) float, m (NaN when not cross-validated)
     scene : str, the scene YAML the session ran against ('' when not recorded)
     """
 
@@ -66,8 +65,6 @@ class Session:
     objects: np.ndarray
     status: np.ndarray
     compute_time: np.ndarray
-    fcl_distance: np.ndarray
-    fcl_discrepancy: np.ndarray
     scene: str
 
 
@@ -161,8 +158,6 @@ def read_session(path: pathlib.Path, typestore) -> Session:
         objects=np.array([m.object for m in rows]),
         status=np.array([m.status for m in rows]),
         compute_time=np.array([m.compute_time for m in rows]),
-        fcl_distance=np.array([m.fcl_distance for m in rows]),
-        fcl_discrepancy=np.array([m.fcl_discrepancy for m in rows]),
         scene=scene)
 
 

@@ -47,7 +47,7 @@ from haptic_util import intra_process
 from haptic_util.callback_errors import callback_errors, log_callback_error
 
 __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'end_process',
-           'request_stop', 'stop_requested', 'callback_errors', 'StartupError']
+           'request_stop', 'callback_errors', 'StartupError']
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
 SHUTDOWN_TIMEOUT = 1.0  # [s] for the executor to finish a callback in progress
@@ -79,11 +79,6 @@ def request_stop(*_) -> None:
 def _end_slice() -> None:
     if not _slice[0].done():
         _slice[0].set_result(None)
-
-
-def stop_requested() -> bool:
-    """Whether a stop was requested (a signal, or ``request_stop``)."""
-    return _flags['stop']
 
 
 def _on_signal(signum, frame) -> None:
