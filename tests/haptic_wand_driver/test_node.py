@@ -1,4 +1,6 @@
 """The driver node's wiring, in-process: what its clocks do, without a launched loop."""
+import time
+
 from contact_model_fields import fields
 import pytest
 import rclpy
@@ -7,17 +9,18 @@ from rclpy.context import Context
 from rclpy.time import Time
 
 from haptic_wand_driver.contact_model import Kind
+from haptic_wand_driver.local_rendering import DEADLINE
 from haptic_wand_driver.node import WandDriverNode
 
 
 @pytest.fixture
-def driver():
+def driver(request):
     context = Context()
     rclpy.init(context=context, domain_id=98)
+    extra = getattr(request, 'param', {})
     node = WandDriverNode(context=context, parameter_overrides=[
-        rclpy.parameter.Parameter('experiment', value='hold'),
-        rclpy.parameter.Parameter('wait_for_wrench', value=False),
-        rclpy.parameter.Parameter('min_subscribers', value=0)])
+        rclpy.parameter.Parameter(name, value=value) for name, value in
+        {'experiment': 'hold', 'wait_for_wrench': False, 'min_subscribers': 0, **extra}.items()])
     yield node
     node.destroy_node()
     rclpy.try_shutdown(context=context)
@@ -47,3 +50,22 @@ def test_rendering_locally_it_takes_the_model_alone_and_holds_the_wrench_of_a_la
                                            [0.0] * 5, 2.5e-4)
     assert force == pytest.approx((1.0, 0.0, -0.5)) and torque == (0.0, 0.0, 0.0)
     assert driver.stats.answers == 1
+
+
+@pytest.mark.parametrize('driver', [{'hold_while_late': 0.1}], indirect=True)
+def test_the_newest_answer_holds_until_the_next_pose_is_sent_then_lives_its_lifetime(
+        driver, monkeypatch):
+    clock = ROSClock()  # both clocks set by hand: ROS time, and the device's a fixed way behind
+    clock._set_ros_time_is_active(True)
+    start = 1_800_000_000_000_000_000
+    device_start = time.monotonic() + 0.1  # the wand has been read at the monotonic clock
+    behind = start * 1e-9 - device_start
+    monkeypatch.setattr(driver, 'get_clock', lambda: clock)
+    monkeypatch.setattr(driver, '_device_time', lambda: clock.now().nanoseconds * 1e-9 - behind)
+    clock.set_ros_time_override(Time(nanoseconds=start))
+    driver.tick()
+    driver.on_model(fields(stamp=divmod(start, 1_000_000_000), valid_for=0.01))
+    assert driver.renderer.packed[0, DEADLINE] == pytest.approx(device_start + 0.1, abs=1e-6)
+    clock.set_ros_time_override(Time(nanoseconds=start + 1_000_000))
+    driver.tick()  # the next pose, on time: no answer to it comes
+    assert driver.renderer.packed[0, DEADLINE] == pytest.approx(device_start + 0.01, abs=1e-6)

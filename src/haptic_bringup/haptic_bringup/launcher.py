@@ -53,6 +53,7 @@ OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
+LATE_POSE_HOLD = 0.1  # [s] the follower's link_timeout: the robot holds its target as long
 BRIDGE_MODULE = 'remote_probe.bridge'
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
@@ -162,7 +163,10 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     keeps it: its controllers sit at the link's ports and do not see the device hold each force
     over a tick the machine stretched (on a loaded machine, up to +70 mJ given to the hand over
     a scan without it). On regular ticks it never acts (the lockstep scan is bit for bit the
-    same with it).
+    same with it). While the driver's next pose is late, the answer to the newest one holds until
+    it is sent, for at most the remote site's link timeout (the robot holds its target as long):
+    an answer that expired inside a stretched tick let the hand fall in, and the next one threw
+    it back out (``haptic_wand_driver.answer_deadline``).
     """
     scheme = config.teleop
     driver = options.setdefault('wand_driver', {})
@@ -172,6 +176,7 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
         driver.setdefault('duration', SCAN_DURATION)
     driver['rendering'] = 'local' if scheme == 'model' else 'remote'
     driver['passivity'] = scheme != 'direct'
+    driver['hold_while_late'] = LATE_POSE_HOLD
     for node in ('teleop_leader', 'teleop_follower'):
         options.setdefault(node, {})['scheme'] = scheme
     if config.record:

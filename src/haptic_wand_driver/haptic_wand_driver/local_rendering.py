@@ -53,13 +53,13 @@ from haptic_wand_driver.orientation import roll_axis
 from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
 from haptic_wand_driver.wrench_input import saturate_components
 
-__all__ = ['LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE', 'MODE_PLANES',
-           'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE']
+__all__ = ['DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE',
+           'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE']
 
 _ZERO = (0.0, 0.0, 0.0)
 MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
 MODE_NONE, MODE_WRENCH, MODE_PLANES = 0.0, 1.0, 2.0  # what ``packed`` holds
-SINCE, SERIAL, PLANES_AT, PLANE_SIZE = 21, 22, 23, 15
+DEADLINE, SINCE, SERIAL, PLANES_AT, PLANE_SIZE = 7, 21, 22, 23, 15
 LAW_SIZE = PLANES_AT + MAX_PLANES * PLANE_SIZE
 _NOTHING = (None, None, -math.inf)  # (model, wrench, deadline) held
 
@@ -111,6 +111,13 @@ class LocalRenderer:
     def clear(self, since: float = -math.inf) -> None:
         """Drop what is held, as ``take``: zero force until the next model or wrench."""
         self._hold(_NOTHING, since, MODE_NONE, 0.0, 0.0, _ZERO, _ZERO * 2, 0, [])
+
+    def expire(self, deadline: float) -> None:
+        """Render what is held now until ``deadline`` (the device's clock, s) at the latest."""
+        before, (model, wrench, held_deadline, take), since = self._held
+        deadline = min(deadline, held_deadline)
+        self.packed[0, DEADLINE] = deadline
+        self._held = (before, (model, wrench, deadline, take), since)
 
     def _hold(self, held: tuple, since: float, mode, force_limit, valid_radius, tip, wrench,
               count, planes) -> None:

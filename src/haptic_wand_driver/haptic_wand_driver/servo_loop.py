@@ -23,8 +23,8 @@ import math
 from numba import njit
 import numpy as np
 
-from haptic_wand_driver.local_rendering import (LAW_SIZE, MODE_PLANES, MODE_WRENCH, PLANE_SIZE,
-                                                PLANES_AT, SERIAL, SINCE)
+from haptic_wand_driver.local_rendering import (DEADLINE, LAW_SIZE, MODE_PLANES, MODE_WRENCH,
+                                                PLANE_SIZE, PLANES_AT, SERIAL, SINCE)
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
 
 __all__ = ['advance', 'compile_now']
@@ -189,7 +189,7 @@ def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     law = packed[0] if time + period > packed[0, SINCE] else packed[1]
     fx = fy = fz = tx = ty = tz = 0.0
     limit = law[0]
-    mode, live = law[6], time + period <= law[7]
+    mode, live = law[6], time + period <= law[DEADLINE]
     if mode == MODE_WRENCH and live:
         fx, fy, fz, tx, ty, tz = law[13], law[14], law[15], law[16], law[17], law[18]
     elif mode == MODE_PLANES and live:
