@@ -8,10 +8,16 @@ from haptic_wand_driver.answer_deadline import AnswerDeadline
 LIFETIME = 0.010  # [s]
 
 
-def test_without_a_hold_an_answer_lives_its_lifetime_whatever_the_ticks_do():
-    answers = AnswerDeadline(hold=0.0)
+def answered(hold: float) -> AnswerDeadline:
+    """A driver that sent a pose at 1 s and holds its answer."""
+    answers = AnswerDeadline(hold)
     answers.sent(1.000)
     answers.taken(1.000, LIFETIME)
+    return answers
+
+
+def test_without_a_hold_an_answer_lives_its_lifetime_whatever_the_ticks_do():
+    answers = answered(hold=0.0)
     assert answers.deadline == 1.010
     assert not answers.sent(1.050)  # a late tick: the deadline stays where it was
     assert answers.deadline == 1.010
@@ -19,9 +25,7 @@ def test_without_a_hold_an_answer_lives_its_lifetime_whatever_the_ticks_do():
 
 
 def test_the_answer_to_the_newest_pose_holds_until_the_next_is_sent_at_most_the_hold():
-    answers = AnswerDeadline(hold=0.1)
-    answers.sent(1.000)
-    answers.taken(1.000, LIFETIME)
+    answers = answered(hold=0.1)
     assert answers.deadline == pytest.approx(1.1)  # no newer pose yet: as long as the hold
     assert answers.sent(1.035)  # the next pose, 35 ms late: the answer held until then
     assert answers.deadline == 1.035
@@ -31,11 +35,8 @@ def test_the_answer_to_the_newest_pose_holds_until_the_next_is_sent_at_most_the_
 
 
 def test_a_loop_that_stops_answering_while_the_driver_ticks_still_zeroes_at_the_lifetime():
-    answers = AnswerDeadline(hold=0.1)
-    answers.sent(1.000)
-    answers.taken(1.000, LIFETIME)
-    assert answers.sent(1.001)  # on time: no answer to it comes
-    for k in range(2, 30):
+    answers = answered(hold=0.1)
+    for k in range(1, 30):  # on time, and no answer comes to any of them
         answers.sent(1.0 + k * 0.001)
     assert answers.deadline == 1.010
     assert answers.late == 0

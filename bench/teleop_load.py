@@ -1,0 +1,146 @@
+"""The telerobotic scan quiet and with one core hogged: the fix beside the code before it.
+
+    .venv/bin/python bench/teleop_load.py [--schemes model tdpa] [--rounds 1]
+        [--baseline 0139399] [--duration 20] [--json PATH]
+
+Each case is the issue's command as a user types it, ``haptic_loop --teleop SCHEME --delay 0.1
+--jitter 0.01 --loss 0.01 --duration 20 --record DIR``: run from this tree (the fix) and from
+the code at ``--baseline`` (``git archive`` of it, run with this venv), on a quiet machine and
+with another process keeping one of the two cores busy, the four alternated in one run, scheme
+by scheme. Every figure is ``teleop_scan.figures`` of the bag, from what the device applied to
+the hand and where the wand was (measured from outside, not from the controllers' books): net
+work on the hand and oscillation (stable: <= 0 and <= 10 %), transparency, the patient's peak
+force; beside them the rate the wand published at and how many of its poses came more than
+10 ms after the one before (the ticks that outlived an answer's lifetime).
+"""
+import argparse
+import functools
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+import machine
+import numpy as np
+import teleop_scan
+
+from haptic_bringup.bag import typestore_with
+from haptic_bringup.launcher import add_venv_prefix
+from haptic_bringup.recorder import custom_definitions
+from haptic_bringup.session import read_vectors
+
+__all__ = ['case', 'main']
+
+REPOSITORY = pathlib.Path(__file__).resolve().parents[1]
+BASELINE = '0139399'  # the code the issue found the hand given energy on
+PACKAGES = ('haptic_util', 'collision_engine', 'force_renderer', 'haptic_wand_driver',
+            'haptic_bringup', 'remote_probe')
+DELAY, JITTER, LOSS, DURATION = 0.1, 0.01, 0.01, 20.0  # the issue's command
+LATE = 0.010  # [s] between two poses: longer than an answer's lifetime
+HOG = 'while True: pass'
+WARM = ('from collision_engine import load_scene; from haptic_util.paths import package_file; '
+        'from haptic_wand_driver import servo_loop; servo_loop.compile_now(); '
+        "load_scene(package_file('package://collision_engine/scenes/phantom.yaml'))")
+
+
+def baseline_tree(ref: str, into: pathlib.Path) -> dict:
+    """Unpack the packages at ``ref`` into ``into``; return the environment that runs them."""
+    archive = subprocess.run(['git', '-C', str(REPOSITORY), 'archive', ref, 'src'],
+                             check=True, capture_output=True).stdout
+    subprocess.run(['tar', '-x', '-C', str(into)], input=archive, check=True)
+    paths = [str(into / 'src' / package) for package in PACKAGES]
+    env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
+        [*paths, *filter(None, [os.environ.get('PYTHONPATH')])])}
+    subprocess.run([sys.executable, '-c', WARM], env=env, check=True)  # numba's caches there
+    return env
+
+
+def case(scheme: str, folder: pathlib.Path, env: dict, domain_id: int,
+         duration: float = DURATION) -> dict:
+    """Run the issue's command once into ``folder``; return the bag's figures."""
+    command = [str(pathlib.Path(sys.executable).with_name('haptic_loop')), '--teleop', scheme,
+               '--delay', str(DELAY), '--jitter', str(JITTER), '--loss', str(LOSS),
+               '--duration', str(duration), '--record', str(folder / 'bag'),
+               '--domain-id', str(domain_id), '--run-dir', str(folder / 'launch')]
+    load = os.getloadavg()[0]
+    done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=240)
+    if done.returncode != 0:
+        raise RuntimeError(f'{" ".join(command)} exited {done.returncode}:\n{done.stderr[-2000:]}')
+    stamps = read_vectors(folder / 'bag', typestore_with(custom_definitions()),
+                          {'/wand/pose': 'pose'}, stamped=True)['/wand/pose'][0]
+    gaps = np.diff(stamps)
+    return {**teleop_scan.figures(teleop_scan.read_scan(folder / 'bag'), DELAY),
+            'rate_hz': float(len(stamps) / (stamps[-1] - stamps[0])),
+            'late_poses': int(np.sum(gaps > LATE)), 'longest_gap_s': float(gaps.max()),
+            'load_before': load}
+
+
+def hogged(run):
+    """Run ``run()`` with another process keeping one core busy."""
+    hog = subprocess.Popen([sys.executable, '-c', HOG])
+    try:
+        time.sleep(1.0)  # let it take its core
+        return run()
+    finally:
+        hog.kill()
+        hog.wait()
+
+
+def print_row(row: dict) -> None:
+    print(f'{row["scheme"]:>6} {row["load"]:>7} {row["code"]:>9} {row["rate_hz"]:6.0f} '
+          f'{row["late_poses"]:5d} {1e3 * row["longest_gap_s"]:6.1f} '
+          f'{"yes" if row["stable"] else "NO":>6} {1e3 * row["net_work_j"]:8.1f} '
+          f'{row["oscillation_percent"]:6.1f} {row["transparency_percent"]:6.1f} '
+          f'{row["peak_patient_n"]:6.2f} {row["load_before"]:5.1f}', flush=True)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--schemes', nargs='+', default=['model', 'tdpa'],
+                        choices=['direct', 'tdpa', 'model'])
+    parser.add_argument('--rounds', type=int, default=1)
+    parser.add_argument('--baseline', default=BASELINE, help='git ref of the code before')
+    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    parser.add_argument('--duration', type=float, default=DURATION,
+                        help="the session's length, s (the issue's: 20)")
+    parser.add_argument('--json', type=pathlib.Path, help='write the rows and the machine here')
+    args = parser.parse_args(argv)
+    add_venv_prefix()
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    started = machine.line('ros-jazzy-rclpy')
+    print(f'machine: {started}; load average {os.getloadavg()[0]:.1f} at the start')
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        (tmp / 'baseline').mkdir()
+        codes = {'fix': dict(os.environ), args.baseline: baseline_tree(args.baseline,
+                                                                       tmp / 'baseline')}
+        print(f'{"scheme":>6} {"load":>7} {"code":>9} {"Hz":>6} {">10ms":>5} {"gap ms":>6} '
+              f'{"stable":>6} {"work mJ":>8} {"osc %":>6} {"err %":>6} {"peak N":>6} '
+              f'{"loadavg":>5}')
+        for _ in range(args.rounds):
+            for scheme in args.schemes:
+                for load in ('quiet', 'hogged'):
+                    for code, env in codes.items():
+                        folder = tmp / f'{scheme}-{load}-{len(rows)}'
+                        folder.mkdir()
+                        run = functools.partial(case, scheme, folder, env, args.domain_id,
+                                                args.duration)
+                        row = {'scheme': scheme, 'load': load, 'code': code,
+                               **(hogged(run) if load == 'hogged' else run())}
+                        rows.append(row)
+                        print_row(row)
+    if args.json:
+        command = (f'haptic_loop --teleop SCHEME --delay {DELAY} --jitter {JITTER} --loss {LOSS} '
+                   f'--duration {args.duration:g} --record DIR')
+        args.json.write_text(json.dumps({'machine': started, 'baseline': args.baseline,
+                                         'command': command, 'rows': rows},
+                                        indent=1, default=float))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
