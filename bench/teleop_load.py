@@ -10,8 +10,9 @@ with another process keeping one of the two cores busy, the four alternated in o
 by scheme. Every figure is ``teleop_scan.figures`` of the bag, from what the device applied to
 the hand and where the wand was (measured from outside, not from the controllers' books): net
 work on the hand and oscillation (stable: <= 0 and <= 10 %), transparency, the patient's peak
-force; beside them the rate the wand published at and how many of its poses came more than
-10 ms after the one before (the ticks that outlived an answer's lifetime).
+force; beside them the rate the wand published at, how many of its poses came more than 10 ms
+after the one before (the ticks that outlived an answer's lifetime), the longest gap, the load
+average when the case started (other work shares the machine) and the session's exit code.
 """
 import argparse
 import functools
@@ -67,15 +68,16 @@ def case(scheme: str, folder: pathlib.Path, env: dict, domain_id: int,
                '--domain-id', str(domain_id), '--run-dir', str(folder / 'launch')]
     load = os.getloadavg()[0]
     done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=240)
-    if done.returncode != 0:
-        raise RuntimeError(f'{" ".join(command)} exited {done.returncode}:\n{done.stderr[-2000:]}')
+    if not (folder / 'bag').exists():  # a session that stopped badly still leaves its bag
+        raise RuntimeError(f'{" ".join(command)} exited {done.returncode}, no bag:\n'
+                           f'{done.stderr[-2000:]}')
     stamps = read_vectors(folder / 'bag', typestore_with(custom_definitions()),
                           {'/wand/pose': 'pose'}, stamped=True)['/wand/pose'][0]
     gaps = np.diff(stamps)
     return {**teleop_scan.figures(teleop_scan.read_scan(folder / 'bag'), DELAY),
             'rate_hz': float(len(stamps) / (stamps[-1] - stamps[0])),
             'late_poses': int(np.sum(gaps > LATE)), 'longest_gap_s': float(gaps.max()),
-            'load_before': load}
+            'load_before': load, 'exit_code': done.returncode}
 
 
 def hogged(run):
@@ -94,7 +96,8 @@ def print_row(row: dict) -> None:
           f'{row["late_poses"]:5d} {1e3 * row["longest_gap_s"]:6.1f} '
           f'{"yes" if row["stable"] else "NO":>6} {1e3 * row["net_work_j"]:8.1f} '
           f'{row["oscillation_percent"]:6.1f} {row["transparency_percent"]:6.1f} '
-          f'{row["peak_patient_n"]:6.2f} {row["load_before"]:5.1f}', flush=True)
+          f'{row["peak_patient_n"]:6.2f} {row["load_before"]:7.1f} {row["exit_code"]:4d}',
+          flush=True)
 
 
 def main(argv=None) -> int:
@@ -120,7 +123,7 @@ def main(argv=None) -> int:
                                                                        tmp / 'baseline')}
         print(f'{"scheme":>6} {"load":>7} {"code":>9} {"Hz":>6} {">10ms":>5} {"gap ms":>6} '
               f'{"stable":>6} {"work mJ":>8} {"osc %":>6} {"err %":>6} {"peak N":>6} '
-              f'{"loadavg":>5}')
+              f'{"loadavg":>7} {"exit":>4}')
         for _ in range(args.rounds):
             for scheme in args.schemes:
                 for load in ('quiet', 'hogged'):
@@ -133,13 +136,17 @@ def main(argv=None) -> int:
                                **(hogged(run) if load == 'hogged' else run())}
                         rows.append(row)
                         print_row(row)
-    if args.json:
-        command = (f'haptic_loop --teleop SCHEME --delay {DELAY} --jitter {JITTER} --loss {LOSS} '
-                   f'--duration {args.duration:g} --record DIR')
-        args.json.write_text(json.dumps({'machine': started, 'baseline': args.baseline,
-                                         'command': command, 'rows': rows},
-                                        indent=1, default=float))
+                        if args.json:  # after each case: a run cut short keeps what it measured
+                            write(args.json, started, args, rows)
     return 0
+
+
+def write(path: pathlib.Path, started: str, args, rows: list) -> None:
+    """Write the machine, the command and the rows as JSON, for the report."""
+    command = (f'haptic_loop --teleop SCHEME --delay {DELAY} --jitter {JITTER} --loss {LOSS} '
+               f'--duration {args.duration:g} --record DIR')
+    path.write_text(json.dumps({'machine': started, 'baseline': args.baseline,
+                                'command': command, 'rows': rows}, indent=1, default=float))
 
 
 if __name__ == '__main__':

@@ -53,7 +53,7 @@ OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
-LATE_POSE_HOLD = 0.1  # [s] the follower's link_timeout: the robot holds its target as long
+LATE_POSE_HOLD = 0.5  # [s] past the stalls seen with the machine fully loaded (up to 0.45 s)
 BRIDGE_MODULE = 'remote_probe.bridge'
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
@@ -164,9 +164,8 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     over a tick the machine stretched (on a loaded machine, up to +70 mJ given to the hand over
     a scan without it). On regular ticks it never acts (the lockstep scan is bit for bit the
     same with it). While the driver's next pose is late, the answer to the newest one holds until
-    it is sent, for at most the remote site's link timeout (the robot holds its target as long):
-    an answer that expired inside a stretched tick let the hand fall in, and the next one threw
-    it back out (``haptic_wand_driver.answer_deadline``).
+    it is sent, for at most ``LATE_POSE_HOLD``: an answer that expired inside a stretched tick let
+    the hand fall in, and the next one threw it back out (``haptic_wand_driver.answer_deadline``).
     """
     scheme = config.teleop
     driver = options.setdefault('wand_driver', {})

@@ -174,7 +174,7 @@ class WandDriverNode(Node):
         elif self._phase is Phase.RUNNING:
             device_now = self._device_time()
             state = self._state = self.device.read(device_now)
-            moved = self.answers.sent(now)  # the held answer now waits on this pose's
+            moved = self.answers.sent(now)  # a newer pose is out: the held answer stops holding
             if self.renderer is None:
                 self._apply(now, state)
             elif moved:
