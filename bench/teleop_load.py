@@ -11,8 +11,10 @@ by scheme. Every figure is ``teleop_scan.figures`` of the bag, from what the dev
 the hand and where the wand was (measured from outside, not from the controllers' books): net
 work on the hand and oscillation (stable: <= 0 and <= 10 %), transparency, the patient's peak
 force; beside them the rate the wand published at, how many of its poses came more than 10 ms
-after the one before (the ticks that outlived an answer's lifetime), the longest gap, the load
-average when the case started (other work shares the machine) and the session's exit code.
+after the one before (the ticks that outlived an answer's lifetime) and the longest gap, the
+remote site's rate, the link's silences (feedback more than 0.1 s apart: the leader renders
+nothing then, and starts again where the wand is), the load average when the case started
+(other work shares the machine) and the session's exit code.
 """
 import argparse
 import functools
@@ -26,6 +28,7 @@ import time
 
 import machine
 import numpy as np
+from rosbags.highlevel import AnyReader
 import teleop_scan
 
 from haptic_bringup.bag import typestore_with
@@ -41,6 +44,7 @@ PACKAGES = ('haptic_util', 'collision_engine', 'force_renderer', 'haptic_wand_dr
             'haptic_bringup', 'remote_probe')
 DELAY, JITTER, LOSS, DURATION = 0.1, 0.01, 0.01, 20.0  # the issue's command
 LATE = 0.010  # [s] between two poses: longer than an answer's lifetime
+SILENT = 0.1  # [s] between two feedbacks: the leader's link_timeout, it renders nothing
 HOG = 'while True: pass'
 WARM = ('from collision_engine import load_scene; from haptic_util.paths import package_file; '
         'from haptic_wand_driver import servo_loop; servo_loop.compile_now(); '
@@ -74,10 +78,24 @@ def case(scheme: str, folder: pathlib.Path, env: dict, domain_id: int,
     stamps = read_vectors(folder / 'bag', typestore_with(custom_definitions()),
                           {'/wand/pose': 'pose'}, stamped=True)['/wand/pose'][0]
     gaps = np.diff(stamps)
-    return {**teleop_scan.figures(teleop_scan.read_scan(folder / 'bag'), DELAY),
-            'rate_hz': float(len(stamps) / (stamps[-1] - stamps[0])),
+    scan = teleop_scan.read_scan(folder / 'bag')
+    return {**teleop_scan.figures(scan, DELAY), 'rate_hz': _rate(stamps),
+            'remote_rate_hz': _rate(scan['/remote/robot/tcp_pose'][0]),
+            'silences': _silences(folder / 'bag'),
             'late_poses': int(np.sum(gaps > LATE)), 'longest_gap_s': float(gaps.max()),
             'load_before': load, 'exit_code': done.returncode}
+
+
+def _rate(times: np.ndarray) -> float:
+    return float(len(times) / (times[-1] - times[0]))
+
+
+def _silences(bag: pathlib.Path) -> int:
+    """Count the feedback's gaps longer than the leader's link timeout, as the recorder got it."""
+    with AnyReader([bag], default_typestore=typestore_with(custom_definitions())) as reader:
+        feedback = [c for c in reader.connections if c.topic == '/teleop/feedback']
+        times = np.array([stamp for _, stamp, _ in reader.messages(connections=feedback)])
+    return int(np.sum(np.diff(times * 1e-9) > SILENT))
 
 
 def hogged(run):
@@ -94,6 +112,7 @@ def hogged(run):
 def print_row(row: dict) -> None:
     print(f'{row["scheme"]:>6} {row["load"]:>7} {row["code"]:>9} {row["rate_hz"]:6.0f} '
           f'{row["late_poses"]:5d} {1e3 * row["longest_gap_s"]:6.1f} '
+          f'{row["remote_rate_hz"]:6.0f} {row["silences"]:4d} '
           f'{"yes" if row["stable"] else "NO":>6} {1e3 * row["net_work_j"]:8.1f} '
           f'{row["oscillation_percent"]:6.1f} {row["transparency_percent"]:6.1f} '
           f'{row["peak_patient_n"]:6.2f} {row["load_before"]:7.1f} {row["exit_code"]:4d}',
@@ -110,6 +129,7 @@ def main(argv=None) -> int:
     parser.add_argument('--duration', type=float, default=DURATION,
                         help="the session's length, s (the issue's: 20)")
     parser.add_argument('--json', type=pathlib.Path, help='write the rows and the machine here')
+    parser.add_argument('--keep', type=pathlib.Path, help='keep each case\'s bag under here')
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -118,18 +138,20 @@ def main(argv=None) -> int:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
+        cases = args.keep or tmp
         (tmp / 'baseline').mkdir()
         codes = {'fix': dict(os.environ), args.baseline: baseline_tree(args.baseline,
                                                                        tmp / 'baseline')}
         print(f'{"scheme":>6} {"load":>7} {"code":>9} {"Hz":>6} {">10ms":>5} {"gap ms":>6} '
+              f'{"rem Hz":>6} {"sil":>4} '
               f'{"stable":>6} {"work mJ":>8} {"osc %":>6} {"err %":>6} {"peak N":>6} '
               f'{"loadavg":>7} {"exit":>4}')
         for _ in range(args.rounds):
             for scheme in args.schemes:
                 for load in ('quiet', 'hogged'):
                     for code, env in codes.items():
-                        folder = tmp / f'{scheme}-{load}-{len(rows)}'
-                        folder.mkdir()
+                        folder = cases / f'{len(rows)}-{scheme}-{load}-{code}'
+                        folder.mkdir(parents=True)
                         run = functools.partial(case, scheme, folder, env, args.domain_id,
                                                 args.duration)
                         row = {'scheme': scheme, 'load': load, 'code': code,
