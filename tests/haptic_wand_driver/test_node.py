@@ -57,7 +57,9 @@ def test_the_newest_answer_holds_until_the_next_pose_is_sent_then_lives_its_life
         driver, monkeypatch):
     clock = ROSClock()  # both clocks set by hand: ROS time, and the device's a fixed way behind
     clock._set_ros_time_is_active(True)
-    start = 1_800_000_000_000_000_000
+    # A stamp whose seconds plus nanoseconds in floats fall below its nanoseconds in floats.
+    start = 1_800_000_000_001_000_123
+    assert 1_800_000_000 + 1_000_123e-9 < start * 1e-9
     device_start = time.monotonic() + 0.1  # the wand has been read at the monotonic clock
     behind = start * 1e-9 - device_start
     monkeypatch.setattr(driver, 'get_clock', lambda: clock)

@@ -261,7 +261,8 @@ class WandDriverNode(Node):
     def on_model(self, fields: Sequence) -> None:
         """Hand a contact model to the device's renderer; a bad one gives zero force."""
         now_ns = clock_ns(self.get_clock())
-        if not self._answered(fields[0] * 1_000_000_000 + fields[1], now_ns):
+        stamp_ns = fields[0] * 1_000_000_000 + fields[1]
+        if not self._answered(stamp_ns, now_ns):
             return
         try:
             model = ContactModel.from_fields(fields, self.params.frame_id)
@@ -274,7 +275,8 @@ class WandDriverNode(Node):
             return
         self._model_stamp = model.stamp
         since = self._arrival()
-        self.answers.taken(model.stamp, model.valid_for)
+        # From the nanoseconds, as the pose's was: seconds plus nanoseconds round otherwise.
+        self.answers.taken(stamp_ns * 1e-9, model.valid_for)
         deadline = self.answers.deadline - self._ros_minus_device()
         if model.kind == Kind.UNAVAILABLE:
             self.renderer.take_wrench(model.held_wrench[:3], model.held_wrench[3:], deadline,
