@@ -9,12 +9,13 @@ the code at ``--baseline`` (``git archive`` of it, run with this venv), on a qui
 with another process keeping one of the two cores busy, the four alternated in one run, scheme
 by scheme. Every figure is ``teleop_scan.figures`` of the bag, from what the device applied to
 the hand and where the wand was (measured from outside, not from the controllers' books): net
-work on the hand and oscillation (stable: <= 0 and <= 10 %), transparency, the patient's peak
-force; beside them the rate the wand published at, how many of its poses came more than 10 ms
-after the one before (the ticks that outlived an answer's lifetime) and the longest gap, the
-remote site's rate, the link's silences (feedback more than 0.1 s apart: the leader renders
-nothing then, and starts again where the wand is), the load average when the case started
-(other work shares the machine) and the session's exit code.
+work on the hand and oscillation (stable: <= 0 and <= 10 %; a session in contact with the
+patient for less than 5 s, which a starved remote site can make, says neither), transparency,
+the patient's peak force. Beside them: the rate the wand published at, how many of its poses
+came more than 10 ms after the one before (the ticks that outlived an answer's lifetime) and
+the longest gap, the remote site's rate, the link's silences (feedback more than 0.1 s apart:
+the leader renders nothing then, and starts again where the wand is), the load average when the
+case started (other work shares the machine) and the session's exit code.
 """
 import argparse
 import functools
@@ -44,6 +45,7 @@ PACKAGES = ('haptic_util', 'collision_engine', 'force_renderer', 'haptic_wand_dr
             'haptic_bringup', 'remote_probe')
 DELAY, JITTER, LOSS, DURATION = 0.1, 0.01, 0.01, 20.0  # the issue's command
 LATE = 0.010  # [s] between two poses: longer than an answer's lifetime
+MIN_CONTACT = 5.0  # [s] in contact: the scan presses for about 12 s
 SILENT = 0.1  # [s] between two feedbacks: the leader's link_timeout, it renders nothing
 HOG = 'while True: pass'
 WARM = ('from collision_engine import load_scene; from haptic_util.paths import package_file; '
@@ -109,11 +111,18 @@ def hogged(run):
         hog.wait()
 
 
+def _verdict(row: dict) -> str:
+    """Stable or not; a session that never pressed the patient says nothing either way."""
+    if row['contact_s'] < MIN_CONTACT:
+        return 'no touch'
+    return 'yes' if row['stable'] else 'NO'
+
+
 def print_row(row: dict) -> None:
     print(f'{row["scheme"]:>6} {row["load"]:>7} {row["code"]:>9} {row["rate_hz"]:6.0f} '
           f'{row["late_poses"]:5d} {1e3 * row["longest_gap_s"]:6.1f} '
           f'{row["remote_rate_hz"]:6.0f} {row["silences"]:4d} '
-          f'{"yes" if row["stable"] else "NO":>6} {1e3 * row["net_work_j"]:8.1f} '
+          f'{_verdict(row):>6} {row["contact_s"]:5.1f} {1e3 * row["net_work_j"]:8.1f} '
           f'{row["oscillation_percent"]:6.1f} {row["transparency_percent"]:6.1f} '
           f'{row["peak_patient_n"]:6.2f} {row["load_before"]:7.1f} {row["exit_code"]:4d}',
           flush=True)
@@ -144,7 +153,8 @@ def main(argv=None) -> int:
                                                                        tmp / 'baseline')}
         print(f'{"scheme":>6} {"load":>7} {"code":>9} {"Hz":>6} {">10ms":>5} {"gap ms":>6} '
               f'{"rem Hz":>6} {"sil":>4} '
-              f'{"stable":>6} {"work mJ":>8} {"osc %":>6} {"err %":>6} {"peak N":>6} '
+              f'{"stable":>6} {"touch":>5} {"work mJ":>8} {"osc %":>6} {"err %":>6} '
+              f'{"peak N":>6} '
               f'{"loadavg":>7} {"exit":>4}')
         for _ in range(args.rounds):
             for scheme in args.schemes:
