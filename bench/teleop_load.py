@@ -94,7 +94,8 @@ def _rate(times: np.ndarray) -> float:
 
 def _silences(bag: pathlib.Path) -> int:
     """Count the feedback's gaps longer than the leader's link timeout, as the recorder got it."""
-    with AnyReader([bag], default_typestore=typestore_with(custom_definitions())) as reader:
+    parts = sorted(metadata.parent for metadata in bag.glob('**/metadata.yaml'))  # a site's each
+    with AnyReader(parts, default_typestore=typestore_with(custom_definitions())) as reader:
         feedback = [c for c in reader.connections if c.topic == '/teleop/feedback']
         times = np.array([stamp for _, stamp, _ in reader.messages(connections=feedback)])
     return int(np.sum(np.diff(times * 1e-9) > SILENT))

@@ -182,9 +182,9 @@ def main(argv=None) -> int:
     parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
     parser.add_argument('--loss', type=float, default=0.01)
     parser.add_argument('--late', action='store_true',
-                        help=f"the operator's site ticks late ({LATE_FRACTION:.0%} of its ticks, "
-                        f'by up to {1e3 * LATE_LONGEST:g} ms): each case with the driver\'s hold '
-                        'and without it (the baseline)')
+                        help=f"the operator's site ticks late ({100 * LATE_FRACTION:g} %% of its "
+                        f'ticks, by up to {1e3 * LATE_LONGEST:g} ms): each case with the '
+                        "driver's hold and without it (the baseline)")
     args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")} (no ROS: one clock, lockstep)')
     teleop_scan.print_header()

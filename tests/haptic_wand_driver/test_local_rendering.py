@@ -138,6 +138,27 @@ def test_a_stiffer_model_stores_no_more_than_the_port_took_in_and_each_model_is_
     assert law.bound[0] == 0.0
 
 
+def test_after_a_lapse_a_model_gives_back_what_the_contact_took_in_and_no_more():
+    """The law expires with the tip pressed in, the hand sinks 1 mm, a new model comes.
+
+    A lapse is no break in contact: what was taken in still pays for the spring, so the new
+    model pushes as hard as that energy allows, where a tip that had left the wall for longer
+    than the books' 50 ms meets it moved out to where it is.
+    """
+    law = renderer()
+    touched(law, wall(radius=1.0), deadline=1.0)
+    for z in np.linspace(0.0, -0.002, 21):
+        law.wrench(0.0, *at(z), 2.5e-4)
+    taken_in = law.passivity.energy
+    for step in range(400):  # 100 ms past the deadline: nothing alive, the hand pushes in
+        law.wrench(1.0 + step * 2.5e-4, *at(-0.002 - 0.001 * step / 399), 2.5e-4)
+    assert law.passivity.energy == taken_in
+    law.take(wall(radius=1.0), deadline=math.inf)
+    force = law.wrench(1.1, *at(-0.003), 2.5e-4)[0]
+    assert force[2] == pytest.approx(math.sqrt(2.0 * 1000.0 * taken_in))
+    assert law.bound[0] == pytest.approx(0.003 - math.sqrt(2.0 * taken_in / 1000.0))
+
+
 class _Recording:
     """The law seen from the wand's servo loop: each period's height and force."""
 

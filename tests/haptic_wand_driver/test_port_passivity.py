@@ -146,3 +146,13 @@ def test_several_planes_move_out_together_as_far_as_the_energy_requires(seed):
 def test_planes_in_front_or_without_stiffness_store_nothing_and_move_nothing():
     assert bounded_shift([(-0.01, 400.0), (0.01, 0.0)], 0.0) == 0.0
     assert bounded_shift([], 0.0) == 0.0
+
+
+def test_a_lapse_of_the_watchdog_keeps_the_contact_s_books():
+    """Zero force because no law was alive is no break in contact: the books stay open."""
+    port = PortPassivity(max_damping=0.0)
+    port.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    port.control((0.0, 0.0, 1.0), (0.0, 0.0, -0.002), (0.0, 0.0, 0.0), 0.001)  # 2 mJ taken in
+    for _ in range(2 * round(BOOKS_CLOSE_AFTER / 0.001)):
+        port.control((0.0, 0.0, 0.0), (0.0, 0.0, -0.002), (0.0, 0.0, 0.0), 0.001, lapsed=True)
+    assert port.energy == pytest.approx(0.002)

@@ -152,7 +152,8 @@ class LocalRenderer:
             force, torque = model.wrench(position, velocity, coordinates[3], coordinates[4],
                                          spin, self._contact_damping(period), limit,
                                          self._shift(model, take, coordinates))
-        force = self.passivity.control(force, position, velocity, period)
+        force = self.passivity.control(force, position, velocity, period,
+                                       time + period > deadline)
         return (saturate_components(force, limit),
                 saturate_components(torque, self.torque_limit))
 

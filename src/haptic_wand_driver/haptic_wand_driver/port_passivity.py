@@ -16,7 +16,9 @@ creates no direction the force did not have (damping along the velocity pushed s
 tip sliding off a wall), amplifies nothing, and never pulls the tip in.
 
 The books close once the force has been zero for ``BOOKS_CLOSE_AFTER``, the same policy as the
-renderer's controller; ``force_renderer.passivity`` says why.
+renderer's controller; ``force_renderer.passivity`` says why. A lapse does not count: a force
+that is zero because the watchdog let no law through (a late tick, a stalled loop) has not left
+the contact, and what the hand put in before stays on the books.
 
 A switch of law is bounded by the same books (``bounded_shift``). A law that renders springs (a
 contact model's planes) taken with the tip already behind them would store energy the hand never
@@ -59,7 +61,7 @@ class PortPassivity:
         self._free = 0.0  # [s] since the force went to zero
 
     def control(self, force: Vector3, position: Vector3, velocity: Vector3,
-                period: float) -> Vector3:
+                period: float, lapsed: bool = False) -> Vector3:
         """Return the force to apply now, given the rendered one and the tip's motion.
 
         Parameters
@@ -72,11 +74,15 @@ class PortPassivity:
             The tip's velocity now.
         period : float, s
             Time until the next call (the servo period).
+        lapsed : bool
+            Whether the force is zero because the device's watchdog let nothing through (no law
+            alive): the contact has not ended, so the period does not count toward closing the
+            books.
         """
         self.observe(position)
         magnitude = math.sqrt(force[0] ** 2 + force[1] ** 2 + force[2] ** 2)
         if magnitude == 0.0:
-            self._free += period
+            self._free += 0.0 if lapsed else period
             if self._free >= BOOKS_CLOSE_AFTER:
                 self.energy = 0.0
             self._force = (0.0, 0.0, 0.0)

@@ -158,12 +158,13 @@ def _observe(books, coordinates):
 
 
 @njit(cache=True, nogil=True)
-def _passive(books, fx, fy, fz, coordinates, rates, period):
+def _passive(books, fx, fy, fz, coordinates, rates, period, lapsed):
     """Return the force the port's passivity controller lets through (``PortPassivity``)."""
     _observe(books, coordinates)
     magnitude = math.sqrt(fx ** 2 + fy ** 2 + fz ** 2)
     if magnitude == 0.0:
-        books[9] += period
+        if not lapsed:
+            books[9] += period
         if books[9] >= BOOKS_CLOSE_AFTER:
             books[0] = 0.0
         books[2] = books[3] = books[4] = 0.0
@@ -201,7 +202,7 @@ def _law_wrench(packed, books, bound, time, coordinates, rates, period):
                 _observe(books, coordinates)
                 bound[0], bound[1] = _bounded_shift(law, coordinates, books[0]), law[SERIAL]
             fx, fy, fz, tx, ty, tz = _planes(law, coordinates, rates, limit, period, bound[0])
-    fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period)
+    fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period, not live)
     fx, fy, fz = _saturate(fx, fy, fz, limit)
     tx, ty, tz = _saturate(tx, ty, tz, law[1])
     return fx, fy, fz, tx, ty, tz
