@@ -122,7 +122,6 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
         if operating[k]:
             state = device.read(now)
             operator_rows.append((now, *state.position, *device.applied()[0]))
-            moved = answers.sent(now)
             to_robot.send(now, leader.command(now, state.position, state.linear_velocity))
         for delivery in to_robot.deliver(now):
             follower.receive(now, delivery.payload)
@@ -135,17 +134,15 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
             continue
         for delivery in to_operator.deliver(now):
             leader.receive(now, delivery.payload)
+        answers.taken(now, MODEL_LIFETIME)  # answered as it went out, as in the site's process
         if renderer is not None:
-            if moved:
-                renderer.expire(answers.deadline)
-            answers.taken(now, MODEL_LIFETIME)
             renderer.take(_model(now, leader.plane(now, state.position), state.position),
                           answers.deadline)
         else:
-            answers.taken(now, MODEL_LIFETIME)
             force = leader.force(now, state.position, state.linear_velocity, TICK)
             device.apply(port.control(force, state.position, state.linear_velocity, TICK),
                          ZERO, until=answers.deadline)
+        answers.sent(now, now)
     operator, remote_table = np.array(operator_rows), np.array(remote_rows)
     return {'time': operator[:, 0], 'wand': operator[:, 1:4], 'felt': operator[:, 4:7],
             'remote_time': remote_table[:, 0], 'patient': remote_table[:, 1:4],

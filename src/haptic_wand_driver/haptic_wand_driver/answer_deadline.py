@@ -35,13 +35,17 @@ class AnswerDeadline:
         self._held = (-math.inf, 0.0)  # the held answer's pose and lifetime
         self._next = -math.inf  # when the first pose after the held answer's went out
 
-    def sent(self, stamp: float) -> bool:
-        """Book a pose sent at ``stamp``; return whether that moved the held answer's deadline."""
+    def sent(self, stamp: float, at: float) -> bool:
+        """Book the pose stamped ``stamp`` as sent at ``at``; return whether the deadline moved.
+
+        Call it once the pose is out (and, in one process, answered): a tick can stall between
+        its stamp and its sending, and the answer held must cover that too.
+        """
         answered, lifetime = self._held
         first = self._next == math.inf and stamp > answered
         if first:
-            self._next = stamp
-            self.late += stamp > answered + lifetime
+            self._next = at
+            self.late += at > answered + lifetime
         self._newest = stamp
         return first and self.hold > lifetime
 

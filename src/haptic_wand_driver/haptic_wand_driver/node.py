@@ -83,6 +83,7 @@ class WandDriverNode(Node):
         self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
         self.renderer = self._local_renderer() if params.rendering == 'local' else None
         self.answers = AnswerDeadline(params.hold_while_late)
+        self._applied = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))  # the wrench the device holds
         self._model_stamp = -math.inf  # of the newest model taken
         self._since = -math.inf  # the device's clock when the renderer last switched
         self._period = 1.0 / params.rate
@@ -174,13 +175,12 @@ class WandDriverNode(Node):
         elif self._phase is Phase.RUNNING:
             device_now = self._device_time()
             state = self._state = self.device.read(device_now)
-            moved = self.answers.sent(now)  # a newer pose is out: the held answer stops holding
             if self.renderer is None:
                 self._apply(now, state)
-            elif moved:
-                self.renderer.expire(self.answers.deadline - self._ros_minus_device())
             self.stats.sent(now_ns)
             self._publish(state, now_ns)
+            if self.answers.sent(now, clock_ns(self.get_clock()) * 1e-9):
+                self._rearm()  # out and not answered yet: the held answer stops holding
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
                 self._phase = Phase.DONE
                 self.get_logger().info(f'experiment done after {self.params.duration:g} s')
@@ -315,10 +315,19 @@ class WandDriverNode(Node):
 
         ``now`` is ROS time, the clock of the stamps.
         """
-        force, torque = self.wrench.current(now, state.yaw)
+        force, torque = self.wrench.current(now, state.yaw, self.answers.deadline)
         force = self.passivity.control(force, state.position, state.linear_velocity,
                                        self._period)
+        self._applied = (force, torque)
         self.device.apply(force, torque, until=self.answers.deadline - self._ros_minus_device())
+
+    def _rearm(self) -> None:
+        """Give what the device holds the held answer's deadline, once that moved."""
+        until = self.answers.deadline - self._ros_minus_device()
+        if self.renderer is not None:
+            self.renderer.expire(until)
+        else:
+            self.device.apply(*self._applied, until=until)
 
     def _take(self, wrench: list, stamp: float, now: float) -> Refusal | None:
         """Hand a received wrench (``WRENCH`` leaves) to the command; return why it was refused."""
