@@ -1,13 +1,15 @@
-"""The telerobotic scan quiet and with one core hogged: the fix beside the code before it.
+"""The telerobotic scan quiet and with cores hogged: the fix beside the code before it.
 
-    .venv/bin/python bench/teleop_load.py [--schemes model tdpa] [--rounds 1]
-        [--baseline 0139399] [--duration 20] [--json PATH]
+    .venv/bin/python bench/teleop_load.py [--schemes model tdpa] [--loads quiet hogged busy]
+        [--rounds 1] [--baseline 0139399] [--duration 20] [--json PATH] [--keep DIR]
 
 Each case is the issue's command as a user types it, ``haptic_loop --teleop SCHEME --delay 0.1
 --jitter 0.01 --loss 0.01 --duration 20 --record DIR``: run from this tree (the fix) and from
-the code at ``--baseline`` (``git archive`` of it, run with this venv), on a quiet machine and
-with another process keeping one of the two cores busy, the four alternated in one run, scheme
-by scheme. Every figure is ``teleop_scan.figures`` of the bag, from what the device applied to
+the code at ``--baseline`` (``git archive`` of it, run with this venv), alternated in one run,
+scheme by scheme and load by load: on a quiet machine (``quiet``), with another process keeping
+one of the two cores busy (``hogged``), and with two keeping both busy (``busy``: what the issue
+saw, the driver at 763 Hz on a busy machine, takes more than one hog here when nothing else
+runs). Every figure is ``teleop_scan.figures`` of the bag, from what the device applied to
 the hand and where the wand was (measured from outside, not from the controllers' books): net
 work on the hand and oscillation (stable: <= 0 and <= 10 %; a session in contact with the
 patient for less than 5 s, which a starved remote site can make, says neither), transparency,
@@ -48,6 +50,7 @@ LATE = 0.010  # [s] between two poses: longer than an answer's lifetime
 MIN_CONTACT = 5.0  # [s] in contact: the scan presses for about 12 s
 SILENT = 0.1  # [s] between two feedbacks: the leader's link_timeout, it renders nothing
 HOG = 'while True: pass'
+LOADS = {'quiet': 0, 'hogged': 1, 'busy': 2}  # processes keeping a core busy
 WARM = ('from collision_engine import load_scene; from haptic_util.paths import package_file; '
         'from haptic_wand_driver import servo_loop; servo_loop.compile_now(); '
         "load_scene(package_file('package://collision_engine/scenes/phantom.yaml'))")
@@ -101,15 +104,16 @@ def _silences(bag: pathlib.Path) -> int:
     return int(np.sum(np.diff(times * 1e-9) > SILENT))
 
 
-def hogged(run):
-    """Run ``run()`` with another process keeping one core busy."""
-    hog = subprocess.Popen([sys.executable, '-c', HOG])
+def loaded(run, hogs: int):
+    """Run ``run()`` with ``hogs`` other processes each keeping a core busy."""
+    load = [subprocess.Popen([sys.executable, '-c', HOG]) for _ in range(hogs)]
     try:
-        time.sleep(1.0)  # let it take its core
+        time.sleep(1.0)  # let them take their cores
         return run()
     finally:
-        hog.kill()
-        hog.wait()
+        for hog in load:
+            hog.kill()
+            hog.wait()
 
 
 def _verdict(row: dict) -> str:
@@ -133,6 +137,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--schemes', nargs='+', default=['model', 'tdpa'],
                         choices=['direct', 'tdpa', 'model'])
+    parser.add_argument('--loads', nargs='+', default=list(LOADS), choices=list(LOADS))
     parser.add_argument('--rounds', type=int, default=1)
     parser.add_argument('--baseline', default=BASELINE, help='git ref of the code before')
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
@@ -159,14 +164,14 @@ def main(argv=None) -> int:
               f'{"loadavg":>7} {"exit":>4}')
         for _ in range(args.rounds):
             for scheme in args.schemes:
-                for load in ('quiet', 'hogged'):
+                for load in args.loads:
                     for code, env in codes.items():
                         folder = cases / f'{len(rows)}-{scheme}-{load}-{code}'
                         folder.mkdir(parents=True)
                         run = functools.partial(case, scheme, folder, env, args.domain_id,
                                                 args.duration)
                         row = {'scheme': scheme, 'load': load, 'code': code,
-                               **(hogged(run) if load == 'hogged' else run())}
+                               **loaded(run, LOADS[load])}
                         rows.append(row)
                         print_row(row)
                         if args.json:  # after each case: a run cut short keeps what it measured
