@@ -1,6 +1,7 @@
 """The telerobotic scan in lockstep, without ROS: the schemes' physics alone, reproducibly.
 
-    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.025 0.05 0.1 0.25] [--json PATH]
+    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.025 0.05 0.1 0.25] [--late]
+        [--json PATH]
 
 The same pieces as the ROS run, driven by one clock at 1 kHz: the simulated wand with its
 scripted hand (the driver's ``SimulatedWand`` at 4 kHz, rendering the model locally or holding
@@ -9,7 +10,9 @@ the abdomen's Hunt–Crossley tissue (a flat skin at the phantom's front) and it
 What it shows is what the schemes do with a delay, free of a busy machine's timing; the ROS run
 (``teleop_scan.py``) shows that the nodes do the same. Beside the launcher's three schemes it runs
 ``tdpa-plain``: TDPA's operator-side controller on the wand itself, without the virtual coupling
-that ``tdpa`` puts between them, the baseline that chatters.
+that ``tdpa`` puts between them, the baseline that chatters. With ``--late`` the operator's site
+skips ticks as a busy machine makes it (the remote site keeps its own), and each case runs with
+the driver's hold of the newest answer (as the launcher sets it) and without (the baseline).
 """
 import argparse
 import math
@@ -20,8 +23,9 @@ import numpy as np
 import result_files
 import teleop_scan
 
-from haptic_bringup.launcher import SCAN_DURATION
+from haptic_bringup.launcher import LATE_POSE_HOLD, SCAN_DURATION
 from haptic_util.paths import package_file
+from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
 from haptic_wand_driver.device import DeviceLimits
 from haptic_wand_driver.local_rendering import LocalRenderer
@@ -41,7 +45,7 @@ from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.teleop import CommandLimits, HAND_SPEED
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
-__all__ = ['as_series', 'scan', 'SCHEMES']
+__all__ = ['as_series', 'late_ticks', 'scan', 'SCHEMES']
 
 PLAIN_TDPA = 'tdpa-plain'  # TDPA's controller on the wand itself: the baseline of the coupling
 SCHEMES = ('direct', PLAIN_TDPA, 'tdpa', 'model')
@@ -50,6 +54,7 @@ SCAN = 'package://remote_probe/config/scan.yaml'
 SKIN = -0.025  # [m] the phantom's front, under the probe's start
 TICK = 1e-3  # [s]
 MODEL_LIFETIME = LeaderParams().model_lifetime  # [s]
+LATE_FRACTION, LATE_LONGEST = 0.02, 0.08  # of the ticks, late by up to [s]
 ZERO = np.zeros(3)
 
 
@@ -81,15 +86,23 @@ def _model(time: float, plane, tip) -> ContactModel:
 
 
 def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
-         duration: float = SCAN_DURATION, seed: int = 0) -> dict:
-    """Run the scan; return per-tick arrays: time, wand, felt (applied), patient, tcp.
+         duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0) -> dict:
+    """Run the scan; return the operator's and the remote site's per-tick arrays.
 
-    ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``.
+    ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``. ``ticks``: the tick
+    numbers at which the operator's site runs (a busy machine skips periods, as a ROS timer
+    does), None for every one; the remote site runs every tick. The site takes each answer as
+    the driver does: held by ``AnswerDeadline(hold)`` (the driver's ``hold_while_late``), a
+    wrench through the device port's passivity controller unless the scheme is ``direct``.
+    Returns ``time``, ``wand``, ``felt`` (applied since the tick before) at the operator's
+    ticks, and ``remote_time``, ``patient``, ``tcp``.
     """
     leader_config = (LeaderConfig('tdpa', coupling=None) if scheme == PLAIN_TDPA
                      else LeaderConfig(scheme))
     scheme = leader_config.scheme
     device, renderer = _device(scheme)
+    port = PortPassivity(WandDriverParams().passivity_max_damping if scheme == 'tdpa' else 0.0)
+    answers = AnswerDeadline(hold)
     robot_config = ImpedanceRobotConfig()
     robot = ImpedanceRobot(robot_config, environment=Tissue(
         ABDOMEN, PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])))
@@ -104,40 +117,65 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     link = LinkConfig(delay, jitter, loss, seed=seed)
     to_robot, to_operator = EmulatedLink(link), EmulatedLink(LinkConfig(
         delay, jitter, loss, seed=seed + 1))
-    rows = []
+    count = round(duration / TICK)
+    operating = np.ones(count + 1, dtype=bool) if ticks is None else np.isin(
+        np.arange(count + 1), ticks)
+    operator_rows, remote_rows = [], []
     state, remote = device.read(0.0), robot.read(0.0)
-    for k in range(1, round(duration / TICK)):
+    for k in range(1, count):
         now = k * TICK
-        command = leader.command(now, state.position, state.linear_velocity)
-        if command is not None:  # none until the feedback is heard
-            to_robot.send(now, command)
+        if operating[k]:
+            state = device.read(now)
+            operator_rows.append((now, *state.position, *device.applied()[0]))
+            command = leader.command(now, state.position, state.linear_velocity)
+            if command is not None:  # none until the feedback is heard
+                to_robot.send(now, command)
         for delivery in to_robot.deliver(now):
             follower.receive(now, delivery.payload)
         reading = sensor.measure(now, remote.external_force).force
         robot.command(follower.target(now, remote.position, remote.velocity, reading, TICK))
         to_operator.send(now, follower.feedback(now))
+        remote = robot.read(now + TICK)
+        remote_rows.append((now + TICK, *remote.external_force, *remote.position))
+        if not operating[k]:
+            continue
         for delivery in to_operator.deliver(now):
             leader.receive(now, delivery.payload)
+        answers.taken(now, MODEL_LIFETIME)  # answered as it went out, as in the site's process
         if renderer is not None:
             renderer.take(_model(now, leader.plane(now, state.position), state.position),
-                          now + MODEL_LIFETIME)
+                          answers.deadline)
         else:
-            device.apply(leader.force(now, state.position, state.linear_velocity, TICK), ZERO,
-                         until=now + MODEL_LIFETIME)
-        state, remote = device.read(now + TICK), robot.read(now + TICK)
-        rows.append((now, *state.position, *device.applied()[0], *remote.external_force,
-                     *remote.position))
-    table = np.array(rows)
-    return {'time': table[:, 0], 'wand': table[:, 1:4], 'felt': table[:, 4:7],
-            'patient': table[:, 7:10], 'tcp': table[:, 10:13]}
+            force = leader.force(now, state.position, state.linear_velocity, TICK)
+            device.apply(port.control(force, state.position, state.linear_velocity, TICK),
+                         ZERO, until=answers.deadline)
+        answers.sent(now, now)
+    operator, remote_table = np.array(operator_rows), np.array(remote_rows)
+    return {'time': operator[:, 0], 'wand': operator[:, 1:4], 'felt': operator[:, 4:7],
+            'remote_time': remote_table[:, 0], 'patient': remote_table[:, 1:4],
+            'tcp': remote_table[:, 4:7]}
+
+
+def late_ticks(duration: float, seed: int, *, late: float = LATE_FRACTION,
+               longest: float = LATE_LONGEST) -> np.ndarray:
+    """Tick numbers of a site on a busy machine: a fraction ``late`` of its ticks come late.
+
+    A late tick skips 1 to ``longest`` s of periods, log-uniformly (a few long stalls among many
+    short ones, as the driver's ticks under a CPU hog).
+    """
+    rng = np.random.default_rng(seed)
+    gaps = np.where(rng.random(round(duration / TICK)) < late,
+                    np.round(np.exp(rng.uniform(math.log(2.0 * TICK), math.log(longest),
+                                                round(duration / TICK))) / TICK), 1)
+    return np.cumsum(gaps.astype(np.int64))
 
 
 def as_series(run: dict) -> dict:
     """Return the run as ``teleop_scan.read_scan`` gives a bag: topic → (times, vectors)."""
     return {'/wand/pose': (run['time'], run['wand']),
             '/wand/applied_wrench': (run['time'], run['felt']),
-            '/remote/robot/ft_sensor/wrench': (run['time'], run['patient']),
-            '/remote/robot/tcp_pose': (run['time'], run['tcp'])}
+            '/remote/robot/ft_sensor/wrench': (run['remote_time'], run['patient']),
+            '/remote/robot/tcp_pose': (run['remote_time'], run['tcp'])}
 
 
 def main(argv=None) -> int:
@@ -147,16 +185,25 @@ def main(argv=None) -> int:
                         default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
     parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
     parser.add_argument('--loss', type=float, default=0.01)
+    parser.add_argument('--late', action='store_true',
+                        help=f"the operator's site ticks late ({100 * LATE_FRACTION:g} %% of its "
+                        f'ticks, by up to {1e3 * LATE_LONGEST:g} ms): each case with the '
+                        "driver's hold and without it (the baseline)")
     result_files.add_option(parser)
     args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")} (no ROS: one clock, lockstep)')
     teleop_scan.print_header()
+    ticks = late_ticks(SCAN_DURATION, 0) if args.late else None
     rows = []
     for delay in args.delays:
         for scheme in args.schemes:
-            run = scan(scheme, delay, jitter=args.jitter * delay, loss=args.loss)
-            rows.append({'scheme': scheme, **teleop_scan.figures(as_series(run), delay)})
-            teleop_scan.print_row(rows[-1])
+            for hold in (LATE_POSE_HOLD, 0.0) if args.late else (0.0,):
+                run = scan(scheme, delay, jitter=args.jitter * delay, loss=args.loss,
+                           ticks=ticks, hold=hold)
+                rows.append({'scheme': scheme, **teleop_scan.figures(as_series(run), delay),
+                             'site_streams': f'late, hold {1e3 * hold:g} ms'
+                             if args.late else ''})
+                teleop_scan.print_row(rows[-1])
     result_files.write(args.json, rows)
     return 0
 

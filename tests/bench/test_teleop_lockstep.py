@@ -7,6 +7,8 @@ import pytest
 import teleop_lockstep
 import teleop_scan
 
+from haptic_bringup.launcher import LATE_POSE_HOLD
+
 MAX_PATIENT_FORCE = 20.0  # [N] the safety's default
 
 
@@ -44,3 +46,19 @@ def test_the_model_is_stable_and_transparent_at_every_delay(delay, transparency)
     assert mediated['mean_patient_n'] > 5.0  # the scan does press
     if transparency is not None:
         assert mediated['transparency_percent'] <= transparency
+
+
+@pytest.mark.parametrize('scheme', ['model', 'tdpa'])
+def test_late_ticks_stay_passive_and_quiet_with_the_newest_answer_held(scheme):
+    """The operator's site skipping ticks as under a CPU hog (one in 50 late, by up to 80 ms).
+
+    Each answer expiring at its 10 ms lifetime, the baseline, lets the hand fall in at every
+    long gap and throws it back: tdpa gives the hand energy, the model swings (its planes are
+    kept passive by the device port, and the hand drifts in instead).
+    """
+    ticks = teleop_lockstep.late_ticks(teleop_lockstep.SCAN_DURATION, 0)
+    held = figures(scheme, 0.1, ticks=ticks, hold=LATE_POSE_HOLD)
+    expiring = figures(scheme, 0.1, ticks=ticks, hold=0.0)
+    assert held['stable'], held
+    assert held['peak_patient_n'] <= MAX_PATIENT_FORCE
+    assert not expiring['stable'], expiring

@@ -1,4 +1,6 @@
 """The driver node's wiring, in-process: what its clocks do, without a launched loop."""
+import time
+
 from contact_model_fields import fields
 import pytest
 import rclpy
@@ -7,17 +9,18 @@ from rclpy.context import Context
 from rclpy.time import Time
 
 from haptic_wand_driver.contact_model import Kind
+from haptic_wand_driver.local_rendering import DEADLINE
 from haptic_wand_driver.node import WandDriverNode
 
 
 @pytest.fixture
-def driver():
+def driver(request):
     context = Context()
     rclpy.init(context=context, domain_id=98)
+    extra = getattr(request, 'param', {})
     node = WandDriverNode(context=context, parameter_overrides=[
-        rclpy.parameter.Parameter('experiment', value='hold'),
-        rclpy.parameter.Parameter('wait_for_wrench', value=False),
-        rclpy.parameter.Parameter('min_subscribers', value=0)])
+        rclpy.parameter.Parameter(name, value=value) for name, value in
+        {'experiment': 'hold', 'wait_for_wrench': False, 'min_subscribers': 0, **extra}.items()])
     yield node
     node.destroy_node()
     rclpy.try_shutdown(context=context)
@@ -47,3 +50,54 @@ def test_rendering_locally_it_takes_the_model_alone_and_holds_the_wrench_of_a_la
                                            [0.0] * 5, 2.5e-4)
     assert force == pytest.approx((1.0, 0.0, -0.5)) and torque == (0.0, 0.0, 0.0)
     assert driver.stats.answers == 1
+
+
+def set_clocks(driver, monkeypatch, start_ns: int) -> tuple:
+    """Drive both of the driver's clocks by hand: ROS time, and the device's a fixed way behind.
+
+    Returns the ROS clock to set and the device's clock at ``start_ns``.
+    """
+    clock = ROSClock()
+    clock._set_ros_time_is_active(True)
+    device_start = time.monotonic() + 0.1  # the wand has been read at the monotonic clock
+    behind = start_ns * 1e-9 - device_start
+    monkeypatch.setattr(driver, 'get_clock', lambda: clock)
+    monkeypatch.setattr(driver, '_device_time', lambda: clock.now().nanoseconds * 1e-9 - behind)
+    clock.set_ros_time_override(Time(nanoseconds=start_ns))
+    return clock, device_start
+
+
+# A stamp whose seconds plus nanoseconds in floats fall below its nanoseconds in floats.
+START = 1_800_000_000_001_000_123
+assert 1_800_000_000 + 1_000_123e-9 < START * 1e-9
+
+
+@pytest.mark.parametrize('driver', [{'hold_while_late': 0.1}], indirect=True)
+def test_the_newest_model_holds_until_the_next_pose_is_sent_then_lives_its_lifetime(
+        driver, monkeypatch):
+    clock, device_start = set_clocks(driver, monkeypatch, START)
+    driver.tick()
+    driver.on_model(fields(stamp=divmod(START, 1_000_000_000), valid_for=0.01))
+    assert driver.renderer.packed[0, DEADLINE] == pytest.approx(device_start + 0.1, abs=1e-6)
+    clock.set_ros_time_override(Time(nanoseconds=START + 1_000_000))
+    driver.tick()  # the next pose, on time: no answer to it comes
+    assert driver.renderer.packed[0, DEADLINE] == pytest.approx(device_start + 0.01, abs=1e-6)
+
+
+@pytest.mark.parametrize('driver', [{'hold_while_late': 0.1, 'rendering': 'remote',
+                                     'passivity': False}],
+                         indirect=True)
+def test_a_held_wrench_no_answer_follows_stops_at_its_lifetime_with_the_hold_on(
+        driver, monkeypatch):
+    """The wrench of the newest pose, then a pose on time that nothing answers."""
+    clock, _ = set_clocks(driver, monkeypatch, START)
+    driver.tick()
+    driver.on_wrench([*divmod(START, 1_000_000_000), 'world', 0.0, 0.0, 2.0, 0.0, 0.0, 0.0])
+    clock.set_ros_time_override(Time(nanoseconds=START + 1_000_000))
+    driver.tick()
+    driver.device.applied()  # from here on
+    clock.set_ros_time_override(Time(nanoseconds=START + 21_000_000))
+    driver.device.read(driver._device_time())
+    force = driver.device.applied()[0]
+    pushing = force[2] / 2.0 * 80  # of the 80 servo periods of those 20 ms
+    assert 36 <= round(pushing) <= 37  # 9 ms on, to its lifetime; the period at its edge: either

@@ -1,9 +1,18 @@
 """The device-port passivity observer and controller: its books, and what it may and may not do."""
 import math
 
+import numpy as np
 import pytest
 
-from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER, PortPassivity
+from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER, bounded_shift, PortPassivity
+
+
+def test_observing_the_same_position_twice_books_nothing_more():
+    port = PortPassivity(max_damping=0.0)
+    port.control((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    port.observe((-0.002, 0.0, 0.0))
+    port.control((1.0, 0.0, 0.0), (-0.002, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    assert port.energy == pytest.approx(0.002)
 
 
 def test_the_observer_books_minus_the_work_of_the_held_force():
@@ -97,3 +106,53 @@ def test_with_a_late_stiff_wall_it_removes_the_energy_the_delay_creates():
     assert free > 1e-4  # the delayed wall pushes back harder than it was pushed: active
     assert controlled < 0.02 * free
     assert math.isfinite(controlled)
+
+
+def stored(springs, shift: float) -> float:
+    """Energy (J) in springs (depth m, stiffness N/m) moved out by ``shift``, summed plainly."""
+    return sum(0.5 * k * max(d - shift, 0.0) ** 2 for d, k in springs if k > 0.0)
+
+
+def least_shift(springs, energy: float) -> float:
+    """The least shift storing at most ``energy``, by bisection on ``stored`` (ground truth)."""
+    low, high = 0.0, max([d for d, _ in springs] + [0.0])
+    if stored(springs, low) <= energy:
+        return 0.0
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if stored(springs, middle) > energy else (low, middle)
+    return high
+
+
+def test_one_plane_moves_out_to_the_depth_its_energy_allows():
+    allowed = math.sqrt(2 * 0.005 / 400)  # the depth at which 400 N/m stores 5 mJ
+    assert bounded_shift([(0.01, 400.0)], 0.005) == pytest.approx(0.01 - allowed)
+    assert bounded_shift([(0.01, 400.0)], 0.0) == pytest.approx(0.01)
+    assert bounded_shift([(0.01, 400.0)], 0.02) == 0.0  # 0.02 J covers the 0.02 J it stores
+    assert bounded_shift([(0.01, 400.0)], -0.001) == pytest.approx(0.01)  # a deficit: none
+
+
+@pytest.mark.parametrize('seed', range(20))
+def test_several_planes_move_out_together_as_far_as_the_energy_requires(seed):
+    rng = np.random.default_rng(seed)
+    springs = [(float(rng.uniform(-0.005, 0.02)), float(10.0 ** rng.uniform(1.0, 5.0)))
+               for _ in range(int(rng.integers(1, 4)))]
+    energy = float(rng.uniform(0.0, 1.2) * stored(springs, 0.0))
+    shift = bounded_shift(springs, energy)
+    assert shift == pytest.approx(least_shift(springs, energy), abs=1e-9)
+    assert stored(springs, shift) <= energy * (1.0 + 1e-9) + 1e-15
+
+
+def test_planes_in_front_or_without_stiffness_store_nothing_and_move_nothing():
+    assert bounded_shift([(-0.01, 400.0), (0.01, 0.0)], 0.0) == 0.0
+    assert bounded_shift([], 0.0) == 0.0
+
+
+def test_a_lapse_of_the_watchdog_keeps_the_contact_s_books():
+    """Zero force because no law was alive is no break in contact: the books stay open."""
+    port = PortPassivity(max_damping=0.0)
+    port.control((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.001)
+    port.control((0.0, 0.0, 1.0), (0.0, 0.0, -0.002), (0.0, 0.0, 0.0), 0.001)  # 2 mJ taken in
+    for _ in range(2 * round(BOOKS_CLOSE_AFTER / 0.001)):
+        port.control((0.0, 0.0, 0.0), (0.0, 0.0, -0.002), (0.0, 0.0, 0.0), 0.001, lapsed=True)
+    assert port.energy == pytest.approx(0.002)

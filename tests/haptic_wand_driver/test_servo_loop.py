@@ -4,8 +4,9 @@ Two simulated wands, the same hand, the same models at the same instants. One is
 ``LocalRenderer`` as the driver gives it (compiled, ``servo_loop``); the other the same law behind
 a wrapper, which the wand runs in its Python loop through ``LocalRenderer.wrench``. Random
 models: up to three planes, tilted, with tool points off the tip (torque), stiff enough to
-saturate and to wake the port's passivity, valid for less than a tick or until the radius is
-left; held wrenches; a model dropped. Every state, force and energy must be the same float.
+saturate and to wake the port's passivity, met with the tip inside (the port's bound moves them
+out), valid for less than a tick or until the radius is left; held wrenches; a model dropped.
+Every state, force, energy and shift must be the same float.
 """
 import math
 
@@ -89,7 +90,8 @@ def _wand(law, hand: bool = True) -> SimulatedWand:
 def _row(wand: SimulatedWand, state, law: LocalRenderer) -> tuple:
     force, torque = wand.applied()
     return (*state.position, state.roll, state.yaw, *state.linear_velocity, state.roll_rate,
-            state.yaw_rate, *force, *torque, law.passivity.energy, law.passivity.net_work)
+            state.yaw_rate, *force, *torque, law.passivity.energy, law.passivity.net_work,
+            law.bound[0])
 
 
 def _run(seed: int, ratio: float, hand: bool):
@@ -129,6 +131,7 @@ def test_the_runs_compared_press_rotate_saturate_and_wake_the_passivity():
     assert np.linalg.norm(torque, axis=1).max() > 0.0
     assert np.linalg.norm(force, axis=1).max() > 7.9  # at the renderer's limits
     assert np.abs(compiled[:, 16]).max() > 0.0  # the passivity's books moved
+    assert compiled[:, 18].max() > 0.0  # models met inside were moved out by the port's bound
 
 
 @pytest.mark.parametrize('seed', range(3))

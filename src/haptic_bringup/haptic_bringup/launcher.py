@@ -63,6 +63,7 @@ RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
 REMOTE_PREFIX = '/remote'  # where the remote site's topics go in its bag
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
+LATE_POSE_HOLD = 0.5  # [s] past the stalls seen with the machine fully loaded (up to 0.45 s)
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
 # A session's bag holds what each site measured and what crossed the link, recorded where it
@@ -180,7 +181,9 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     keeps it: its controllers sit at the link's ports and do not see the device hold each force
     over a tick the machine stretched (on a loaded machine, up to +70 mJ given to the hand over
     a scan without it). On regular ticks it never acts (the lockstep scan is bit for bit the
-    same with it).
+    same with it). While the driver's next pose is late, the answer to the newest one holds until
+    it is sent, for at most ``LATE_POSE_HOLD``: an answer that expired inside a stretched tick let
+    the hand fall in, and the next one threw it back out (``haptic_wand_driver.answer_deadline``).
     """
     scheme = config.teleop
     driver = options.setdefault('wand_driver', {})
@@ -190,6 +193,7 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
         driver.setdefault('duration', SCAN_DURATION)
     driver['rendering'] = 'local' if scheme == 'model' else 'remote'
     driver['passivity'] = scheme != 'direct'
+    driver['hold_while_late'] = LATE_POSE_HOLD
     for node in ('teleop_leader', 'teleop_follower'):
         options.setdefault(node, {})['scheme'] = scheme
     if config.record:

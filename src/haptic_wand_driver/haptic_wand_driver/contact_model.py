@@ -126,9 +126,20 @@ class ContactModel:
                       position[2] - self.tip[2])
         return dx * dx + dy * dy + dz * dz <= self.valid_radius * self.valid_radius
 
+    def springs(self, position: Sequence[float], roll: float,
+                yaw: float) -> list[tuple[float, float]]:
+        """Each plane's (depth of its tool point behind it, stiffness along its normal), m, N/m."""
+        springs = []
+        for plane in self.planes:
+            n, k = plane.normal, plane.stiffness
+            springs.append((_depth(plane, position, rotate(plane.tool_point, roll, yaw)),
+                            k[0] * n[0] * n[0] + k[1] * n[1] * n[1] + k[2] * n[2] * n[2]))
+        return springs
+
     def wrench(self, position: Sequence[float], velocity: Sequence[float], roll: float,
                yaw: float, angular_velocity: Sequence[float],
-               contact_damping=None, limit: float = math.inf) -> tuple[Vector3, Vector3]:
+               contact_damping=None, limit: float = math.inf,
+               shift: float = 0.0) -> tuple[Vector3, Vector3]:
         """Force (N) and torque about the tip (N·m) of the planes on the tool, world frame.
 
         ``position``, ``velocity`` (3,) are the tip's; ``roll``, ``yaw`` (rad) its orientation;
@@ -137,17 +148,17 @@ class ContactModel:
         see ``local_rendering``); None adds none. It acts on the plane's force saturated to
         ``limit`` (N): damping added to an unsaturated spring and then saturated is lost
         whenever the spring alone passes the limit, and a deep tap then comes back out as hard
-        as it went in (at K = 1e5 N/m and 10 N the tool bounced off the wall).
+        as it went in (at K = 1e5 N/m and 10 N the tool bounced off the wall). ``shift`` (m)
+        moves every plane out along its normal (the port's bound on a switch,
+        ``port_passivity.bounded_shift``).
         """
         fx = fy = fz = tx = ty = tz = 0.0
         for plane in self.planes:
             arm = rotate(plane.tool_point, roll, yaw)
-            point = (position[0] + arm[0], position[1] + arm[1], position[2] + arm[2])
-            n = plane.normal
-            depth = (n[0] * (plane.point[0] - point[0]) + n[1] * (plane.point[1] - point[1])
-                     + n[2] * (plane.point[2] - point[2]))
+            depth = _depth(plane, position, arm) - shift
             if depth <= 0.0:
                 continue
+            n = plane.normal
             spin = _cross(angular_velocity, arm)
             speed = (velocity[0] + spin[0], velocity[1] + spin[1], velocity[2] + spin[2])
             f = unilateral_spring_damper((depth * n[0], depth * n[1], depth * n[2]), n, speed,
@@ -159,6 +170,13 @@ class ContactModel:
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
         return (fx, fy, fz), (tx, ty, tz)
+
+
+def _depth(plane: Plane, position: Sequence[float], arm: Vector3) -> float:
+    """How far (m) the tool point at ``arm`` from the tip lies behind ``plane``."""
+    n, p = plane.normal, plane.point
+    return (n[0] * (p[0] - (position[0] + arm[0])) + n[1] * (p[1] - (position[1] + arm[1]))
+            + n[2] * (p[2] - (position[2] + arm[2])))
 
 
 def _damped_along(force: Vector3, normal: Vector3, velocity: Sequence[float],

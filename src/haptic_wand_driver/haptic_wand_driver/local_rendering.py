@@ -19,23 +19,29 @@ pushes, it adds ``contact_damping_ratio`` × 2 sqrt(K_n m_n) (1: critical), capp
 rigid surface, and energy only ever taken out. It is taken off the plane's force already saturated
 to the limit, so a wall pressed past its force limit still takes energy out on the way back.
 
+Passive at any tick rate: the first servo period that renders a model's planes moves them out as
+far as the port's books require (``port_passivity.bounded_shift``), and keeps that shift for the
+model's life. A model that comes after a late tick, the one before expired and the hand in
+deeper, then gives back no more than the hand put in.
+
 A model renders from the servo period that holds its ``since`` (the device's clock when it
 arrived), and what was held before renders the periods until then: so a device that runs its
 periods after the fact (the simulated wand, on each read) switches where a real one would,
 without being advanced at every arrival. One ``take`` at a time: a device must have run the
 period of the last ``since`` before the next ``take``, or that model is never rendered.
 
-Thread safety: ``take`` swaps one tuple, which a servo thread reads whole; the passivity books are
-the servo thread's alone.
+Thread safety: ``take`` swaps one tuple, which a servo thread reads whole; the passivity books and
+``bound`` are the servo thread's alone.
 
 ``packed`` is the same as floats for the simulated wand's compiled servo loop (``servo_loop``,
 run in the thread that calls ``take``: the packing is not atomic), rewritten by every ``take``,
 ``take_wrench`` or ``clear``: row 0 the law from its ``since`` on, row 1 the one before. A row:
 the force and torque limits, the contact damping ratio, the mass (3); the mode (``MODE_*``), the
 deadline, the model's force limit, valid radius and tip (3), the held wrench (6), the plane
-count, the damping cap per mass and period (``MAX_DAMPING_PER_MASS``), ``since``; from
-``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point, normal, stiffness, damping, tool
-point).
+count, the damping cap per mass and period (``MAX_DAMPING_PER_MASS``), ``since``, the take's
+number; from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point, normal, stiffness,
+damping, tool point). ``bound`` is the shift the port's bound set (m) and the number of the take
+it was set for.
 """
 import math
 from typing import Sequence
@@ -44,16 +50,16 @@ import numpy as np
 
 from haptic_wand_driver.contact_model import ContactModel, Kind, MAX_PLANES
 from haptic_wand_driver.orientation import roll_axis
-from haptic_wand_driver.port_passivity import PortPassivity
+from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
 from haptic_wand_driver.wrench_input import saturate_components
 
-__all__ = ['LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE', 'MODE_PLANES',
-           'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SINCE']
+__all__ = ['DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE',
+           'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE']
 
 _ZERO = (0.0, 0.0, 0.0)
 MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
 MODE_NONE, MODE_WRENCH, MODE_PLANES = 0.0, 1.0, 2.0  # what ``packed`` holds
-SINCE, PLANES_AT, PLANE_SIZE = 21, 22, 15
+DEADLINE, SINCE, SERIAL, PLANES_AT, PLANE_SIZE = 7, 21, 22, 23, 15
 LAW_SIZE = PLANES_AT + MAX_PLANES * PLANE_SIZE
 _NOTHING = (None, None, -math.inf)  # (model, wrench, deadline) held
 
@@ -82,7 +88,9 @@ class LocalRenderer:
         self.mass = tuple(mass)
         self.contact_damping_ratio = contact_damping_ratio
         self.packed = np.zeros((2, LAW_SIZE))  # (servo_loop's layout)
-        self._held = (_NOTHING, _NOTHING, -math.inf)  # before since, from since, since
+        self.bound = np.array([0.0, -1.0])  # the shift of the planes, the take it is for
+        self._held = ((*_NOTHING, 0),) * 2 + (-math.inf,)  # before since, from since, since
+        self._takes = 0
         self.clear()
 
     def take(self, model: ContactModel, deadline: float, since: float = -math.inf) -> None:
@@ -104,15 +112,23 @@ class LocalRenderer:
         """Drop what is held, as ``take``: zero force until the next model or wrench."""
         self._hold(_NOTHING, since, MODE_NONE, 0.0, 0.0, _ZERO, _ZERO * 2, 0, [])
 
+    def expire(self, deadline: float) -> None:
+        """Render what is held now until ``deadline`` (the device's clock, s) at the latest."""
+        before, (model, wrench, held_deadline, take), since = self._held
+        deadline = min(deadline, held_deadline)
+        self.packed[0, DEADLINE] = deadline
+        self._held = (before, (model, wrench, deadline, take), since)
+
     def _hold(self, held: tuple, since: float, mode, force_limit, valid_radius, tip, wrench,
               count, planes) -> None:
         """Hold ``held`` from ``since`` on, and what was held before until then."""
+        self._takes += 1
         self.packed[1] = self.packed[0]
         self.packed[0, :PLANES_AT + len(planes)] = (
             self.force_limit, self.torque_limit, self.contact_damping_ratio, *self.mass, mode,
             held[2], force_limit, valid_radius, *tip, *wrench, count, MAX_DAMPING_PER_MASS,
-            since, *planes)
-        self._held = (self._held[1], held, since)
+            since, self._takes, *planes)
+        self._held = (self._held[1], (*held, self._takes), since)
 
     def wrench(self, time: float, coordinates: Sequence[float], rates: Sequence[float],
                period: float) -> tuple[tuple, tuple]:
@@ -122,7 +138,7 @@ class LocalRenderer:
         roll, yaw) and their rates; ``period`` the servo period (s).
         """
         before, held, since = self._held
-        model, wrench, deadline = held if time + period > since else before
+        model, wrench, deadline, take = held if time + period > since else before
         position, velocity = coordinates[:3], rates[:3]
         force, torque = _ZERO, _ZERO
         limit = self.force_limit
@@ -134,10 +150,21 @@ class LocalRenderer:
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
             limit = min(self.force_limit, model.force_limit)
             force, torque = model.wrench(position, velocity, coordinates[3], coordinates[4],
-                                         spin, self._contact_damping(period), limit)
-        force = self.passivity.control(force, position, velocity, period)
+                                         spin, self._contact_damping(period), limit,
+                                         self._shift(model, take, coordinates))
+        force = self.passivity.control(force, position, velocity, period,
+                                       time + period > deadline)
         return (saturate_components(force, limit),
                 saturate_components(torque, self.torque_limit))
+
+    def _shift(self, model: ContactModel, take: int, coordinates: Sequence[float]) -> float:
+        """Return the shift of ``model``'s planes, set by the port's bound at its first period."""
+        if take != self.bound[1]:
+            self.passivity.observe(coordinates[:3])
+            self.bound[:] = (bounded_shift(model.springs(coordinates, coordinates[3],
+                                                         coordinates[4]),
+                                           self.passivity.energy), take)
+        return float(self.bound[0])
 
     def _contact_damping(self, period: float):
         """Return the per-plane damping for this servo period (None when the ratio is zero)."""

@@ -2,8 +2,9 @@
 
 Publishes ``wand/pose`` (PoseStamped) and ``wand/twist`` (TwistStamped) at ``rate``, and applies
 each ``wand/wrench`` (WrenchStamped) to the device when it arrives. A wrench older than
-``wrench_timeout``, or one with NaN, gives zero force. The wrench's stamp is the stamp of the pose
-it answers, so the driver measures the loop's round trip (``stats_file``).
+``wrench_timeout``, or one with NaN, gives zero force; while the next pose is late, the answer to
+the newest one may hold longer (``hold_while_late``, ``answer_deadline``). The wrench's stamp is
+the stamp of the pose it answers, so the driver measures the loop's round trip (``stats_file``).
 """
 import enum
 import math
@@ -26,6 +27,7 @@ from haptic_util.paths import resolve_path
 from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
+from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
 from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
 from haptic_wand_driver.experiments import make_script, needs_scene, surface_projection
@@ -80,6 +82,8 @@ class WandDriverNode(Node):
         # only when enabled.
         self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
         self.renderer = self._local_renderer() if params.rendering == 'local' else None
+        self.answers = AnswerDeadline(params.hold_while_late)
+        self._applied = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))  # the wrench the device holds
         self._model_stamp = -math.inf  # of the newest model taken
         self._since = -math.inf  # the device's clock when the renderer last switched
         self._period = 1.0 / params.rate
@@ -175,6 +179,8 @@ class WandDriverNode(Node):
                 self._apply(now, state)
             self.stats.sent(now_ns)
             self._publish(state, now_ns)
+            if self.answers.sent(now, clock_ns(self.get_clock()) * 1e-9):
+                self._rearm()  # out and not answered yet: the held answer stops holding
             if self.params.duration and device_now - self._probe_start >= self.params.duration:
                 self._phase = Phase.DONE
                 self.get_logger().info(f'experiment done after {self.params.duration:g} s')
@@ -248,12 +254,15 @@ class WandDriverNode(Node):
         refusal = self._take(wrench, stamp_ns * 1e-9, now)
         if refusal is not None:
             self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
+        else:
+            self.answers.taken(stamp_ns * 1e-9, self.params.wrench_timeout)
         self._apply(now, state)
 
     def on_model(self, fields: Sequence) -> None:
         """Hand a contact model to the device's renderer; a bad one gives zero force."""
         now_ns = clock_ns(self.get_clock())
-        if not self._answered(fields[0] * 1_000_000_000 + fields[1], now_ns):
+        stamp_ns = fields[0] * 1_000_000_000 + fields[1]
+        if not self._answered(stamp_ns, now_ns):
             return
         try:
             model = ContactModel.from_fields(fields, self.params.frame_id)
@@ -266,7 +275,9 @@ class WandDriverNode(Node):
             return
         self._model_stamp = model.stamp
         since = self._arrival()
-        deadline = model.stamp + model.valid_for - self._ros_minus_device()
+        # From the nanoseconds, as the pose's was: seconds plus nanoseconds round otherwise.
+        self.answers.taken(stamp_ns * 1e-9, model.valid_for)
+        deadline = self.answers.deadline - self._ros_minus_device()
         if model.kind == Kind.UNAVAILABLE:
             self.renderer.take_wrench(model.held_wrench[:3], model.held_wrench[3:], deadline,
                                       since)
@@ -304,11 +315,19 @@ class WandDriverNode(Node):
 
         ``now`` is ROS time, the clock of the stamps.
         """
-        wrench = self.wrench
-        force, torque = wrench.current(now, state.yaw)
+        force, torque = self.wrench.current(now, state.yaw, self.answers.deadline)
         force = self.passivity.control(force, state.position, state.linear_velocity,
                                        self._period)
-        self.device.apply(force, torque, until=wrench.expiry - self._ros_minus_device())
+        self._applied = (force, torque)
+        self.device.apply(force, torque, until=self.answers.deadline - self._ros_minus_device())
+
+    def _rearm(self) -> None:
+        """Give what the device holds the held answer's deadline, once that moved."""
+        until = self.answers.deadline - self._ros_minus_device()
+        if self.renderer is not None:
+            self.renderer.expire(until)
+        else:
+            self.device.apply(*self._applied, until=until)
 
     def _take(self, wrench: list, stamp: float, now: float) -> Refusal | None:
         """Hand a received wrench (``WRENCH`` leaves) to the command; return why it was refused."""
@@ -339,7 +358,7 @@ class WandDriverNode(Node):
                                                    or answered < BEHIND_ANSWERED)
         values = {'phase': self._phase.value, 'published': self._published,
                   'recent_rate_hz': rate, 'recent_answered_percent': answered,
-                  'refused': self._refused.total(),
+                  'refused': self._refused.total(), 'late_poses': self.answers.late,
                   **{f'refused: {kind}': n for kind, n in self._refused.counts.items()},
                   'port_net_work_j': self.passivity.net_work, **summary}
         return Report(WARN if behind else OK,

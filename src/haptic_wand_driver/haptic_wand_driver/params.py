@@ -22,6 +22,11 @@ class WandDriverParams:
                                 unit='s', low=0.0)
     wrench_timeout: float = parameter(0.010, 'a wrench older than this is stale: zero force',
                                       unit='s', low=0.0005, high=1.0)
+    hold_while_late: float = parameter(0.0, 'while the next pose is late (a busy machine), the '
+                                       'answer to the newest pose holds until it is sent, at '
+                                       'most this long after its pose (at most the answer\'s '
+                                       'lifetime, 0 say: that lifetime only)', unit='s',
+                                       low=0.0, high=1.0)
     rendering: str = parameter('local', 'local: the device renders the contact model at its servo '
                                'rate; remote: it applies the wrench as it arrives',
                                choices=('local', 'remote'))

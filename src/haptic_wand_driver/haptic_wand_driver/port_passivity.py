@@ -16,13 +16,24 @@ creates no direction the force did not have (damping along the velocity pushed s
 tip sliding off a wall), amplifies nothing, and never pulls the tip in.
 
 The books close once the force has been zero for ``BOOKS_CLOSE_AFTER``, the same policy as the
-renderer's controller; ``force_renderer.passivity`` says why.
+renderer's controller; ``force_renderer.passivity`` says why. A lapse does not count: a force
+that is zero because the watchdog let no law through (a late tick, a stalled loop) has not left
+the contact, and what the hand put in before stays on the books.
+
+A switch of law is bounded by the same books (``bounded_shift``). A law that renders springs (a
+contact model's planes) taken with the tip already behind them would store energy the hand never
+put in, and give it back as the tip is pushed out. That is what a late tick does: the model held
+expires before the next one comes, the force drops to zero, the hand pushes the tip in, and the
+next model meets it deeper (a hand pressing a wall through late ticks got 58-120 mJ back). So at a
+switch the planes are moved out along their normals until they store no more than the port has
+absorbed in this contact, as passive set-position modulation does (Lee and Huang, IEEE T-RO
+2010): what the hand put in comes back at most, however late the switch.
 """
 import math
 
 import numpy as np
 
-__all__ = ['BOOKS_CLOSE_AFTER', 'PortPassivity']
+__all__ = ['BOOKS_CLOSE_AFTER', 'PortPassivity', 'bounded_shift']
 
 BOOKS_CLOSE_AFTER = 0.05  # [s] of zero force that ends a contact's books (a bounce is shorter)
 
@@ -50,7 +61,7 @@ class PortPassivity:
         self._free = 0.0  # [s] since the force went to zero
 
     def control(self, force: Vector3, position: Vector3, velocity: Vector3,
-                period: float) -> Vector3:
+                period: float, lapsed: bool = False) -> Vector3:
         """Return the force to apply now, given the rendered one and the tip's motion.
 
         Parameters
@@ -63,13 +74,17 @@ class PortPassivity:
             The tip's velocity now.
         period : float, s
             Time until the next call (the servo period).
+        lapsed : bool
+            Whether the force is zero because the device's watchdog let nothing through (no law
+            alive): the contact has not ended, so the period does not count toward closing the
+            books.
         """
-        self._observe(position)
+        self.observe(position)
         # Products, not ** 2: glibc's pow(x, 2) differs from x * x in the last bit now and then
         # (1,647 of 2e6 draws here), and the compiled loop multiplies.
         magnitude = math.sqrt(force[0] * force[0] + force[1] * force[1] + force[2] * force[2])
         if magnitude == 0.0:
-            self._free += period
+            self._free += 0.0 if lapsed else period
             if self._free >= BOOKS_CLOSE_AFTER:
                 self.energy = 0.0
             self._force = (0.0, 0.0, 0.0)
@@ -102,11 +117,31 @@ class PortPassivity:
         self._force = (fx, fy, fz)
         self._position = (px, py, pz) if known else None
 
-    def _observe(self, position: Vector3) -> None:
-        """Book the work the held force did on the tip since the last call."""
+    def observe(self, position: Vector3) -> None:
+        """Book the work the held force did on the tip since the last call (again: nothing)."""
         if self._position is not None:
             f, p, q = self._force, self._position, position
             work = f[0] * (q[0] - p[0]) + f[1] * (q[1] - p[1]) + f[2] * (q[2] - p[2])
             self.energy -= work
             self.net_work += work
         self._position = (position[0], position[1], position[2])
+
+
+def bounded_shift(springs, energy: float) -> float:
+    """Return how far (m) to move planes out so that they store at most ``energy`` (J).
+
+    ``springs`` are each plane's (depth, stiffness along its normal), m and N/m; every plane moves
+    out by the same shift s >= 0, the least for which sum(k max(d - s, 0)^2 / 2) <= energy. The
+    deepest planes are taken first: while m of them are behind the shifted planes the sum is a
+    quadratic in s, whose smaller root is the shift if it lies before the next plane's depth.
+    """
+    behind = sorted(((d, k) for d, k in springs if d > 0.0 and k > 0.0), reverse=True)
+    a = b = c = 0.0
+    for m, (depth, stiffness) in enumerate(behind):
+        a += stiffness
+        b += stiffness * depth
+        c += stiffness * depth * depth
+        shift = (b - math.sqrt(max(b * b - a * (c - 2.0 * energy), 0.0))) / a
+        if m + 1 == len(behind) or shift >= behind[m + 1][0]:
+            return max(shift, 0.0)
+    return 0.0

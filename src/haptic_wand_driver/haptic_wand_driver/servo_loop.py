@@ -13,6 +13,7 @@ before its loop starts. Its inputs, float64 arrays:
 * ``packed`` (2, n): the renderer's settings and what it holds, from a period on and before it
   (``LocalRenderer.packed``, whose layout ``local_rendering`` defines);
 * ``books``: the port's passivity (``PortPassivity.books``);
+* ``bound``: the shift of the planes and the take it was set for (``LocalRenderer.bound``);
 * ``joints`` (5, 6): per joint, the hand's stiffness and damping, the inverse inertia, the
   damping decay per period and the workspace stops (lower, upper);
 * ``targets`` (n, 2, 5): the hand's target and its rate at each period.
@@ -22,8 +23,8 @@ import math
 from numba import njit
 import numpy as np
 
-from haptic_wand_driver.local_rendering import (LAW_SIZE, MODE_PLANES, MODE_WRENCH, PLANE_SIZE,
-                                                PLANES_AT, SINCE)
+from haptic_wand_driver.local_rendering import (DEADLINE, LAW_SIZE, MODE_PLANES, MODE_WRENCH,
+                                                PLANE_SIZE, PLANES_AT, SERIAL, SINCE)
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
 
 __all__ = ['advance', 'compile_now']
@@ -75,20 +76,65 @@ def _plane_force(law, at, depth, vx, vy, vz, limit, period):
 
 
 @njit(cache=True, nogil=True)
-def _planes(law, coordinates, rates, limit, period):
-    """Force and torque of the held planes (``ContactModel.wrench``), world frame."""
+def _arm(law, at, cr, sr, cy, sy):
+    """Return the tool point of the plane at ``at``, turned by the wand's roll and yaw."""
+    x, y, z = law[at + 12], law[at + 13], law[at + 14]
+    y, z = cr * y - sr * z, sr * y + cr * z
+    return cy * x - sy * y, sy * x + cy * y, z
+
+
+@njit(cache=True, nogil=True)
+def _depth(law, at, coordinates, ax, ay, az):
+    """How far the tool point at (ax, ay, az) from the tip lies behind the plane at ``at``."""
+    return (law[at + 3] * (law[at] - (coordinates[0] + ax))
+            + law[at + 4] * (law[at + 1] - (coordinates[1] + ay))
+            + law[at + 5] * (law[at + 2] - (coordinates[2] + az)))
+
+
+@njit(cache=True, nogil=True)
+def _bounded_shift(law, coordinates, energy):
+    """Return the planes' shift that stores at most ``energy`` (``bounded_shift``)."""
+    roll, yaw = coordinates[3], coordinates[4]
+    cr, sr, cy, sy = math.cos(roll), math.sin(roll), math.cos(yaw), math.sin(yaw)
+    depths, stiffnesses = np.empty(3), np.empty(3)
+    behind = 0
+    for k in range(int(law[19])):
+        at = PLANES_AT + PLANE_SIZE * k
+        ax, ay, az = _arm(law, at, cr, sr, cy, sy)
+        depth = _depth(law, at, coordinates, ax, ay, az)
+        nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
+        stiffness = law[at + 6] * nx * nx + law[at + 7] * ny * ny + law[at + 8] * nz * nz
+        if not (depth > 0.0 and stiffness > 0.0):
+            continue
+        j = behind  # deepest first, as sorted() orders the (depth, stiffness) pairs
+        while j > 0 and (depths[j - 1] < depth
+                         or (depths[j - 1] == depth and stiffnesses[j - 1] < stiffness)):
+            depths[j], stiffnesses[j] = depths[j - 1], stiffnesses[j - 1]
+            j -= 1
+        depths[j], stiffnesses[j] = depth, stiffness
+        behind += 1
+    a = b = c = 0.0
+    for m in range(behind):
+        a += stiffnesses[m]
+        b += stiffnesses[m] * depths[m]
+        c += stiffnesses[m] * depths[m] * depths[m]
+        shift = (b - math.sqrt(max(b * b - a * (c - 2.0 * energy), 0.0))) / a
+        if m + 1 == behind or shift >= depths[m + 1]:
+            return max(shift, 0.0)
+    return 0.0
+
+
+@njit(cache=True, nogil=True)
+def _planes(law, coordinates, rates, limit, period, shift):
+    """Force and torque of the held planes moved out by ``shift`` (``ContactModel.wrench``)."""
     roll, yaw = coordinates[3], coordinates[4]
     cr, sr, cy, sy = math.cos(roll), math.sin(roll), math.cos(yaw), math.sin(yaw)
     wx, wy, wz = rates[3] * cy, rates[3] * sy, rates[3] * 0.0 + rates[4]
     fx = fy = fz = tx = ty = tz = 0.0
     for k in range(int(law[19])):
         at = PLANES_AT + PLANE_SIZE * k
-        x, y, z = law[at + 12], law[at + 13], law[at + 14]
-        y, z = cr * y - sr * z, sr * y + cr * z
-        ax, ay, az = cy * x - sy * y, sy * x + cy * y, z
-        depth = (law[at + 3] * (law[at] - (coordinates[0] + ax))
-                 + law[at + 4] * (law[at + 1] - (coordinates[1] + ay))
-                 + law[at + 5] * (law[at + 2] - (coordinates[2] + az)))
+        ax, ay, az = _arm(law, at, cr, sr, cy, sy)
+        depth = _depth(law, at, coordinates, ax, ay, az) - shift
         if depth <= 0.0:
             continue
         sx, sy_, sz = _cross(wx, wy, wz, ax, ay, az)
@@ -101,17 +147,24 @@ def _planes(law, coordinates, rates, limit, period):
 
 
 @njit(cache=True, nogil=True)
-def _passive(books, fx, fy, fz, coordinates, rates, period):
-    """Return the force the port's passivity controller lets through (``PortPassivity``)."""
+def _observe(books, coordinates):
+    """Book the work the held force did since the last period (``PortPassivity.observe``)."""
     if books[8] != 0.0:
         work = (books[2] * (coordinates[0] - books[5]) + books[3] * (coordinates[1] - books[6])
                 + books[4] * (coordinates[2] - books[7]))
         books[0] -= work
         books[1] += work
     books[5], books[6], books[7], books[8] = coordinates[0], coordinates[1], coordinates[2], 1.0
+
+
+@njit(cache=True, nogil=True)
+def _passive(books, fx, fy, fz, coordinates, rates, period, lapsed):
+    """Return the force the port's passivity controller lets through (``PortPassivity``)."""
+    _observe(books, coordinates)
     magnitude = math.sqrt(fx * fx + fy * fy + fz * fz)
     if magnitude == 0.0:
-        books[9] += period
+        if not lapsed:
+            books[9] += period
         if books[9] >= BOOKS_CLOSE_AFTER:
             books[0] = 0.0
         books[2] = books[3] = books[4] = 0.0
@@ -132,12 +185,12 @@ def _passive(books, fx, fy, fz, coordinates, rates, period):
 
 
 @njit(cache=True, nogil=True)
-def _law_wrench(packed, books, time, coordinates, rates, period):
+def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     """Return what ``LocalRenderer.wrench`` renders this period: force and torque, saturated."""
     law = packed[0] if time + period > packed[0, SINCE] else packed[1]
     fx = fy = fz = tx = ty = tz = 0.0
     limit = law[0]
-    mode, live = law[6], time + period <= law[7]
+    mode, live = law[6], time + period <= law[DEADLINE]
     if mode == MODE_WRENCH and live:
         fx, fy, fz, tx, ty, tz = law[13], law[14], law[15], law[16], law[17], law[18]
     elif mode == MODE_PLANES and live:
@@ -145,16 +198,19 @@ def _law_wrench(packed, books, time, coordinates, rates, period):
         if dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
             if law[8] < limit:
                 limit = law[8]
-            fx, fy, fz, tx, ty, tz = _planes(law, coordinates, rates, limit, period)
-    fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period)
+            if law[SERIAL] != bound[1]:  # the port's bound, at the model's first period
+                _observe(books, coordinates)
+                bound[0], bound[1] = _bounded_shift(law, coordinates, books[0]), law[SERIAL]
+            fx, fy, fz, tx, ty, tz = _planes(law, coordinates, rates, limit, period, bound[0])
+    fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period, not live)
     fx, fy, fz = _saturate(fx, fy, fz, limit)
     tx, ty, tz = _saturate(tx, ty, tz, law[1])
     return fx, fy, fz, tx, ty, tz
 
 
 @njit(cache=True, nogil=True)
-def advance(coordinates, rates, joints, targets, packed, books, force_limit, torque_limit, start,
-            first, step, rendered, edges, pushing):
+def advance(coordinates, rates, joints, targets, packed, books, bound, force_limit, torque_limit,
+            start, first, step, rendered, edges, pushing):
     """Run ``len(targets)`` servo periods from period ``first``, in place.
 
     Adds each period's force and torque to ``rendered`` (6,), writes to ``edges`` the periods at
@@ -163,8 +219,8 @@ def advance(coordinates, rates, joints, targets, packed, books, force_limit, tor
     written = 0
     for k in range(targets.shape[0]):
         done = first + k
-        fx, fy, fz, tx, ty, tz = _law_wrench(packed, books, start + done * step, coordinates,
-                                             rates, step)
+        fx, fy, fz, tx, ty, tz = _law_wrench(packed, books, bound, start + done * step,
+                                             coordinates, rates, step)
         fx, fy, fz = _saturate(fx, fy, fz, force_limit)
         tx, ty, tz = _saturate(tx, ty, tz, torque_limit)
         rendered[0] += fx
@@ -205,4 +261,5 @@ def compile_now() -> None:
     """Compile ``advance`` for the types the wand passes (or load it from numba's cache)."""
     advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)),
             np.zeros((2, LAW_SIZE)),
-            np.zeros(11), 1.0, 1.0, 0.0, 0, 1.0, np.zeros(6), np.empty(0, dtype=np.int64), False)
+            np.zeros(11), np.zeros(2), 1.0, 1.0, 0.0, 0, 1.0, np.zeros(6),
+            np.empty(0, dtype=np.int64), False)

@@ -295,7 +295,7 @@ class SimulatedWand(HapticDevice):
         edges = np.empty(target_steps - first, dtype=np.int64)
         books, limits = law.passivity.books(), self._config.limits
         pushing, written = self._compiled(
-            coordinates, rates, self._joint_table, targets, law.packed, books,
+            coordinates, rates, self._joint_table, targets, law.packed, books, law.bound,
             limits.force_limit, limits.torque_limit, self._start, first, step, rendered, edges,
             self._pushing)
         law.passivity.restore(books)

@@ -132,7 +132,8 @@ class WrenchCommand:
         """Whether a wrench is held and at most ``timeout`` old at ``now`` (s)."""
         return self._stamp is not None and now - self._stamp <= self._timeout
 
-    def current(self, now: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+    def current(self, now: float, yaw: float,
+                expiry: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Return the wrench to apply at ``now``: zero unless fresh; actuatable; saturated.
 
         Parameters
@@ -140,6 +141,9 @@ class WrenchCommand:
         now : float, s
         yaw : float, rad
             The wand's current yaw, which sets its roll axis.
+        expiry : float or None, s
+            When the held wrench stops being fresh, if not ``timeout`` after its stamp (the
+            driver's ``answer_deadline``).
 
         Returns
         -------
@@ -147,7 +151,9 @@ class WrenchCommand:
         torque : (3,) float, N·m, workspace frame
             Only its components about the roll axis and z remain (no pitch torque).
         """
-        if not self.is_fresh(now):
+        fresh = (self.is_fresh(now) if expiry is None
+                 else self._stamp is not None and now <= expiry)
+        if not fresh:
             return np.zeros(3), np.zeros(3)
         x, y, z = roll_axis(yaw)
         torque_x, torque_y, torque_z = self._torque
