@@ -12,7 +12,7 @@ import pytest
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import published_counts, PUBLISHERS, topic_counts
+from haptic_bringup.session import published_counts, PUBLISHERS, read_vectors, topic_counts
 
 RUNNING = 2.0  # [s] of tapping before the Ctrl-C
 START_TIMEOUT = 180.0  # [s] imports and, on a cold cache, compiling the kernels
@@ -47,6 +47,7 @@ def test_a_ctrl_c_stops_the_command_cleanly_and_the_bag_holds_everything_publish
         try:
             assert closed(output, command), output.read_text()[-3000:]
             time.sleep(RUNNING)
+            interrupted = time.time()
             os.killpg(command.pid, signal.SIGINT)
             time.sleep(GAP)
             os.killpg(command.pid, signal.SIGINT)
@@ -64,4 +65,7 @@ def test_a_ctrl_c_stops_the_command_cleanly_and_the_bag_holds_everything_publish
     recorded = topic_counts(tmp_path / 'bag')
     assert set(published) == set(PUBLISHERS)
     assert {topic: recorded[topic] for topic in PUBLISHERS} == published
-    assert published['/wand/pose'] >= 0.5 * RUNNING * 1000  # it ran, at about 1 kHz
+    stamps, _ = read_vectors(tmp_path / 'bag', typestore_with(custom_definitions()),
+                             {'/wand/pose': 'pose'}, stamped=True)['/wand/pose']
+    # It ran until the Ctrl-C: its rate, which CI's load sets, is bench_loop's business.
+    assert len(stamps) >= 100 and stamps[-1] >= interrupted - RUNNING / 2
