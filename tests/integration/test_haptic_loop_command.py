@@ -47,6 +47,7 @@ def test_a_ctrl_c_stops_the_command_cleanly_and_the_bag_holds_everything_publish
         try:
             assert closed(output, command), output.read_text()[-3000:]
             time.sleep(RUNNING)
+            interrupted = time.time()
             os.killpg(command.pid, signal.SIGINT)
             time.sleep(GAP)
             os.killpg(command.pid, signal.SIGINT)
@@ -66,4 +67,5 @@ def test_a_ctrl_c_stops_the_command_cleanly_and_the_bag_holds_everything_publish
     assert {topic: recorded[topic] for topic in PUBLISHERS} == published
     stamps, _ = read_vectors(tmp_path / 'bag', typestore_with(custom_definitions()),
                              {'/wand/pose': 'pose'}, stamped=True)['/wand/pose']
-    assert stamps[-1] - stamps[0] >= RUNNING  # it ran until the Ctrl-C; its rate is bench_loop's
+    # It ran until the Ctrl-C: its rate, which CI's load sets, is bench_loop's business.
+    assert len(stamps) >= 100 and stamps[-1] >= interrupted - RUNNING / 2
