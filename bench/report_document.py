@@ -15,7 +15,8 @@ from report_sections import (counts_section, DEFINITIONS, error_time_section,
                              experiment_section, extreme_section, force_effect_section,
                              headline_section, identical_modes, interval_table, loop_section,
                              provenance_section, servo_section, stiff_wall_section,
-                             sweep_section, table_2, table_3, teleop_section, tradeoff_section)
+                             sweep_section, table_2, table_3, teleop_load_section, teleop_section,
+                             tradeoff_section)
 import result_files
 
 __all__ = ['Findings', 'readme']
@@ -210,7 +211,7 @@ def _teleop_chapter(findings: Findings) -> list[str]:
         'chatters), *model* (the remote site\'s contact estimate rendered by the wand at '
         'its servo rate, updated passively). *Lockstep* runs the same pieces on one clock '
         'without ROS (`bench/teleop_lockstep.py`); *ROS 2* runs both sites as processes in two '
-        'DDS domains with the link bridge between them (`bench/teleop_scan.py`, as '
+        'DDS domains joined by the site gateways (`bench/teleop_scan.py`, as '
         '`haptic_loop --teleop`). Every figure comes from what the device applied to the hand '
         'and what the remote sensor measured: *stable* is a net work of the applied force on '
         'the hand ≤ 0 and an oscillation (RMS of the felt force about its 0.25 s mean, in '
@@ -226,6 +227,14 @@ def _teleop_chapter(findings: Findings) -> list[str]:
               if (findings.results / TELEOP_FIGURE).exists() else [])
     parts += _stored(findings, 'teleop_scan', lambda rows: [
         teleop_section([{**r, 'source': 'ROS 2'} for r in rows]), '', *figure])
+    parts += ['### On a busy machine', '',
+              'The issue\'s command, `haptic_loop --teleop SCHEME --delay 0.1 --jitter 0.01 '
+              '--loss 0.01 --duration 20`, quiet, with one core kept busy by another process '
+              '(*hogged*) and with both (*busy*), from this tree (*fix*) and from the code '
+              'before it, alternated in one run (`bench/teleop_load.py`). Read from the bags; '
+              'a session that pressed the patient less than 5 s says nothing of stability.', '']
+    parts += _stored(findings, 'teleop_load', lambda stored: [
+        teleop_load_section(stored['rows']), f'Code before: `{stored["baseline"]}`.', ''])
     parts += ['### The demo\'s scan', '',
               'Measured by this run, from the bag `demo` recorded: model-mediated over a 50 ms '
               'link with 5 ms jitter and 1 % loss.', '']

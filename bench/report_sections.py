@@ -16,6 +16,7 @@ from report_paper_replay import PaperReplay
 from report_recordings import NO_FORCE_RUN, Recording
 from report_truth import Truth
 import stiffness_sweep
+from teleop_load import verdict
 
 from collision_engine import read_scene
 from collision_engine.mesh_io import load_mesh
@@ -24,8 +25,8 @@ from haptic_bringup.contacts import contact_intervals, MIN_FORCE
 __all__ = ['DEFINITIONS', 'counts_section', 'error_time_section', 'experiment_section',
            'extreme_section', 'force_effect_section', 'headline_section', 'identical_modes',
            'interval_table', 'loop_section', 'provenance_section', 'servo_section',
-           'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'teleop_section',
-           'tradeoff_section']
+           'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'teleop_load_section',
+           'teleop_section', 'tradeoff_section']
 
 
 def provenance_section(info: dict, recordings: dict, argv: list) -> str:
@@ -405,3 +406,16 @@ def teleop_section(rows: list) -> str:
           f'{1e3 * r["net_work_j"]:+.1f}', f'{r["oscillation_percent"]:.1f}',
           number(r['transparency_n'], '.2f'), number(r['transparency_percent'], '.1f'),
           f'{r["peak_patient_n"]:.2f}', f'{1e3 * r["tracking_m"]:.1f}'] for r in rows])
+
+
+def teleop_load_section(rows: list) -> str:
+    """Tabulate the scan quiet and with cores hogged, the fix beside the code before it."""
+    return markdown_table(
+        ['scheme', 'load', 'code', 'poses (Hz)', 'poses > 10 ms late', 'longest gap (ms)',
+         'remote site (Hz)', 'link silences', 'stable', 'in contact (s)',
+         'net work on the hand (mJ)', 'oscillation (%)', 'load average'],
+        [[r['scheme'], r['load'], r['code'], f'{r["rate_hz"]:.0f}', str(r['late_poses']),
+          f'{1e3 * r["longest_gap_s"]:.0f}', f'{r["remote_rate_hz"]:.0f}', str(r['silences']),
+          {'yes': 'yes', 'NO': '**no**'}.get(verdict(r), verdict(r)), f'{r["contact_s"]:.1f}',
+          f'{1e3 * r["net_work_j"]:+.1f}', f'{r["oscillation_percent"]:.1f}',
+          f'{r["load_before"]:.1f}'] for r in rows])

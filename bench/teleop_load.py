@@ -1,7 +1,7 @@
 """The telerobotic scan quiet and with cores hogged: the fix beside the code before it.
 
     .venv/bin/python bench/teleop_load.py [--schemes model tdpa] [--loads quiet hogged busy]
-        [--rounds 1] [--baseline 0139399] [--duration 20] [--json PATH] [--keep DIR]
+        [--rounds 1] [--baseline d242b42] [--duration 20] [--json PATH] [--keep DIR]
 
 Each case is the issue's command as a user types it, ``haptic_loop --teleop SCHEME --delay 0.1
 --jitter 0.01 --loss 0.01 --duration 20 --record DIR``: run from this tree (the fix) and from
@@ -21,7 +21,6 @@ case started (other work shares the machine) and the session's exit code.
 """
 import argparse
 import functools
-import json
 import os
 import pathlib
 import subprocess
@@ -31,6 +30,7 @@ import time
 
 import machine
 import numpy as np
+import result_files
 from rosbags.highlevel import AnyReader
 import teleop_scan
 
@@ -39,12 +39,14 @@ from haptic_bringup.launcher import add_venv_prefix
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_vectors
 
-__all__ = ['case', 'main']
+__all__ = ['case', 'main', 'verdict']
 
 REPOSITORY = pathlib.Path(__file__).resolve().parents[1]
-BASELINE = '0139399'  # the code the issue found the hand given energy on
+# The code before the fix (main before 'passive' was merged), which shares this tree's messages:
+# the issue's 0139399 does not (the safety issue added fields), so it cannot run with this venv.
+BASELINE = 'd242b42'
 PACKAGES = ('haptic_util', 'collision_engine', 'force_renderer', 'haptic_wand_driver',
-            'haptic_bringup', 'remote_probe')
+            'haptic_bringup', 'remote_probe', 'site_gateway')
 DELAY, JITTER, LOSS, DURATION = 0.1, 0.01, 0.01, 20.0  # the issue's command
 LATE = 0.010  # [s] between two poses: longer than an answer's lifetime
 MIN_CONTACT = 5.0  # [s] in contact: the scan presses for about 12 s
@@ -116,7 +118,7 @@ def loaded(run, hogs: int):
             hog.wait()
 
 
-def _verdict(row: dict) -> str:
+def verdict(row: dict) -> str:
     """Stable or not; a session that never pressed the patient says nothing either way."""
     if row['contact_s'] < MIN_CONTACT:
         return 'no touch'
@@ -127,7 +129,7 @@ def print_row(row: dict) -> None:
     print(f'{row["scheme"]:>6} {row["load"]:>7} {row["code"]:>9} {row["rate_hz"]:6.0f} '
           f'{row["late_poses"]:5d} {1e3 * row["longest_gap_s"]:6.1f} '
           f'{row["remote_rate_hz"]:6.0f} {row["silences"]:4d} '
-          f'{_verdict(row):>6} {row["contact_s"]:5.1f} {1e3 * row["net_work_j"]:8.1f} '
+          f'{verdict(row):>6} {row["contact_s"]:5.1f} {1e3 * row["net_work_j"]:8.1f} '
           f'{row["oscillation_percent"]:6.1f} {row["transparency_percent"]:6.1f} '
           f'{row["peak_patient_n"]:6.2f} {row["load_before"]:7.1f} {row["exit_code"]:4d}',
           flush=True)
@@ -143,7 +145,7 @@ def main(argv=None) -> int:
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     parser.add_argument('--duration', type=float, default=DURATION,
                         help="the session's length, s (the issue's: 20)")
-    parser.add_argument('--json', type=pathlib.Path, help='write the rows and the machine here')
+    result_files.add_option(parser)
     parser.add_argument('--keep', type=pathlib.Path, help='keep each case\'s bag under here')
     args = parser.parse_args(argv)
     add_venv_prefix()
@@ -174,17 +176,9 @@ def main(argv=None) -> int:
                                **loaded(run, LOADS[load])}
                         rows.append(row)
                         print_row(row)
-                        if args.json:  # after each case: a run cut short keeps what it measured
-                            write(args.json, started, args, rows)
+                        # After each case: a run cut short keeps what it measured.
+                        result_files.write(args.json, {'baseline': args.baseline, 'rows': rows})
     return 0
-
-
-def write(path: pathlib.Path, started: str, args, rows: list) -> None:
-    """Write the machine, the command and the rows as JSON, for the report."""
-    command = (f'haptic_loop --teleop SCHEME --delay {DELAY} --jitter {JITTER} --loss {LOSS} '
-               f'--duration {args.duration:g} --record DIR')
-    path.write_text(json.dumps({'machine': started, 'baseline': args.baseline,
-                                'command': command, 'rows': rows}, indent=1, default=float))
 
 
 if __name__ == '__main__':
