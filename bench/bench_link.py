@@ -14,7 +14,6 @@ each figure is given beside its floor, and as the round trip added over it. A pi
 measured window, in % of one core. No emulated delay: the stage passes messages straight on.
 """
 import argparse
-import json
 import os
 import pathlib
 import socket
@@ -34,6 +33,7 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.serialization import serialize_message
 from rclpy.task import Future
+import result_files
 
 from haptic_bringup.launcher import add_venv_prefix, loop_environment
 from haptic_bringup.processes import start_child, stop_children
@@ -223,11 +223,10 @@ def main(argv=None) -> int:
     parser.add_argument('--rate', type=float, default=1000.0, help='[Hz] pings')
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)),
                         help="the operator's side; the echo's is the next")
-    parser.add_argument('--json', metavar='PATH', help='also write the figures there')
+    result_files.add_option(parser)
     args = parser.parse_args(argv[1:])
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    description = machine.describe('ros-jazzy-rclpy', 'eclipse-zenoh')
     print(f'machine: {machine.line("ros-jazzy-rclpy", "eclipse-zenoh")}; load average '
           f'{os.getloadavg()[0]:.2f}')
     print(f'{args.rate:g} Hz pings for {args.seconds:g} s per case, {args.runs} alternated '
@@ -266,11 +265,8 @@ def main(argv=None) -> int:
         for q in PERCENTILES)
         + f'; lost {summary["lost"]} of {summary["sent"]}; gateways\' CPU '
         + ', '.join(f'{name} {cpu:.1f} %' for name, cpu in summary['gateway_cpu_pct'].items()))
-    if args.json:
-        pathlib.Path(args.json).write_text(json.dumps(
-            {'machine': description, 'load_average_after': os.getloadavg()[0],
-             'rate_hz': args.rate, 'seconds': args.seconds, 'runs': results,
-             'summary': summary}, indent=2))
+    result_files.write(args.json, {'rate_hz': args.rate, 'seconds': args.seconds,
+                                   'runs': results, 'summary': summary})
     return 0
 
 

@@ -13,7 +13,8 @@ from report_experiments import PAPER
 from report_probe import probe_section
 from report_sections import (counts_section, DEFINITIONS, error_time_section,
                              experiment_section, extreme_section, force_effect_section,
-                             headline_section, identical_modes, interval_table, loop_section,
+                             headline_section, identical_modes, interval_table, link_section,
+                             loop_section,
                              provenance_section, servo_section, stiff_wall_section,
                              sweep_section, table_2, table_3, teleop_load_section, teleop_section,
                              tradeoff_section)
@@ -227,6 +228,12 @@ def _teleop_chapter(findings: Findings) -> list[str]:
               if (findings.results / TELEOP_FIGURE).exists() else [])
     parts += _stored(findings, 'teleop_scan', lambda rows: [
         teleop_section([{**r, 'source': 'ROS 2'} for r in rows]), '', *figure])
+    parts += ['### The link between the sites', '',
+              'The deployed path, DDS to the operator\'s gateway, Zenoh over mutual TLS, the '
+              'remote gateway and DDS, and back, at 1 kHz and no emulated delay, beside its '
+              'floor: the same two processes exchanging the same bytes as UDP datagrams on the '
+              'same loopback, alternated in one run (`bench/bench_link.py`).', '']
+    parts += _stored(findings, 'link', lambda stored: [link_section(stored), ''])
     parts += ['### On a busy machine', '',
               'The issue\'s command, `haptic_loop --teleop SCHEME --delay 0.1 --jitter 0.01 '
               '--loss 0.01 --duration 20`, quiet, with one core kept busy by another process '

@@ -24,7 +24,7 @@ from haptic_bringup.contacts import contact_intervals, MIN_FORCE
 
 __all__ = ['DEFINITIONS', 'counts_section', 'error_time_section', 'experiment_section',
            'extreme_section', 'force_effect_section', 'headline_section', 'identical_modes',
-           'interval_table', 'loop_section', 'provenance_section', 'servo_section',
+           'interval_table', 'link_section', 'loop_section', 'provenance_section', 'servo_section',
            'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'teleop_load_section',
            'teleop_section', 'tradeoff_section']
 
@@ -419,3 +419,20 @@ def teleop_load_section(rows: list) -> str:
           {'yes': 'yes', 'NO': '**no**'}.get(verdict(r), verdict(r)), f'{r["contact_s"]:.1f}',
           f'{1e3 * r["net_work_j"]:+.1f}', f'{r["oscillation_percent"]:.1f}',
           f'{r["load_before"]:.1f}'] for r in rows])
+
+
+def link_section(stored: dict) -> str:
+    """Tabulate the gateways' round trip beside plain UDP's, the loss, each gateway's CPU."""
+    def median(case: str, key: str) -> float:
+        return float(np.median([run[key] for run in stored['runs'][case]]))
+    summary = stored['summary']
+    quantiles = ('p50', 'p99', 'p99.9')
+    rows = [[case, *(f'{median(case, f"{q}_ms"):.3f}' for q in quantiles),
+             f'{sum(r["lost"] for r in stored["runs"][case])} of '
+             f'{sum(r["sent"] for r in stored["runs"][case])}'] for case in ('floor', 'gateways')]
+    added = (f'{summary["added_ms"][q]:+.3f} ({summary["ratio"][q]:.1f} ×)' for q in quantiles)
+    rows.append(['added by the gateways', *added, ''])
+    cpu = ', '.join(f'{name} {value:.1f} %' for name, value in summary['gateway_cpu_pct'].items())
+    return (markdown_table(['path', 'round trip p50 (ms)', 'p99 (ms)', 'p99.9 (ms)', 'lost'],
+                           rows)
+            + f'\n\nEach gateway\'s CPU over the window, in % of one core: {cpu}.')

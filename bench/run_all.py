@@ -85,7 +85,7 @@ BENCHMARKS = (
     Benchmark('teleop_scan', 'teleop_scan.py', ('--delays', '0.05'), stored=True),
     Benchmark('link_door', 'bench_link_door.py', ('--messages', '2000', '--repeats', '1')),
     Benchmark('image', 'bench_image.py', ('--frames', '100', '--no-simus')),
-    Benchmark('link', 'bench_link.py', ('--seconds', '5')),
+    Benchmark('link', 'bench_link.py', ('--seconds', '5'), stored=True),
     Benchmark('teleop_load', 'teleop_load.py', ('--schemes', 'model', '--loads', 'hogged',
                                                 '--duration', '8'), stored=True),
     Benchmark('recording_load', 'recording_load.py', ('--layouts', 'composed', '--stops', 'end',
