@@ -236,15 +236,17 @@ def _teleop_chapter(findings: Findings) -> list[str]:
     parts += _stored(findings, 'link', lambda stored: [link_section(stored), ''])
     parts += ['### On a busy machine', '',
               'The issue\'s command, `haptic_loop --teleop SCHEME --delay 0.1 --jitter 0.01 '
-              '--loss 0.01 --duration 20`, quiet, with one core kept busy by another process '
-              '(*hogged*) and with both (*busy*), from this tree (*fix*) and from the code '
+              '--loss 0.01 --duration 20`, with no process of the benchmark\'s own keeping a core '
+              'busy (*quiet*; the load average says what else shared the machine), with one '
+              '(*hogged*) and with two (*busy*), from this tree (*fix*) and from the code '
               'before it, alternated in one run (`bench/teleop_load.py`). Read from the bags; '
               'a session that pressed the patient less than 5 s says nothing of stability.', '']
     parts += _stored(findings, 'teleop_load', lambda stored: [
         teleop_load_section(stored['rows']), f'Code before: `{stored["baseline"]}`.', ''])
     parts += ['### The demo\'s scan', '',
               'Measured by this run, from the bag `demo` recorded: model-mediated over a 50 ms '
-              'link with 5 ms jitter and 1 % loss.', '']
+              'link with 5 ms jitter and 1 % loss, through the two sites\' gateways over mutual '
+              'TLS on loopback, the path that is deployed.', '']
     if findings.teleop is None:
         return parts + ['*The demo recorded no telerobotic scan.*', '']
     return parts + [teleop_section([findings.teleop]), '']
