@@ -141,11 +141,13 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
             continue
         for delivery in to_operator.deliver(now):
             leader.receive(now, delivery.payload)
-        answers.taken(now, MODEL_LIFETIME)  # answered as it went out, as in the site's process
         if renderer is not None:
-            renderer.take(_model(now, leader.plane(now, state.position), state.position),
-                          answers.deadline)
+            plane = leader.plane(now, state.position)
+            if plane is not None or leader.live(now):  # silent: no answer, as the leader node
+                answers.taken(now, MODEL_LIFETIME)  # answered as it went out, as in the site
+                renderer.take(_model(now, plane, state.position), answers.deadline)
         else:
+            answers.taken(now, MODEL_LIFETIME)
             force = leader.force(now, state.position, state.linear_velocity, TICK)
             device.apply(port.control(force, state.position, state.linear_velocity, TICK),
                          ZERO, until=answers.deadline)

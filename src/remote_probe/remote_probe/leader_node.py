@@ -71,6 +71,7 @@ class LeaderNode(Node):
         self._refused = Tally()
         self._answers = 0
         self._withheld = 0  # poses whose command was not sent: the feedback was silent
+        self._unknown = 0  # poses given no model: the feedback was silent
         self._command_pub = stream_publisher(self, COMMAND, 'teleop/command')
         answer = ((MODEL, 'wand/contact_model') if params.scheme == 'model'
                   else (WRENCH, 'wand/wrench'))
@@ -145,7 +146,13 @@ class LeaderNode(Node):
             self._command_pub.publish(command_fields(command, self.params.robot_frame))
         now = self._now()
         if self.params.scheme == 'model':
-            self._answer(stamp_ns, self.leader.plane(now, position), position)
+            plane = self.leader.plane(now, position)
+            if plane is None and not self.leader.live(now):
+                # Unknown, not free: the device zeroes the force when the last model lapses,
+                # and its port keeps the books of the contact the silence interrupted.
+                self._unknown += 1
+                return
+            self._answer(stamp_ns, plane, position)
         else:
             self._answer(stamp_ns, self.leader.force(now, position, velocity,
                                                      max(period, 1e-6)))
@@ -185,7 +192,8 @@ class LeaderNode(Node):
         values = {'published': self._answers, 'link_live': live,
                   'round_trip_s': math.nan if round_trip is None else round_trip,
                   'clutched': leader is not None and leader.map.clutched,
-                  'withheld': self._withheld, 'refused': self._refused.total(),
+                  'withheld': self._withheld, 'unanswered': self._unknown,
+                  'refused': self._refused.total(),
                   **{f'refused: {kind}': n for kind, n in self._refused.counts.items()}}
         if leader is not None:
             values['operator_energy_out_j'] = leader.passivity.books.energy_out
