@@ -71,7 +71,6 @@ BENCHMARKS = (
     Benchmark('gjk_tradeoff', 'gjk_tradeoff.py', ('--points', '200'), stored=True),
     Benchmark('wand_driver', 'bench_wand_driver.py', ('--repeats', '2', '--seconds', '2')),
     Benchmark('loop', 'bench_loop.py', ('--runs', '1', '--seconds', '3'), stored=True),
-    Benchmark('bridge', 'bench_bridge.py', ('--runs', '1', '--seconds', '3')),
     Benchmark('loop_stats', 'bench_loop_stats.py', ('--hours', '0.1', '1')),
     Benchmark('stream_cost', 'stream_cost.py', ('--seconds', '2', '--runs', '1')),
     Benchmark('stiffness_sweep', 'stiffness_sweep.py', ('--points', '5'), stored=True),

@@ -4,7 +4,7 @@
         [--delays 0 0.01 0.025 0.05 0.1 0.25] [--jitter 0.1] [--loss 0.01]
         [--site-streams in-process dds] [--json PATH]
 
-Both sites run as real processes in two DDS domains, with the link bridge between them
+Both sites run as real processes in two DDS domains, joined by the two site gateways
 (``haptic_loop --teleop``): the scripted sonographer approaches the patient phantom, presses,
 sweeps along it at about 8 N and lifts. Every figure comes from the bag, from what the device
 applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor measured

@@ -23,7 +23,6 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'link_bridge = remote_probe.bridge:main',
             'make_phantom = remote_probe.phantom:main',
             'sim_robot = remote_probe.robot_node:main',
             'teleop_follower = remote_probe.follower_node:main',

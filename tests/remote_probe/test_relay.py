@@ -1,4 +1,4 @@
-"""The bridge's pure part: which topics cross, and one direction's order, losses and counts."""
+"""The gateway's pure relay: which topics cross, and one direction's order, losses and counts."""
 import math
 
 import pytest

@@ -70,7 +70,7 @@ def run_experiment(name: str, out: pathlib.Path, *, composed: bool = True,
 
 
 def run_teleop(out: pathlib.Path, *, domain_id: int = 42) -> pathlib.Path:
-    """Run the telerobotic scan over ROS 2 (two domains and the bridge); return its bag."""
+    """Run the telerobotic scan over ROS 2 (two domains, the site gateways); return its bag."""
     run = out / TELEOP
     shutil.rmtree(run, ignore_errors=True)
     run.mkdir(parents=True)

@@ -452,7 +452,7 @@ def parse_args(argv=None) -> argparse.Namespace:
 
 
 def link_parameters(args: argparse.Namespace) -> dict:
-    """Return the bridge's link parameters from the command line."""
+    """Return the emulated link's parameters from the command line."""
     link = {'delay': args.delay, 'jitter': args.jitter, 'loss': args.loss}
     if args.delay_trace:
         link['delay_trace'] = str(pathlib.Path(args.delay_trace).resolve())

@@ -1,6 +1,6 @@
 """A relay between sites talks to its site over UDP on 127.0.0.1, never Fast DDS's shared memory.
 
-Why: a relay (the site gateway, the link bridge) stands for the network between the sites, and
+Why: a relay (the site gateway) stands for the network between the sites, and
 it may stop: SIGSTOP in a test, a link down, a process descheduled. Over shared memory, a site
 stalled while its relay was stopped: a sender that finds a peer's port unanswered checks its
 health, sleeping 333 ms at a time for up to 1 s (``healthy_check_timeout_ms``), and it does so

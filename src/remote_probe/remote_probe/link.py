@@ -3,7 +3,7 @@
 Why: the operator and the patient are far apart, and every bilateral scheme must be judged at
 the delays of real links (23–30 ms for 5G over 2,600 km, 100–370 ms over the internet, over
 500 ms by satellite). The kernel here has no netem qdisc, so the link is emulated in user space:
-the bridge process hands each message to ``EmulatedLink.send`` and relays what ``deliver``
+the site gateway hands each message to ``EmulatedLink.send`` and relays what ``deliver``
 returns. It is pure (times are arguments, no clock is read), so a run is reproducible.
 
 Each message is lost with probability ``loss``, else it arrives after the one-way delay plus

@@ -1,12 +1,13 @@
-"""What the link bridge relays, and one direction of it: routes, the emulated link, the counts.
+"""What a site gateway relays, and one direction of it: routes, the emulated link, the counts.
 
-Why a pure part: the bridge process only moves serialized messages between two DDS domains; what
-it must get right is which topics cross, in which order and when they come out, and what it says
-about that. All of that is here, without rclpy, so it is tested with plain times and bytes.
+Why a pure part: the gateway process only moves serialized messages between its DDS domain and
+Zenoh; what it must get right is which topics cross, in which order and when they come out, and
+what it says about that. All of that is here, without rclpy, so it is tested with plain times
+and bytes.
 
-A route is one topic that crosses, written ``'topic:pkg/msg/Type'``. The bridge never
+A route is one topic that crosses, written ``'topic:pkg/msg/Type'``. The gateway never
 deserializes a message (it forwards the CDR bytes), but DDS needs the type to match publishers
-and subscribers, so the type is resolved at start-up and a typo stops the bridge there.
+and subscribers, so the type is resolved at start-up and a typo stops the gateway there.
 
 All the routes of one direction share one ``EmulatedLink``: one path, so without ``reorder`` a
 message never overtakes an earlier one, whatever its topic, as on a real connection.
@@ -81,9 +82,9 @@ def parse_routes(entries: Iterable[str], direction: str) -> tuple:
 
 
 def check_no_loop(to_remote: tuple, to_operator: tuple) -> None:
-    """Raise ValueError if a topic crosses both ways: the bridge would echo it back forever.
+    """Raise ValueError if a topic crosses both ways: the gateways would echo it back forever.
 
-    The bridge's nodes live in the root namespace, so ``a`` and ``/a`` are one topic.
+    The gateway's node lives in the root namespace, so ``a`` and ``/a`` are one topic.
     """
     both = ({route.topic.lstrip('/') for route in to_remote}
             & {route.topic.lstrip('/') for route in to_operator})
@@ -100,7 +101,7 @@ class Release(NamedTuple):
 
 
 class Relay:
-    """One direction of the bridge: messages in, messages due out, and what happened to them.
+    """One direction of a gateway: messages in, messages due out, and what happened to them.
 
     Parameters
     ----------

@@ -41,7 +41,7 @@ from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
 from haptic_util.qos import HAPTIC_STREAM_QOS
 from haptic_util.transport import loopback_udp
-from remote_probe.bridge import emulated_link, LinkStageParams, ReleaseTimer
+from remote_probe.link_stage import emulated_link, LinkStageParams, ReleaseTimer
 from remote_probe.relay import message_class, Relay
 from site_gateway.inbound import Inbound
 from site_gateway.routes import bye_key, other_role, RELIABLE, ROLES, site_routes
@@ -131,8 +131,8 @@ def _open(config: dict, name: str) -> zenoh.Session:
 def _qos(kind: str) -> QoSProfile:
     """Return the QoS of a crossing's kind: reliable for what must arrive, else a stream.
 
-    A stream is read with the haptic streams' shallow history, as link_bridge read it: after a
-    stall only the newest go on. Read with ``LINK_QOS`` (1000 deep), the operator's gateway
+    A stream is read with the haptic streams' shallow history: after a stall only the newest
+    go on. Read with ``LINK_QOS`` (1000 deep), the operator's gateway
     stopped taking commands altogether a few seconds into the attacked session, in 2 runs of 2
     (its timers and its other direction went on); with this depth it relayed to the end.
     """

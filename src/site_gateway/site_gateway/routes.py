@@ -7,7 +7,7 @@ arrives is authenticated: a command under ``haptic/remote/...`` was put by a hol
 remote site's certificate, and the gateway refuses it by name, where a key alone would say
 nothing of who sent it.
 
-Topics are written as for ``link_bridge`` (``'topic:pkg/msg/Type'``, see ``remote_probe.relay``).
+Topics are written ``'topic:pkg/msg/Type'`` (``remote_probe.relay``).
 A topic crosses as a 1 kHz stream (the newest message matters, a late one is worthless: drop
 rather than block) unless it is listed as reliable (it must arrive, as the clutch must).
 """

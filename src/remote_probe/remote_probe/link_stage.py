@@ -1,0 +1,95 @@
+"""The emulated link as a stage of a node: what a site sends, held for its delay, jitter and loss.
+
+Why: experiments set the link's delay over the real transport (the kernel here has no netem),
+so the site gateway holds each message it sends for the emulated link (``remote_probe.link``)
+before handing it to Zenoh. The release timer (steady clock) is re-armed for the link's next
+arrival rather than polling at 1 kHz: a release is then late by the executor's wake-up alone.
+"""
+from dataclasses import dataclass
+import math
+import time
+from typing import Callable
+
+from rclpy.clock import Clock, ClockType
+from rclpy.node import Node
+
+from haptic_util.executor import StartupError
+from haptic_util.parameters import parameter
+from remote_probe.link import DelayTrace, EmulatedLink, LinkConfig
+from remote_probe.relay import Relay
+
+__all__ = ['LinkStageParams', 'ReleaseTimer', 'emulated_link']
+
+_STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() reads
+
+
+@dataclass(frozen=True)
+class LinkStageParams:
+    """The emulated link's parameters (the site gateway's outgoing stage)."""
+
+    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
+                             high=10.0)
+    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
+                              "message's delay", unit='s', low=0.0, high=10.0)
+    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
+    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
+                              'holds back those behind it)')
+    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
+                          low=0)
+    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
+                                 'from each direction\'s first message, instead of delay; '
+                                 'empty: none')
+
+
+def emulated_link(params: LinkStageParams, direction: str, node_name: str) -> EmulatedLink:
+    """Return one direction's emulated link (``to_operator`` draws with ``seed + 1``).
+
+    A bad value or an unreadable trace raises ``StartupError`` naming the node.
+    """
+    seed = params.seed + (1 if direction == 'to_operator' else 0)
+    try:
+        config = LinkConfig(params.delay, params.jitter, params.loss, params.reorder, seed)
+    except ValueError as error:
+        raise StartupError(f'{node_name}: {error}') from None
+    try:
+        trace = DelayTrace.from_csv(params.delay_trace) if params.delay_trace else None
+    except (ValueError, OSError) as error:
+        raise StartupError(f'{node_name}: parameter delay_trace: {error}') from None
+    return EmulatedLink(config, trace=trace)
+
+
+class ReleaseTimer:
+    """One direction's emulated link in a node: messages in, each out when its time comes.
+
+    The timer (steady clock) is armed for the link's next arrival, rather than polling at
+    1 kHz; a message whose time has come on arrival (no delay) goes out at once, through
+    ``emit(route, data)``: a DDS publisher here, a Zenoh one in the site gateway.
+    """
+
+    def __init__(self, relay: Relay, node: Node, emit: Callable[[int, bytes], None]) -> None:
+        self.relay = relay
+        self._emit = emit
+        self._timer = node.create_timer(1.0, self.on_timer, clock=_STEADY, autostart=False)
+        self._armed = None  # [s] the arrival the timer is armed for
+
+    def on_message(self, route: int, data: bytes) -> None:
+        self.relay.send(time.monotonic(), route, data)
+        self.release()
+
+    def on_timer(self) -> None:
+        self._armed = None  # it fired: arm it again, even for the same arrival
+        self.release()
+
+    def release(self) -> None:
+        now = time.monotonic()
+        for route, data in self.relay.release(now):
+            self._emit(route, data)
+        due = self.relay.next_arrival
+        if due == self._armed:
+            return
+        self._armed = due
+        if due is None:
+            self._timer.cancel()
+            return
+        self._timer.timer_period_ns = max(1, math.ceil((due - now) * 1e9))
+        self._timer.reset()
