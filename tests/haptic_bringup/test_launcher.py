@@ -66,4 +66,10 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
     assert operator['output'] == str(tmp_path / 'scan' / 'operator')
     assert remote['output'] == str(tmp_path / 'scan' / 'remote') and remote['prefix'] == '/remote'
     assert site_nodes(config, 'operator') == ('wand_driver', 'teleop_leader', 'operator_recorder')
-    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'probe_imager',
+                                            'remote_recorder')
+    assert operator['topics'][-1] == '/probe/image'  # recorded where it is seen
+    blind = LoopConfig(teleop='model', record=str(tmp_path / 'blind'), imaging=False)
+    assert site_nodes(blind, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    assert '/probe/image' not in node_parameters(blind)['operator_recorder'][
+        'ros__parameters']['topics']
