@@ -18,7 +18,8 @@ ROS 2 install, ``ros2 launch haptic_bringup haptic_loop.launch.py`` does the sam
 
 With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
 (the wand driver and the leader, one process) in one DDS domain, the remote site (the robot with
-its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and
+its F/T sensor on the patient phantom, the follower and the probe's imager, one process; no
+imager with ``--no-imaging``) in the next domain, and
 both sites' gateways between them (``haptic_bringup.site.loopback_gateways``): the deployed path,
 over loopback mutual TLS, each gateway delaying, jittering and dropping what it sends. With
 ``--record DIR`` each site's process records itself: DIR is the session, holding the bags
@@ -450,6 +451,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='teleop: the remote site\'s DDS domain (default: the next one)')
     parser.add_argument('--delay-trace', metavar='CSV',
                         help='teleop: replay one-way delays from a CSV (time,delay in s)')
+    parser.add_argument('--no-imaging', dest='imaging', action='store_false',
+                        help='teleop: the remote site makes no probe image')
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', DEFAULT_DOMAIN_ID)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
@@ -477,7 +480,7 @@ def main(argv=None) -> int:
                         duration=args.duration, record=args.record, domain_id=args.domain_id,
                         params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
                         teleop=args.teleop, link=link_parameters(args),
-                        remote_domain=args.remote_domain_id)
+                        remote_domain=args.remote_domain_id, imaging=args.imaging)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     loop = Loop(config)
     stop = []

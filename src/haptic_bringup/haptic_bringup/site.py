@@ -179,6 +179,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='probability that the emulated link loses a message')
     parser.add_argument('--delay-trace', metavar='CSV',
                         help='replay one-way delays from a CSV (time,delay in s)')
+    parser.add_argument('--no-imaging', dest='imaging', action='store_false',
+                        help='remote: make no probe image (operator: record none)')
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
@@ -197,7 +199,7 @@ def site_config(args: argparse.Namespace) -> SiteConfig:
     loop = LoopConfig(composed=True, teleop=args.scheme, domain_id=args.domain_id,
                       experiment=args.experiment, duration=args.duration, record=args.record,
                       params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
-                      link=link_parameters(args))
+                      link=link_parameters(args), imaging=args.imaging)
     return SiteConfig(args.role, loop, tuple(args.listen), tuple(args.connect), args.certs,
                       args.insecure)
 
