@@ -110,24 +110,36 @@ def run(imaging: bool, domain_id: int, niceness: int | None = None) -> dict:
     return row
 
 
+def _cpu(row: dict) -> float:
+    """Return the CPU of all the run's processes, % of one core."""
+    return sum(row['cpu_percent'].values())
+
+
 def summary(rows: list) -> dict:
-    """Return the ratios on / off of each stream figure (runs' medians), and the CPU added."""
-    on = [r for r in rows if r['imaging']]
-    off = [r for r in rows if not r['imaging']]
+    """Return the ratios on / off of each stream figure, and the CPU imaging adds.
+
+    ``rows`` come in pairs, one run on and one off side by side, which share the machine's load
+    more than runs further apart: each ratio is taken within a pair, and its median and range
+    over the pairs are given.
+    """
+    pairs = [(a, b) if a['imaging'] else (b, a) for a, b in zip(rows[0::2], rows[1::2])]
+    on, off = [pair[0] for pair in pairs], [pair[1] for pair in pairs]
 
     def median(runs, key):
         return float(np.median([r[key] for r in runs]))
 
-    ratios = {key: median(on, key) / median(off, key) for key in (
-        'operator_rate_hz', 'operator_answered_percent', 'operator_round_trip_p99_s',
-        'robot_rate_hz', 'robot_tick_p99_s', 'commands_hz', 'feedback_hz')}
-    total = {name: [sum(r['cpu_percent'].values()) for r in runs]
-             for name, runs in (('on', on), ('off', off))}
-    added = float(np.median(total['on']) - np.median(total['off']))
+    ratios, ranges = {}, {}
+    for key in ('operator_rate_hz', 'operator_answered_percent', 'operator_round_trip_p99_s',
+                'robot_rate_hz', 'robot_tick_p99_s', 'commands_hz', 'feedback_hz'):
+        each = [a[key] / b[key] for a, b in pairs]
+        ratios[key], ranges[key] = float(np.median(each)), (min(each), max(each))
+    added = float(np.median([_cpu(a) - _cpu(b) for a, b in pairs]))
     frames_hz = median(on, 'frames_hz')
-    return {'ratios': ratios, 'cpu_on_percent': float(np.median(total['on'])),
-            'cpu_off_percent': float(np.median(total['off'])), 'cpu_added_percent': added,
-            'frames_hz': frames_hz, 'cpu_per_frame_s': added / 100.0 / frames_hz,
+    return {'pairs': len(pairs), 'ratios': ratios, 'ranges': ranges,
+            'cpu_on_percent': float(np.median([_cpu(r) for r in on])),
+            'cpu_off_percent': float(np.median([_cpu(r) for r in off])),
+            'cpu_added_percent': added, 'frames_hz': frames_hz,
+            'cpu_per_frame_s': added / 100.0 / frames_hz,
             'frame_cpu_p50_s': median(on, 'frame_cpu_p50_s'),
             'pose_to_image_p99_s': median(on, 'pose_to_image_p99_s'),
             'pose_to_publication_p99_s': median(on, 'pose_to_publication_p99_s'),
@@ -144,7 +156,7 @@ def _print_row(row: dict) -> None:
           f'{1e3 * row["operator_round_trip_p99_s"]:.2f} ms; robot {row["robot_rate_hz"]:.0f} '
           f'Hz, tick p99 {1e3 * row["robot_tick_p99_s"]:.2f} ms; commands '
           f'{row["commands_hz"]:.0f}/s, feedback {row["feedback_hz"]:.0f}/s; CPU '
-          f'{sum(row["cpu_percent"].values()):.0f} % ('
+          f'{_cpu(row):.0f} % ('
           + ', '.join(f'{n} {c:.0f}' for n, c in row['cpu_percent'].items())
           + f'){image}; load {row["load"]:.1f}', flush=True)
 
@@ -166,8 +178,10 @@ def main(argv=None) -> int:
             rows.append(run(imaging, args.domain_id, args.niceness))
             _print_row(rows[-1])
     result = summary(rows)
-    print('on / off (median over the runs; targets: rates and answered >= 0.99, p99 <= 1.1): '
-          + ', '.join(f'{key} {value:.3f}' for key, value in result['ratios'].items()))
+    ratios = [f'{key} {value:.3f} [{low:.3f}-{high:.3f}]' for (key, value), (low, high)
+              in zip(result['ratios'].items(), result['ranges'].values())]
+    print('on / off within each pair, median [range] (targets: rates and answered >= 0.99, p99 '
+          '<= 1.1): ' + ', '.join(ratios))
     print(f'CPU: {result["cpu_on_percent"]:.0f} % of a core on, {result["cpu_off_percent"]:.0f} '
           f'% off: imaging adds {result["cpu_added_percent"]:.0f} % at '
           f'{result["frames_hz"]:.1f} frames/s, {1e3 * result["cpu_per_frame_s"]:.1f} ms a frame '

@@ -180,7 +180,7 @@ def truth_section(results: dict) -> str:
 def cost_section(results: dict) -> str:
     """Return what imaging costs the telerobotic session: ratios on / off, CPU, pose to image."""
     summary = results['summary']
-    ratios, targets = summary['ratios'], summary['targets']
+    ratios, ranges, targets = summary['ratios'], summary['ranges'], summary['targets']
     names = {'operator_rate_hz': ('operator\'s poses a second', 'rate'),
              'operator_answered_percent': ('operator\'s poses answered', 'answered'),
              'operator_round_trip_p99_s': ('operator\'s round trip, p99', 'p99'),
@@ -195,15 +195,20 @@ def cost_section(results: dict) -> str:
         scale, unit = (1e3, ' ms') if key.endswith('_s') else (1.0, '')
         bound = targets[kind]
         met = ratios[key] <= bound if kind == 'p99' else ratios[key] >= bound
+        low, high = ranges[key]
         rows.append([label, f'{scale * off:.2f}{unit}', f'{scale * on:.2f}{unit}',
-                     f'{ratios[key]:.3f}', f'{"<=" if kind == "p99" else ">="} {bound:g} '
+                     f'{ratios[key]:.3f} [{low:.2f}-{high:.2f}]',
+                     f'{"<=" if kind == "p99" else ">="} {bound:g} '
                      f'({"met" if met else "MISSED"})'])
     loads = [r['load'] for r in results['rows']]
     delay = summary['delay_s']
     return '\n'.join([
-        markdown_table(['stream', 'imaging off', 'on', 'on / off', 'target'], rows), '',
-        f'Medians over {len(results["rows"]) // 2} runs each way, alternated, at a load '
-        f'average of {min(loads):.1f}-{max(loads):.1f}. The '
+        markdown_table(['stream', 'imaging off', 'on', 'on / off [range]', 'target'], rows), '',
+        f'{summary["pairs"]} pairs of runs, one on and one off side by side; the figures on and '
+        f'off are medians over the runs, each ratio is taken within a pair, its median and '
+        f'range over the pairs given. The load average was {min(loads):.1f}-{max(loads):.1f} '
+        f'(other jobs on the machine): where a ratio\'s range spans its target both ways, the '
+        f'runs vary more with that load than with imaging. The '
         f'session\'s processes used {summary["cpu_off_percent"]:.0f} % of a core without '
         f'imaging and {summary["cpu_on_percent"]:.0f} % with it: imaging adds '
         f'{summary["cpu_added_percent"]:.0f} % at {summary["frames_hz"]:.1f} frames a second, '

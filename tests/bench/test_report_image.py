@@ -50,13 +50,17 @@ def test_the_cost_section_says_which_target_each_ratio_meets():
     rows = [row(True, 980.0, 0.0012), row(False, 1000.0, 0.001)]
     keys = [k for k in rows[0] if k not in ('imaging', 'load')]
     ratios = {k: rows[0][k] / rows[1][k] for k in keys}
-    summary = {'ratios': ratios, 'targets': {'rate': 0.99, 'answered': 0.99, 'p99': 1.1},
+    summary = {'pairs': 1, 'ratios': ratios, 'ranges': {k: (v, v) for k, v in ratios.items()},
+               'targets': {'rate': 0.99, 'answered': 0.99, 'p99': 1.1},
                'cpu_on_percent': 90.0, 'cpu_off_percent': 70.0, 'cpu_added_percent': 20.0,
                'frames_hz': 30.0, 'cpu_per_frame_s': 0.0067, 'frame_cpu_p50_s': 0.0055,
                'pose_to_image_p99_s': 0.08, 'pose_to_publication_p99_s': 0.02, 'delay_s': 0.05}
     text = cost_section({'rows': rows, 'summary': summary, 'niceness': 5})
-    assert "| operator's poses a second | 1000.00 | 980.00 | 0.980 | >= 0.99 (MISSED) |" in text
-    assert "| operator's round trip, p99 | 1.00 ms | 1.20 ms | 1.200 | <= 1.1 (MISSED) |" in text
-    assert "| robot's ticks a second | 1000.00 | 1000.00 | 1.000 | >= 0.99 (met) |" in text
+    assert ("| operator's poses a second | 1000.00 | 980.00 | 0.980 [0.98-0.98] | >= 0.99 "
+            "(MISSED) |") in text
+    assert ("| operator's round trip, p99 | 1.00 ms | 1.20 ms | 1.200 [1.20-1.20] | <= 1.1 "
+            "(MISSED) |") in text
+    assert ("| robot's ticks a second | 1000.00 | 1000.00 | 1.000 [1.00-1.00] | >= 0.99 "
+            "(met) |") in text
     assert 'imaging adds 20 % at 30.0 frames a second, 6.7 ms of CPU a frame' in text
     assert '80 ms at the operator over the 50 ms link (target 100 ms)' in text

@@ -6,18 +6,29 @@ Truths come from outside the imaging: the frame's stamp is one of the poses the 
 (its bag), the delay is the link's, and the contact is the robot's F/T sensor's (the tissue's
 Hunt-Crossley force, which shares no code with the imaging's coupling).
 """
+import math
 import pathlib
+import signal
 import subprocess
 import sys
+import time
 
 from domains import session_domain_id
+from geometry_msgs.msg import PoseStamped
 import numpy as np
 import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from sensor_msgs.msg import Image
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import Loop, loop_environment, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_frames, read_vectors, reported
+from haptic_util.qos import FRAME_QOS, HAPTIC_STREAM_QOS
+from haptic_util.stamps import to_nanoseconds
 
 DELAY = 0.05  # [s] one way, 5 ms jitter
 FRAME_RATE = 30.0  # [Hz] the imager's default
@@ -105,3 +116,45 @@ def test_a_badly_configured_scanner_stops_at_start_naming_what_to_fix(tmp_path, 
     line = run_imager(tmp_path, *parameters)
     for word in words:
         assert word in line
+
+
+def test_a_pose_that_cannot_be_imaged_gives_a_dark_frame_with_its_reason_logged(tmp_path):
+    """The node alone, fed by the test: each pose imaged once, a bad one dark and its reason."""
+    domain_id = session_domain_id()
+    node = subprocess.Popen([sys.executable, '-m', 'ultrasound_sim.node'],
+                            env=loop_environment(domain_id, tmp_path / 'log'),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    context = Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    try:
+        feeder = Node('test_robot', context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(feeder)
+        frames = {}
+        feeder.create_subscription(Image, 'probe/image', lambda msg: frames.setdefault(
+            to_nanoseconds(msg.header.stamp), msg), FRAME_QOS)
+        poses = feeder.create_publisher(PoseStamped, 'robot/tcp_pose', HAPTIC_STREAM_QOS)
+        shown = {}
+        for frame_id, z in (('base_link', SKIN - 0.003), ('base_link', math.nan),
+                            ('world', SKIN - 0.003), ('base_link', SKIN + 0.001)):
+            pose = PoseStamped()
+            pose.header.frame_id, pose.pose.position.z = frame_id, z
+            pose.header.stamp = feeder.get_clock().now().to_msg()
+            stamp = to_nanoseconds(pose.header.stamp)
+            deadline = time.monotonic() + 60.0  # the node's start: imports and its warm-up
+            while stamp not in frames and time.monotonic() < deadline:
+                poses.publish(pose)  # again until it is imaged: a best-effort stream
+                executor.spin_once(timeout_sec=0.05)
+            assert stamp in frames, f'no frame of the pose {frame_id} z={z}'
+            shown[(frame_id, z)] = np.asarray(frames[stamp].data).mean()
+        deadline = time.monotonic() + 2.5  # its 1 Hz report logs what went dark
+        while time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+    finally:
+        rclpy.try_shutdown(context=context)
+        node.send_signal(signal.SIGINT)
+        log, _ = node.communicate(timeout=30)
+    assert node.returncode == 0, log
+    assert list(shown.values())[0] > 20.0  # pressed: tissue
+    assert all(value == 0.0 for value in list(shown.values())[1:]), shown
+    assert 'dark frame' in log and "'world', not 'base_link'" in log, log
