@@ -100,13 +100,13 @@ def run(imaging: bool, domain_id: int, niceness: int | None = None) -> dict:
             frames = read_frames(bag, typestore)
             shown = (frames.stamp >= start + WINDOW[0]) & (frames.stamp < start + WINDOW[1])
             latency = (frames.received - frames.stamp)[shown]
-            said = reported(bag, typestore, 'pose_to_image_p99_s').get('probe_imager', ['nan'])
-            frame_cpu = reported(bag, typestore, 'frame_cpu_p50_s').get('probe_imager', ['nan'])
+            said = {key: reported(bag, typestore, key).get('probe_imager', ['nan'])[-1]
+                    for key in ('pose_to_publication_p99_s', 'frame_cpu_p50_s')}
             row.update({'frames_hz': _rate(frames.stamp[shown]),
                         'pose_to_image_p50_s': float(np.percentile(latency, 50)),
                         'pose_to_image_p99_s': float(np.percentile(latency, 99)),
-                        'pose_to_publication_p99_s': float(said[-1]),
-                        'frame_cpu_p50_s': float(frame_cpu[-1])})
+                        'pose_to_publication_p99_s': float(said['pose_to_publication_p99_s']),
+                        'frame_cpu_p50_s': float(said['frame_cpu_p50_s'])})
     return row
 
 

@@ -217,5 +217,6 @@ def cost_section(results: dict) -> str:
         f'{1e3 * summary["pose_to_image_p99_s"]:.0f} ms at the operator over the '
         f'{1e3 * delay:.0f} ms link (target {50 + 1e3 * delay:.0f} ms), '
         f'{1e3 * summary["pose_to_publication_p99_s"]:.0f} ms to its publication at the remote '
-        f'site; the imaging thread runs at niceness +{results["niceness"]}, so under load the '
-        f'image waits and the loop does not.'])
+        f'site. The imaging thread runs at niceness +{results["niceness"]}: the loops go first '
+        f'for the cores, yet when other jobs fill both, the CPU imaging takes is theirs less '
+        f'(at niceness 0 every figure here was worse).'])

@@ -105,12 +105,13 @@ class ProbeImagerNode(Node):
         values = {'published': self._published, 'dark': self._dark.total(),
                   'replaced': self._worker.replaced, 'frame_p50_s': wall[0],
                   'frame_p99_s': wall[1], 'frame_cpu_p50_s': cpu[0],
-                  'pose_to_image_p50_s': latency[0], 'pose_to_image_p99_s': latency[1]}
+                  'pose_to_publication_p50_s': latency[0],
+                  'pose_to_publication_p99_s': latency[1]}
         if self._pose is None:
             return Report(WARN, 'waiting for robot/tcp_pose', values)
         return Report(OK, f'{self._published} frames; frame time p50 {1e3 * wall[0]:.1f} ms, '
-                      f'p99 {1e3 * wall[1]:.1f} ms; pose to image p99 {1e3 * latency[1]:.1f} ms',
-                      values)
+                      f'p99 {1e3 * wall[1]:.1f} ms; pose to publication p99 '
+                      f'{1e3 * latency[1]:.1f} ms', values)
 
     def destroy_node(self) -> bool:
         self._worker.close()
