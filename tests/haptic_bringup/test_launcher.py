@@ -6,7 +6,8 @@ import sys
 import yaml
 
 from haptic_bringup.launcher import (expected_endpoints, loop_environment, LoopConfig,
-                                     node_parameters, site_nodes)
+                                     node_parameters, parse_args, site_nodes, teleop_endpoints)
+from haptic_bringup.site import parse_args as site_args, site_config
 
 
 def test_children_discover_on_localhost_only_in_the_chosen_domain(tmp_path, monkeypatch):
@@ -73,3 +74,8 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
     assert site_nodes(blind, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
     assert '/probe/image' not in node_parameters(blind)['operator_recorder'][
         'ros__parameters']['topics']
+    assert '/probe/image' not in teleop_endpoints(blind)[blind.remote_domain_id]
+    assert teleop_endpoints(config)[config.remote_domain_id]['/probe/image'] == (1, 1)
+    remote = site_config(site_args(['remote', '--listen', 'tls/0.0.0.0:7447', '--insecure',
+                                    '--no-imaging']))
+    assert remote.loop.imaging is False and parse_args(['--teleop', 'model']).imaging
