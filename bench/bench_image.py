@@ -21,7 +21,6 @@ frequencies. ``--json PATH`` writes every figure for the report.
 """
 
 import argparse
-import json
 import math
 import os
 from pathlib import Path
@@ -31,6 +30,7 @@ import time
 
 import machine
 import numpy as np
+import result_files
 
 import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
 from collision_engine import load_scene
@@ -161,7 +161,7 @@ def main(argv=None) -> dict:
     """Run the benchmark, print its tables, and write ``--json`` if asked."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--frames', type=int, default=600)
-    parser.add_argument('--json', type=Path, help='write every figure here')
+    result_files.add_option(parser)
     parser.add_argument('--no-simus', action='store_true', help='skip the PSF against SIMUS')
     args = parser.parse_args(argv)
     core = _pin_to_one_core()
@@ -198,8 +198,7 @@ def main(argv=None) -> dict:
               f'{row["rayleigh"]:.3f} | {row["error"]:+.1%} |')
     result['load_after'] = os.getloadavg()
     print(f'\n# load average after: {result["load_after"][0]:.2f}')
-    if args.json:
-        args.json.write_text(json.dumps(result, indent=2))
+    result_files.write(args.json, result)
     return result
 
 

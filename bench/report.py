@@ -10,9 +10,10 @@ box and the cylinder, brute force with a winding-number sign for the hand; it sh
 with the engine), replays the paper's own collision code (``paper_method.py``, on the paper's
 STL objects) along the same trajectories, and writes ``README.md`` with PNG figures into
 ``--out``: the paper's Figures 1-3 and Tables 1, 2, 4 with its reported values beside ours,
-the probe's torque against the analytic face (``report_probe``), the demo's telerobotic scan,
-message counts, and the machine. Every number of ours there is computed by this run; the
-paper's are typed in from it (``PAPER``) and labelled as such.
+the probe's torque against the analytic face (``report_probe``), the demo's telerobotic scan and
+its probe images (``report_image``), message counts, and the machine. Every number of ours
+there is computed by this run; the paper's are typed in from it (``PAPER``) and labelled as
+such.
 
 The benchmarks' sections (error against run time, our GJK's trade-off, the loop against its
 floor, the stiffness sweep, the stiff wall over the loop, the servo rate, the extreme-geometry
@@ -39,6 +40,7 @@ from report_document import Findings, readme
 from report_experiments import EXPERIMENTS
 from report_figures import (error_time_figure, experiment_figure, headline_figure, sweep_figure,
                             tradeoff_figure)
+from report_image import image_figures, read_image_scan
 from report_metrics import measure
 from report_paper_replay import replay_paper
 from report_probe import probe_figure, read_probe_runs
@@ -50,7 +52,7 @@ import result_files
 __all__ = ['STAGES', 'build', 'main']
 
 ROOT = Path(__file__).resolve().parents[1]
-STAGES = ('bags', 'truth', 'paper', 'figures', 'probe', 'teleop', 'stored', 'write')
+STAGES = ('bags', 'truth', 'paper', 'figures', 'probe', 'teleop', 'image', 'stored', 'write')
 
 
 class _Stages:
@@ -115,6 +117,14 @@ def build(args) -> Path:
     teleop = stages.run('teleop', 'the demo\'s telerobotic scan',
                         lambda: teleop_demo_row(args.demo_dir))
 
+    def image():
+        scan = read_image_scan(args.demo_dir, type_store)
+        if scan is not None:
+            image_figures(scan, out)
+        return scan
+
+    image_scan = stages.run('image', 'the probe\'s image along the scan', image)
+
     def stored():
         found = stored_results(args.results)
         _stored_figures(found, args.results, out)
@@ -125,7 +135,7 @@ def build(args) -> Path:
     def write():
         findings = Findings(
             recordings, truths, replays, measures, control_contacts(args.demo_dir, type_store),
-            probe, teleop, benchmarks, args.results)
+            probe, teleop, benchmarks, args.results, image_scan)
         return readme(findings, provenance=provenance(), argv=args.argv, demo_dir=args.demo_dir,
                       durations=stages.durations)
 

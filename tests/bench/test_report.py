@@ -3,7 +3,8 @@ from pathlib import Path
 
 from report import main
 from report_benchmarks import STORED, stored_results
-from report_document import _stability_chapter, _teleop_chapter, _timing_chapter, Findings
+from report_document import (_image_chapter, _stability_chapter, _teleop_chapter,
+                             _timing_chapter, Findings)
 from result_files import describe, missing, write
 from run_all import BENCHMARKS
 from stiffness_sweep import SweepRow
@@ -16,7 +17,8 @@ def findings(benchmarks: dict, results: Path, teleop=None) -> Findings:
 
 
 def benchmark_chapters(f: Findings) -> str:
-    return '\n'.join(_timing_chapter(f) + _stability_chapter(f) + _teleop_chapter(f))
+    return '\n'.join(_timing_chapter(f) + _stability_chapter(f) + _teleop_chapter(f)
+                     + _image_chapter(f))
 
 
 def test_a_demo_folder_without_bags_fails_and_names_the_missing_bag(tmp_path, capsys):
@@ -38,6 +40,7 @@ def test_every_stored_benchmark_has_its_section_saying_how_to_measure_it_when_mi
     for name in STORED:
         assert text.count(missing(name, tmp_path)) == 1, name
     assert '*The demo recorded no telerobotic scan.*' in text
+    assert '*The demo recorded no probe image.*' in text
 
 
 def test_a_stored_result_is_shown_with_where_and_when_it_was_measured(tmp_path: Path):

@@ -6,7 +6,8 @@ import sys
 import yaml
 
 from haptic_bringup.launcher import (expected_endpoints, loop_environment, LoopConfig,
-                                     node_parameters, site_nodes)
+                                     node_parameters, parse_args, site_nodes, teleop_endpoints)
+from haptic_bringup.site import parse_args as site_args, site_config
 
 
 def test_children_discover_on_localhost_only_in_the_chosen_domain(tmp_path, monkeypatch):
@@ -66,4 +67,15 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
     assert operator['output'] == str(tmp_path / 'scan' / 'operator')
     assert remote['output'] == str(tmp_path / 'scan' / 'remote') and remote['prefix'] == '/remote'
     assert site_nodes(config, 'operator') == ('wand_driver', 'teleop_leader', 'operator_recorder')
-    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'probe_imager',
+                                            'remote_recorder')
+    assert operator['topics'][-1] == '/probe/image'  # recorded where it is seen
+    blind = LoopConfig(teleop='model', record=str(tmp_path / 'blind'), imaging=False)
+    assert site_nodes(blind, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    assert '/probe/image' not in node_parameters(blind)['operator_recorder'][
+        'ros__parameters']['topics']
+    assert '/probe/image' not in teleop_endpoints(blind)[blind.remote_domain_id]
+    assert teleop_endpoints(config)[config.remote_domain_id]['/probe/image'] == (1, 1)
+    remote = site_config(site_args(['remote', '--listen', 'tls/0.0.0.0:7447', '--insecure',
+                                    '--no-imaging']))
+    assert remote.loop.imaging is False and parse_args(['--teleop', 'model']).imaging

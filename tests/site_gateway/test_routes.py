@@ -2,12 +2,13 @@
 import pytest
 
 from remote_probe.relay import Route
-from site_gateway.routes import (bye_key, other_role, RELIABLE, role_in_key, site_routes,
-                                 STREAM)
+from site_gateway.routes import (bye_key, FRAME, other_role, RELIABLE, role_in_key,
+                                 site_routes, STREAM)
 
 COMMAND = '/teleop/command:haptic_msgs/msg/TeleopCommand'
 FEEDBACK = '/teleop/feedback:haptic_msgs/msg/TeleopFeedback'
 CLUTCH = 'teleop/clutch:std_msgs/msg/Bool'
+IMAGE = '/probe/image:sensor_msgs/msg/Image'
 
 
 def test_each_site_sends_what_its_role_publishes_and_receives_the_rest():
@@ -23,6 +24,11 @@ def test_each_site_sends_what_its_role_publishes_and_receives_the_rest():
     assert remote.outgoing[0].key('haptic') == 'haptic/remote/teleop/feedback'
 
 
+def test_an_image_crosses_as_a_frame():
+    remote = site_routes('remote', [COMMAND], [FEEDBACK, IMAGE], frames=['probe/image'])
+    assert [c.kind for c in remote.outgoing] == [STREAM, FRAME]
+
+
 def test_the_role_in_a_key_is_read_back():
     assert role_in_key('haptic/remote/teleop/command', 'haptic') == 'remote'
     assert role_in_key('haptic/operator/x', 'haptic') == 'operator'
@@ -36,6 +42,8 @@ def test_the_role_in_a_key_is_read_back():
     (('pilot', [COMMAND], [FEEDBACK]), ["role 'pilot'"]),
     (('operator', [COMMAND], [COMMAND]), ['both', 'one way']),
     (('operator', [COMMAND], [FEEDBACK], ['teleop/clutch']), ['reliable', 'teleop/clutch']),
+    (('operator', [COMMAND], [FEEDBACK], [], ['/probe/image']), ['frames', 'probe/image']),
+    (('operator', [COMMAND], [IMAGE], ['probe/image'], ['/probe/image']), ['both', 'choose']),
     (('operator', ['_gateway/bye:std_msgs/msg/Bool'], [FEEDBACK]), ['gateways\' own']),
     (('operator', ['teleop/command'], [FEEDBACK]), ["'topic:pkg/msg/Type'"]),
 ])

@@ -12,8 +12,9 @@ the operator's hand would go if nothing pushed back. ``probe-flat`` and ``probe-
 a linear probe (a 10 x 40 mm face) rolled and yawed +-20 degrees on a flat slab and on the
 patient phantom: force and torque about the tip. ``teleop`` is the telerobotic scan: the
 operator's site and the remote robot on the patient phantom, in two DDS domains, model-mediated
-over a 50 ms link (5 ms jitter, 1 % loss); it prints the force the patient felt and the hand
-felt, and the round trip the operator measured.
+over a 50 ms link (5 ms jitter, 1 % loss), the remote site imaging the probe's view; it prints
+the force the patient felt and the hand felt, the round trip the operator measured, and the
+probe's frames the operator received.
 """
 import argparse
 import os
@@ -28,7 +29,7 @@ from haptic_bringup.bag import typestore_with
 from haptic_bringup.contacts import contact_intervals, format_contacts
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import (published_counts, PUBLISHERS, read_session,
+from haptic_bringup.session import (published_counts, PUBLISHERS, read_frames, read_session,
                                     read_vectors, reported, topic_counts)
 
 __all__ = ['main', 'EXPERIMENTS', 'run_experiment']
@@ -92,12 +93,16 @@ def summarise_teleop(bag: pathlib.Path) -> str:
     patient = np.linalg.norm(series['/remote/robot/ft_sensor/wrench'][1], axis=1)
     felt = np.linalg.norm(series['/wand/applied_wrench'][1], axis=1)
     round_trip = reported(bag, typestore, 'round_trip_s').get('teleop_leader', ['nan'])[-1]
+    frames = read_frames(bag, typestore)
+    latency = frames.received - frames.stamp
+    late = 1e3 * np.percentile(latency, (50, 99)) if len(latency) else (np.nan, np.nan)
     return (f'== {TELEOP}: {TELEOP_SCHEME} over a {1e3 * TELEOP_LINK["delay"]:g} ms link ==\n'
             f'patient force: median {np.median(patient[patient > 1.0]):.2f} N in contact, peak '
             f'{patient.max():.2f} N; felt / {FORCE_SCALE:g}: median '
             f'{np.median(felt[felt > FORCE_SCALE]) / FORCE_SCALE:.2f} N; round trip measured by '
             f'the operator from echoed stamps: {1e3 * float(round_trip):.1f}'
-            ' ms')
+            f' ms\nprobe image: {len(frames.stamp)} frames at the operator; pose to image p50 '
+            f'{late[0]:.0f} ms, p99 {late[1]:.0f} ms')
 
 
 def summarise(name: str, files: dict) -> str:

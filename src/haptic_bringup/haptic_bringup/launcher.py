@@ -18,7 +18,8 @@ ROS 2 install, ``ros2 launch haptic_bringup haptic_loop.launch.py`` does the sam
 
 With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
 (the wand driver and the leader, one process) in one DDS domain, the remote site (the robot with
-its F/T sensor on the patient phantom, and the follower, one process) in the next domain, and
+its F/T sensor on the patient phantom, the follower and the probe's imager, one process; no
+imager with ``--no-imaging``) in the next domain, and
 both sites' gateways between them (``haptic_bringup.site.loopback_gateways``): the deployed path,
 over loopback mutual TLS, each gateway delaying, jittering and dropping what it sends. With
 ``--record DIR`` each site's process records itself: DIR is the session, holding the bags
@@ -54,9 +55,11 @@ TELEOP_NODES = {
     'teleop_leader': ('remote_probe', 'remote_probe.leader_node', 'LeaderNode'),
     'sim_robot': ('remote_probe', 'remote_probe.robot_node', 'SimulatedRobotNode'),
     'teleop_follower': ('remote_probe', 'remote_probe.follower_node', 'FollowerNode'),
+    'probe_imager': ('ultrasound_sim', 'ultrasound_sim.node', 'ProbeImagerNode'),
 }
 OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
+IMAGER = 'probe_imager'  # the remote site's ultrasound scanner, unless LoopConfig.imaging is off
 # The recorder in each kind of process (haptic_bringup.process_recorder), by its node name.
 RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
     'recorder', 'operator_recorder', 'remote_recorder')
@@ -65,13 +68,17 @@ SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 LATE_POSE_HOLD = 0.5  # [s] past the stalls seen with the machine fully loaded (up to 0.45 s)
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
-TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
+IMAGE = '/probe/image'
+TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',
+               f'{IMAGE}:sensor_msgs/msg/Image')
+FRAMES = (IMAGE,)  # what crosses as frames: after the streams, dropped when congested
 # A session's bag holds what each site measured and what crossed the link, recorded where it
 # arrives (its sent copy is the same message, earlier). Left out, each one step from those and
 # read by no analysis: the wand's twist (the pose's rate), the leader's answer to its driver (the
 # feedback through the leader) and the robot's target (the command through the patient-safety
 # filter). Each 1 kHz stream recorded costs its writer and the recorder about 5 % of a core
-# (docs/cpu_budget.md), on two cores that hold both sites.
+# (docs/cpu_budget.md), on two cores that hold both sites. The probe's image is recorded where
+# the operator sees it, once: its stamp is the pose's, so the bag gives pose to image there.
 OPERATOR_RECORDED = ('/wand/pose', '/wand/applied_wrench', '/teleop/feedback', '/diagnostics')
 REMOTE_RECORDED = ('/robot/tcp_pose', '/robot/ft_sensor/wrench', '/teleop/command', '/diagnostics')
 COMPOSED_MODULE = 'haptic_bringup.composed'
@@ -100,6 +107,7 @@ class LoopConfig:
     python: str = sys.executable
     teleop: Optional[str] = None  # a bilateral scheme: a telerobotic session instead
     link: dict = dataclasses.field(default_factory=dict)  # delay, jitter, loss, ... (s)
+    imaging: bool = True  # teleop: the remote site images the probe's view (probe_imager)
     remote_domain: Optional[int] = None  # the remote site's DDS domain; None: the next one
     # Composed, the loop's process records itself; False: a recorder process does, as for three
     # processes (the baseline the benchmarks compare it with).
@@ -198,16 +206,16 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
         options.setdefault(node, {})['scheme'] = scheme
     if config.record:
         session = pathlib.Path(config.record).resolve()
-        options[OPERATOR_RECORDER] = {'output': str(session / 'operator'),
-                                      'topics': list(OPERATOR_RECORDED)}
+        options[OPERATOR_RECORDER] = {'output': str(session / 'operator'), 'topics': [
+            *OPERATOR_RECORDED, *([IMAGE] if config.imaging else [])]}
         options[REMOTE_RECORDER] = {'output': str(session / 'remote'),
                                     'topics': list(REMOTE_RECORDED), 'prefix': REMOTE_PREFIX}
 
 
 def site_nodes(config: LoopConfig, site: str) -> tuple:
     """Return the node names of a telerobotic site's process: its nodes, and its recorder."""
-    nodes, recorder = ((OPERATOR_SITE, OPERATOR_RECORDER) if site == 'operator'
-                       else (REMOTE_SITE, REMOTE_RECORDER))
+    nodes, recorder = ((OPERATOR_SITE, OPERATOR_RECORDER) if site == 'operator' else
+                       ((*REMOTE_SITE, *([IMAGER] if config.imaging else [])), REMOTE_RECORDER))
     return (*nodes, recorder) if config.record else nodes
 
 
@@ -218,19 +226,23 @@ def teleop_endpoints(config: LoopConfig) -> dict:
     intra-process delivery. So is each site's recorder, which is in its process and, with that
     delivery, takes what crossed the link through the reader of the node that uses it. The
     recorder's reader of ``/diagnostics`` says it exists: a site builds it last, so its nodes
-    then spin (a remote site still starting would miss the operator's short session).
+    then spin (a remote site still starting would miss the operator's short session). The
+    probe's image is no stream: its imager and the operator's recorder take it over DDS.
     """
     site = 0 if config.intra_process else 1  # a subscriber in the publisher's process
     recording = site if config.record else 0
     reports = {'/diagnostics': (0, 1)} if config.record else {}
+    imaged = config.imaging
     return {
         config.domain_id: {'/wand/pose': (1, site + recording), '/teleop/command': (1, 1),
-                           '/teleop/feedback': (1, 1 + recording), **reports},
+                           '/teleop/feedback': (1, 1 + recording), **reports,
+                           **({IMAGE: (1, int(bool(config.record)))} if imaged else {})},
         config.remote_domain_id: {'/teleop/command': (1, 1 + recording),
                                   '/teleop/feedback': (1, 1),
                                   '/robot/target_pose': (1, site),
-                                  '/robot/tcp_pose': (1, site + recording),
-                                  '/robot/ft_sensor/wrench': (1, site + recording), **reports},
+                                  '/robot/tcp_pose': (1, site + recording + site * imaged),
+                                  '/robot/ft_sensor/wrench': (1, site + recording), **reports,
+                                  **({IMAGE: (1, 1)} if imaged else {})},
     }
 
 
@@ -443,6 +455,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='teleop: the remote site\'s DDS domain (default: the next one)')
     parser.add_argument('--delay-trace', metavar='CSV',
                         help='teleop: replay one-way delays from a CSV (time,delay in s)')
+    parser.add_argument('--no-imaging', dest='imaging', action='store_false',
+                        help='teleop: the remote site makes no probe image')
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', DEFAULT_DOMAIN_ID)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
@@ -470,7 +484,7 @@ def main(argv=None) -> int:
                         duration=args.duration, record=args.record, domain_id=args.domain_id,
                         params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
                         teleop=args.teleop, link=link_parameters(args),
-                        remote_domain=args.remote_domain_id)
+                        remote_domain=args.remote_domain_id, imaging=args.imaging)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     loop = Loop(config)
     stop = []

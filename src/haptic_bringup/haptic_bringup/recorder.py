@@ -40,13 +40,14 @@ from rclpy.serialization import deserialize_message, serialize_message
 from std_msgs.msg import Bool
 
 from haptic_bringup.bag import typestore_with
-from haptic_bringup.params import DIAGNOSTICS, LATCHED_TOPICS, RecorderParams, TOPIC_TYPES
+from haptic_bringup.params import (DIAGNOSTICS, FRAME_TOPICS, LATCHED_TOPICS, RecorderParams,
+                                   TOPIC_TYPES)
 from haptic_bringup.queued_bag import QueuedBag
 from haptic_util import diagnostics
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.parameters import declare_parameters
-from haptic_util.qos import LATCHED_QOS, RECORDER_QOS, RELIABLE_RECORDER_QOS
+from haptic_util.qos import FRAME_QOS, LATCHED_QOS, RECORDER_QOS, RELIABLE_RECORDER_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 
@@ -109,8 +110,9 @@ class Recorder(Node):
         if topic == DIAGNOSTICS:
             self._record_reports(name)
         elif topic in TOPIC_TYPES:
-            self._over_dds(topic, name, TOPIC_TYPES[topic],
-                           LATCHED_QOS if topic in LATCHED_TOPICS else RECORDER_QOS)
+            qos = (LATCHED_QOS if topic in LATCHED_TOPICS else
+                   FRAME_QOS if topic in FRAME_TOPICS else RECORDER_QOS)
+            self._over_dds(topic, name, TOPIC_TYPES[topic], qos)
         else:
             self._pending.append((topic, name))
 

@@ -17,8 +17,9 @@ from rosbags.highlevel import AnyReader
 from haptic_bringup.bag import killed_bags
 from haptic_util.stamps import to_nanoseconds
 
-__all__ = ['Session', 'bags', 'read_session', 'read_vectors', 'reported', 'topic_counts',
-           'published_counts', 'applied_work', 'PUBLISHERS', 'SITE_PUBLISHERS']
+__all__ = ['Frames', 'Session', 'bags', 'read_frames', 'read_session', 'read_vectors',
+           'reported', 'topic_counts', 'published_counts', 'applied_work', 'PUBLISHERS',
+           'SITE_PUBLISHERS']
 
 # Which node publishes each stream, by its name in /diagnostics reports (a node publishes each
 # of its streams once per count): the loop's, and a telerobotic site's own measurements.
@@ -181,6 +182,48 @@ def read_vectors(path: pathlib.Path, typestore, topics: dict, stamped: bool = Fa
             series[connection.topic][1].append(_xyz(vector))
     return {topic: (np.array(times), np.array(vectors).reshape(-1, 3))
             for topic, (times, vectors) in series.items()}
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Frames:
+    """A recorded mono8 image stream (the probe's ``/probe/image``).
+
+    Attributes
+    ----------
+    received : (n,) float, s
+        When the recorder received each frame (the machine's clock).
+    stamp : (n,) float, s
+        Each frame's stamp: the pose it was made from.
+    images : (n, height, width) uint8
+    frame_ids : set of str
+    """
+
+    received: np.ndarray
+    stamp: np.ndarray
+    images: np.ndarray
+    frame_ids: set
+
+
+def read_frames(path: pathlib.Path, typestore, topic: str = '/probe/image') -> Frames:
+    """Return the mono8 frames of ``topic`` in the session; raise ValueError for another encoding.
+
+    The frames are read into memory: about 2 MB a second at 30 Hz of 256 x 256.
+    """
+    received, stamps, images, frame_ids = [], [], [], set()
+    with AnyReader(bags(path), default_typestore=typestore) as reader:
+        connections = [c for c in reader.connections if c.topic == topic]
+        for connection, stamp, raw in reader.messages(connections=connections):
+            msg = reader.deserialize(raw, connection.msgtype)
+            if msg.encoding != 'mono8' or msg.step != msg.width:
+                raise ValueError(f'{path}: {topic}: {msg.encoding!r} (step {msg.step}, width '
+                                 f'{msg.width}), not packed mono8')
+            received.append(stamp * 1e-9)
+            stamps.append(to_nanoseconds(msg.header.stamp) * 1e-9)
+            images.append(np.asarray(msg.data, dtype=np.uint8).reshape(msg.height, msg.width))
+            frame_ids.add(msg.header.frame_id)
+    shape = images[0].shape if images else (0, 0)
+    return Frames(np.array(received), np.array(stamps),
+                  np.array(images, dtype=np.uint8).reshape(-1, *shape), frame_ids)
 
 
 def applied_work(session: Session) -> float:

@@ -32,9 +32,9 @@ from typing import Optional
 
 import yaml
 
-from haptic_bringup.launcher import (link_parameters, Loop, loop_environment, LoopConfig,
-                                     node_parameters, site_nodes, teleop_endpoints, TO_OPERATOR,
-                                     TO_REMOTE)
+from haptic_bringup.launcher import (FRAMES, link_parameters, Loop, loop_environment,
+                                     LoopConfig, node_parameters, site_nodes, teleop_endpoints,
+                                     TO_OPERATOR, TO_REMOTE)
 from haptic_bringup.processes import start_child
 from site_gateway.certs import init_ca, issue
 
@@ -63,7 +63,7 @@ def gateway_parameters(role: str, *, listen=(), connect=(), certs: Optional[str]
     return {'role': role, 'listen': list(listen) or [''], 'connect': list(connect) or [''],
             'certs': str(pathlib.Path(certs).expanduser().resolve()) if certs else '',
             'insecure': insecure, 'to_remote': list(TO_REMOTE),
-            'to_operator': list(TO_OPERATOR), **(link or {})}
+            'to_operator': list(TO_OPERATOR), 'frames': list(FRAMES), **(link or {})}
 
 
 def site_parameters(site: SiteConfig) -> dict:
@@ -85,7 +85,7 @@ def loopback_gateway_parameters(folder: pathlib.Path, *, link: Optional[dict] = 
     The single-machine session takes the deployed path: a CA and both sites' certificates made
     for the run in ``folder/certs``, the remote gateway listening on a free loopback port, the
     operator's dialling it, each applying the emulated ``link`` to what it sends. ``routes``
-    (``to_remote``, ``to_operator``) replace the session's crossing topics.
+    (``to_remote``, ``to_operator``, and ``frames`` if any) replace the session's crossings.
     """
     certs = folder / 'certs'
     init_ca(certs)
@@ -94,8 +94,9 @@ def loopback_gateway_parameters(folder: pathlib.Path, *, link: Optional[dict] = 
     with socket.socket() as probe:
         probe.bind(('127.0.0.1', 0))
         endpoint = [f'tls/127.0.0.1:{probe.getsockname()[1]}']
+    replaced = {'frames': [''], **routes} if routes else {}
     return {role: {**gateway_parameters(role, certs=str(certs), link=link, **{side: endpoint}),
-                   **(routes or {})}
+                   **replaced}
             for role, side in (('remote', 'listen'), ('operator', 'connect'))}
 
 
@@ -178,6 +179,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='probability that the emulated link loses a message')
     parser.add_argument('--delay-trace', metavar='CSV',
                         help='replay one-way delays from a CSV (time,delay in s)')
+    parser.add_argument('--no-imaging', dest='imaging', action='store_false',
+                        help='remote: make no probe image (operator: record none)')
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
@@ -196,7 +199,7 @@ def site_config(args: argparse.Namespace) -> SiteConfig:
     loop = LoopConfig(composed=True, teleop=args.scheme, domain_id=args.domain_id,
                       experiment=args.experiment, duration=args.duration, record=args.record,
                       params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
-                      link=link_parameters(args))
+                      link=link_parameters(args), imaging=args.imaging)
     return SiteConfig(args.role, loop, tuple(args.listen), tuple(args.connect), args.certs,
                       args.insecure)
 

@@ -8,8 +8,8 @@ transient-local, so that a late subscriber, such as a recorder or RViz, still re
 """
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-__all__ = ['HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_QOS', 'RECORDER_QOS', 'RELIABLE_RECORDER_QOS',
-           'MARKER_QOS']
+__all__ = ['FRAME_QOS', 'HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_QOS', 'RECORDER_QOS',
+           'RELIABLE_RECORDER_QOS', 'MARKER_QOS']
 
 STREAM_DEPTH = 10
 
@@ -59,6 +59,16 @@ LATCHED_QOS = QoSProfile(
 MARKER_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=1,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.VOLATILE,
+)
+
+# Frames for people to look at (an ultrasound image): reliable, so that every viewer matches
+# (RViz's Image display subscribes reliably by default, rqt_image_view best effort), keep last
+# 2: a slow viewer gets the newest, and a publisher never waits for one.
+FRAME_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=2,
     reliability=ReliabilityPolicy.RELIABLE,
     durability=DurabilityPolicy.VOLATILE,
 )

@@ -39,12 +39,12 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.qos import FRAME_QOS, HAPTIC_STREAM_QOS
 from haptic_util.transport import loopback_udp
 from remote_probe.link_stage import emulated_link, LinkStageParams, ReleaseTimer
 from remote_probe.relay import message_class, Relay
 from site_gateway.inbound import Inbound
-from site_gateway.routes import bye_key, other_role, RELIABLE, ROLES, site_routes
+from site_gateway.routes import bye_key, FRAME, other_role, RELIABLE, ROLES, site_routes
 from site_gateway.zenoh_config import (check_endpoints, Credentials, LEASE, publisher_options,
                                        session_config)
 
@@ -85,6 +85,8 @@ class GatewayParams(LinkStageParams):
         TELEOP_TO_OPERATOR, "topics the remote site sends, 'topic:pkg/msg/Type'; [''] for none")
     reliable: tuple[str, ...] = parameter(('',), 'topics (of the above) that must arrive: '
                                           "reliable, blocking; [''] for none")
+    frames: tuple[str, ...] = parameter(('',), 'topics (of the above) that are images: after '
+                                        "the streams, dropped when congested; [''] for none")
     key_prefix: str = parameter('haptic', 'the Zenoh keys of this session start with it')
     lease: float = parameter(LEASE, 'a connection silent this long is closed and opened anew',
                              unit='s', low=0.1, high=60.0)
@@ -97,7 +99,8 @@ def _plan(params: GatewayParams, name: str) -> tuple:
     listen = tuple(e.strip() for e in params.listen if e.strip())
     connect = tuple(e.strip() for e in params.connect if e.strip())
     try:
-        routes = site_routes(params.role, params.to_remote, params.to_operator, params.reliable)
+        routes = site_routes(params.role, params.to_remote, params.to_operator, params.reliable,
+                             params.frames)
         check_endpoints(listen, connect, insecure=params.insecure)
         credentials = None
         if not params.insecure:
@@ -129,14 +132,18 @@ def _open(config: dict, name: str) -> zenoh.Session:
 
 
 def _qos(kind: str) -> QoSProfile:
-    """Return the QoS of a crossing's kind: reliable for what must arrive, else a stream.
+    """Return the QoS of a crossing's kind: reliable for what must arrive, a frame's, a stream's.
+
+    A frame is read and written as its publisher and viewers take it (``FRAME_QOS``): reliable
+    (an image is many UDP fragments, and one lost would lose it) yet never blocking, as it
+    keeps only the newest.
 
     A stream is read with the haptic streams' shallow history: after a stall only the newest
     go on. Read with ``LINK_QOS`` (1000 deep), the operator's gateway
     stopped taking commands altogether a few seconds into the attacked session, in 2 runs of 2
     (its timers and its other direction went on); with this depth it relayed to the end.
     """
-    return RELIABLE_QOS if kind == RELIABLE else HAPTIC_STREAM_QOS
+    return {RELIABLE: RELIABLE_QOS, FRAME: FRAME_QOS}.get(kind, HAPTIC_STREAM_QOS)
 
 
 class GatewayNode(Node):

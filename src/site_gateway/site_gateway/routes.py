@@ -9,18 +9,21 @@ nothing of who sent it.
 
 Topics are written ``'topic:pkg/msg/Type'`` (``remote_probe.relay``).
 A topic crosses as a 1 kHz stream (the newest message matters, a late one is worthless: drop
-rather than block) unless it is listed as reliable (it must arrive, as the clutch must).
+rather than block) unless it is listed as reliable (it must arrive, as the clutch must) or as a
+frame (an image: tens of kilobytes at tens of hertz, for a person to look at; the newest
+matters, and it must never hold a stream back: it goes after the streams, dropped when the link
+is congested).
 """
 from dataclasses import dataclass
 from typing import Iterable
 
 from remote_probe.relay import check_no_loop, parse_routes, Route
 
-__all__ = ['Crossing', 'RELIABLE', 'ROLES', 'STREAM', 'SiteRoutes', 'bye_key', 'other_role',
-           'role_in_key', 'site_routes']
+__all__ = ['Crossing', 'FRAME', 'RELIABLE', 'ROLES', 'STREAM', 'SiteRoutes', 'bye_key',
+           'other_role', 'role_in_key', 'site_routes']
 
 ROLES = ('operator', 'remote')
-STREAM, RELIABLE = 'stream', 'reliable'
+STREAM, RELIABLE, FRAME = 'stream', 'reliable', 'frame'
 _PUBLISHER = {'to_remote': 'operator', 'to_operator': 'remote'}
 _BYE = '_gateway/bye'  # under a role's keys: that site's gateway is stopping
 
@@ -85,27 +88,37 @@ class SiteRoutes:
     incoming: tuple  # Crossing, published by the other site
 
 
+def _topics(listed: Iterable[str]) -> set:
+    """Return the topics listed (as in the routes), blank entries skipped."""
+    return {topic.strip().lstrip('/') for topic in listed if topic.strip()}
+
+
 def site_routes(role: str, to_remote: Iterable[str], to_operator: Iterable[str],
-                reliable: Iterable[str] = ()) -> SiteRoutes:
+                reliable: Iterable[str] = (), frames: Iterable[str] = ()) -> SiteRoutes:
     """Return ``role``'s side of the table; raise ValueError naming what is wrong.
 
-    ``reliable`` lists topics (as in the routes) that must arrive; blank entries are skipped,
-    as in the routes. A topic may cross one way only, and none may be named like the
-    gateways' own key.
+    ``reliable`` lists topics (as in the routes) that must arrive, ``frames`` those that cross
+    as frames; blank entries are skipped, as in the routes. A topic may cross one way only, as
+    one kind, and none may be named like the gateways' own key.
     """
     other_role(role)
     routes = {'to_remote': parse_routes(to_remote, 'to_remote'),
               'to_operator': parse_routes(to_operator, 'to_operator')}
     check_no_loop(routes['to_remote'], routes['to_operator'])
-    must_arrive = {topic.strip().lstrip('/') for topic in reliable if topic.strip()}
+    kinds = {RELIABLE: _topics(reliable), FRAME: _topics(frames)}
+    both = kinds[RELIABLE] & kinds[FRAME]
+    if both:
+        raise ValueError(f'{sorted(both)} listed both as reliable and as frames; choose one')
+    kind_of = {topic: kind for kind, topics in kinds.items() for topic in topics}
     crossings = [Crossing(route, _PUBLISHER[direction],
-                          RELIABLE if route.topic.lstrip('/') in must_arrive else STREAM)
+                          kind_of.get(route.topic.lstrip('/'), STREAM))
                  for direction, entries in routes.items() for route in entries]
     topics = {crossing.topic for crossing in crossings}
-    unknown = must_arrive - topics
-    if unknown:
-        raise ValueError(f'reliable: {sorted(unknown)} cross neither way; list each in '
-                         f'to_remote or to_operator')
+    for kind, listed in (('reliable', kinds[RELIABLE]), ('frames', kinds[FRAME])):
+        unknown = listed - topics
+        if unknown:
+            raise ValueError(f'{kind}: {sorted(unknown)} cross neither way; list each in '
+                             f'to_remote or to_operator')
     if _BYE in topics:
         raise ValueError(f'topic {_BYE!r} is the gateways\' own; it cannot cross')
     return SiteRoutes(role, tuple(c for c in crossings if c.publisher == role),

@@ -20,6 +20,9 @@ Why these settings (``../shared/zenoh-link.md``):
   blocks. An express message takes a batch of its priority's queue until it is written, and
   a full queue drops it: with Zenoh's default of 2 batches, a sender descheduled for 2 ms
   loses messages (0.5-3.3 % of a 1 kHz stream over 10 s here at load 16, none with 16).
+- Frames (the probe's image, 64 kB at 30 Hz) go at data priority, below the streams and what
+  must arrive: Zenoh sends a higher priority's batches first, so an image being written never
+  holds a stream back. Dropped when congested, as a late image is worthless too.
 """
 from dataclasses import dataclass
 import os
@@ -28,7 +31,7 @@ import stat
 
 import zenoh
 
-from site_gateway.routes import RELIABLE, ROLES, SiteRoutes, STREAM
+from site_gateway.routes import FRAME, RELIABLE, ROLES, SiteRoutes, STREAM
 
 __all__ = ['Credentials', 'LEASE', 'RETRY', 'access_control', 'check_endpoints',
            'publisher_options', 'session_config']
@@ -110,7 +113,8 @@ def session_config(routes: SiteRoutes, *, listen, connect, credentials: Credenti
         'transport': {'link': {'tx': {'lease': round(lease * 1e3),
                                       'keep_alive': KEEP_ALIVES_PER_LEASE,
                                       'queue': {'size': {'real_time': QUEUE_BATCHES,
-                                                         'interactive_high': QUEUE_BATCHES}}}}},
+                                                         'interactive_high': QUEUE_BATCHES,
+                                                         'data': QUEUE_BATCHES}}}}},
     }
     if credentials is not None:
         files = {'root_ca_certificate': credentials.ca,
@@ -149,7 +153,7 @@ def access_control(role: str, prefix: str) -> dict:
 
 
 def publisher_options(kind: str) -> dict:
-    """Return the ``declare_publisher`` options of a crossing's kind (STREAM or RELIABLE)."""
+    """Return the ``declare_publisher`` options of a crossing's kind (STREAM, RELIABLE, FRAME)."""
     if kind == STREAM:
         return {'express': True, 'priority': zenoh.Priority.REAL_TIME,
                 'congestion_control': zenoh.CongestionControl.DROP,
@@ -158,4 +162,8 @@ def publisher_options(kind: str) -> dict:
         return {'express': True, 'priority': zenoh.Priority.INTERACTIVE_HIGH,
                 'congestion_control': zenoh.CongestionControl.BLOCK,
                 'reliability': zenoh.Reliability.RELIABLE}
-    raise ValueError(f'kind {kind!r} is not {STREAM!r} nor {RELIABLE!r}')
+    if kind == FRAME:
+        return {'express': True, 'priority': zenoh.Priority.DATA,
+                'congestion_control': zenoh.CongestionControl.DROP,
+                'reliability': zenoh.Reliability.BEST_EFFORT}
+    raise ValueError(f'kind {kind!r} is not one of {[STREAM, RELIABLE, FRAME]}')

@@ -1,0 +1,199 @@
+"""The probe's image in the telerobotic session: what it costs the 1 kHz loops, and how late it is.
+
+    .venv/bin/python bench/imaging_session.py [--pairs 3] [--niceness N] [--json PATH]
+
+The model-mediated scan over a 50 ms link (5 ms jitter, 1 % loss), as ``make demo`` runs it,
+with the remote site's imager on and off (``LoopConfig.imaging``), alternated in one run (on,
+off, then off, on, ...): the same machine, the same load, the baseline beside each. Every
+figure is measured from outside the imager, over the scan's press and sweep (3 to 15 s after
+its first pose):
+
+- **the 1 kHz streams**: the operator's loop as its driver measures it (poses a second, the
+  share answered, the round trip's p99: ``stats_file``); the robot's ticks from the stamps of
+  the ``robot/tcp_pose`` its own process recorded (a second, and the tick's p99); the commands
+  that reached the remote site and the feedback that reached the operator, a second. Targets,
+  on over off: rates and answered share >= 0.99, p99 <= 1.1;
+- **the CPU** of every process of the session (``psutil``, % of one core): what imaging adds,
+  and that per frame (the added CPU over the frames a second the operator received);
+- **pose to image**: the frame's stamp (the TCP pose it shows) to its arrival in the
+  operator's bag, p50 and p99, the link's delay included (target: p99 <= 50 ms + the delay);
+  and to its publication at the remote site, as the imager reports it.
+
+The imager makes its frames in a thread of its own, at a niceness 5 above the site's loop
+(``worker_niceness``): ``--niceness`` sets another, to weigh the image's lateness against the
+loop's. The load average is printed with each run: the machine is shared, and only the ratios
+of runs side by side are figures.
+"""
+import argparse
+import os
+import pathlib
+import sys
+import tempfile
+
+import machine
+import numpy as np
+import result_files
+from rosbags.highlevel import AnyReader
+from teleop_scan import process_cpu
+
+from haptic_bringup.bag import typestore_with
+from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.recorder import custom_definitions
+from haptic_bringup.session import bags, read_frames, read_vectors, reported
+
+__all__ = ['main', 'run', 'summary']
+
+LINK = {'delay': 0.05, 'jitter': 0.005, 'loss': 0.01}  # as the demo's scan
+WINDOW = (3.0, 15.0)  # [s] after the scan's first pose: the press and the sweep
+TARGETS = {'rate': 0.99, 'answered': 0.99, 'p99': 1.1}
+STAMPED = {'/wand/pose': 'pose', '/remote/robot/tcp_pose': 'pose'}
+CROSSED = ('/remote/teleop/command', '/teleop/feedback')  # recorded where they arrived
+
+
+def _in_window(times: np.ndarray, start: float) -> np.ndarray:
+    return times[(times >= start + WINDOW[0]) & (times < start + WINDOW[1])]
+
+
+def _rate(times: np.ndarray) -> float:
+    return len(times) / (WINDOW[1] - WINDOW[0])
+
+
+def _received(bag: pathlib.Path, topic: str) -> np.ndarray:
+    """When the recorder received each message of ``topic`` (s), without decoding it."""
+    with AnyReader(bags(bag)) as reader:
+        connections = [c for c in reader.connections if c.topic == topic]
+        return np.array([t * 1e-9 for _, t, _ in reader.messages(connections=connections)])
+
+
+def run(imaging: bool, domain_id: int, niceness: int | None = None) -> dict:
+    """One scan with the imager on or off; its figures (module docstring)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = pathlib.Path(tmp)
+        stats = folder / 'loop_stats.npz'
+        overrides = {'wand_driver': {'stats_file': str(stats)}}
+        if niceness is not None:
+            overrides['probe_imager'] = {'worker_niceness': niceness}
+        config = LoopConfig(teleop='model', link=dict(LINK), record=str(folder / 'bag'),
+                            domain_id=domain_id, run_dir=folder / 'launch', imaging=imaging,
+                            overrides=overrides)
+        with Loop(config) as loop:
+            cpu = process_cpu(loop)
+            if loop.wait(60.0) is None:
+                raise RuntimeError('the scan did not end')
+        typestore = typestore_with(custom_definitions())
+        bag = folder / 'bag'
+        stamped = read_vectors(bag, typestore, STAMPED, stamped=True)
+        received = {topic: _received(bag, topic) for topic in CROSSED}
+        start = stamped['/wand/pose'][0][0]
+        ticks = np.diff(_in_window(stamped['/remote/robot/tcp_pose'][0], start))
+        loop_stats = np.load(stats)
+        row = {'imaging': imaging, 'load': os.getloadavg()[0],
+               'operator_rate_hz': float(loop_stats['rate_hz']),
+               'operator_answered_percent': float(loop_stats['answered_percent']),
+               'operator_round_trip_p99_s': float(loop_stats['latency_p99_s']),
+               'robot_rate_hz': _rate(_in_window(stamped['/remote/robot/tcp_pose'][0], start)),
+               'robot_tick_p99_s': float(np.percentile(ticks, 99)),
+               'commands_hz': _rate(_in_window(received['/remote/teleop/command'], start)),
+               'feedback_hz': _rate(_in_window(received['/teleop/feedback'], start)),
+               'cpu_percent': cpu}
+        if imaging:
+            frames = read_frames(bag, typestore)
+            shown = (frames.stamp >= start + WINDOW[0]) & (frames.stamp < start + WINDOW[1])
+            latency = (frames.received - frames.stamp)[shown]
+            said = {key: reported(bag, typestore, key).get('probe_imager', ['nan'])[-1]
+                    for key in ('pose_to_publication_p99_s', 'frame_cpu_p50_s')}
+            row.update({'frames_hz': _rate(frames.stamp[shown]),
+                        'pose_to_image_p50_s': float(np.percentile(latency, 50)),
+                        'pose_to_image_p99_s': float(np.percentile(latency, 99)),
+                        'pose_to_publication_p99_s': float(said['pose_to_publication_p99_s']),
+                        'frame_cpu_p50_s': float(said['frame_cpu_p50_s'])})
+    return row
+
+
+def _cpu(row: dict) -> float:
+    """Return the CPU of all the run's processes, % of one core."""
+    return sum(row['cpu_percent'].values())
+
+
+def summary(rows: list) -> dict:
+    """Return the ratios on / off of each stream figure, and the CPU imaging adds.
+
+    ``rows`` come in pairs, one run on and one off side by side, which share the machine's load
+    more than runs further apart: each ratio is taken within a pair, and its median and range
+    over the pairs are given.
+    """
+    pairs = [(a, b) if a['imaging'] else (b, a) for a, b in zip(rows[0::2], rows[1::2])]
+    on, off = [pair[0] for pair in pairs], [pair[1] for pair in pairs]
+
+    def median(runs, key):
+        return float(np.median([r[key] for r in runs]))
+
+    ratios, ranges = {}, {}
+    for key in ('operator_rate_hz', 'operator_answered_percent', 'operator_round_trip_p99_s',
+                'robot_rate_hz', 'robot_tick_p99_s', 'commands_hz', 'feedback_hz'):
+        each = [a[key] / b[key] for a, b in pairs]
+        ratios[key], ranges[key] = float(np.median(each)), (min(each), max(each))
+    added = float(np.median([_cpu(a) - _cpu(b) for a, b in pairs]))
+    frames_hz = median(on, 'frames_hz')
+    return {'pairs': len(pairs), 'ratios': ratios, 'ranges': ranges,
+            'cpu_on_percent': float(np.median([_cpu(r) for r in on])),
+            'cpu_off_percent': float(np.median([_cpu(r) for r in off])),
+            'cpu_added_percent': added, 'frames_hz': frames_hz,
+            'cpu_per_frame_s': added / 100.0 / frames_hz,
+            'frame_cpu_p50_s': median(on, 'frame_cpu_p50_s'),
+            'pose_to_image_p99_s': median(on, 'pose_to_image_p99_s'),
+            'pose_to_publication_p99_s': median(on, 'pose_to_publication_p99_s'),
+            'delay_s': LINK['delay'], 'targets': TARGETS}
+
+
+def _print_row(row: dict) -> None:
+    image = (f'  frames {row["frames_hz"]:.1f}/s, pose to image p50/p99 '
+             f'{1e3 * row["pose_to_image_p50_s"]:.1f}/{1e3 * row["pose_to_image_p99_s"]:.1f} ms '
+             f'(published p99 {1e3 * row["pose_to_publication_p99_s"]:.1f} ms)'
+             if row['imaging'] else '')
+    print(f'imaging {"on " if row["imaging"] else "off"}: operator {row["operator_rate_hz"]:.0f}'
+          f' Hz, {row["operator_answered_percent"]:.1f} % answered, round trip p99 '
+          f'{1e3 * row["operator_round_trip_p99_s"]:.2f} ms; robot {row["robot_rate_hz"]:.0f} '
+          f'Hz, tick p99 {1e3 * row["robot_tick_p99_s"]:.2f} ms; commands '
+          f'{row["commands_hz"]:.0f}/s, feedback {row["feedback_hz"]:.0f}/s; CPU '
+          f'{_cpu(row):.0f} % ('
+          + ', '.join(f'{n} {c:.0f}' for n, c in row['cpu_percent'].items())
+          + f'){image}; load {row["load"]:.1f}', flush=True)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--pairs', type=int, default=3, help='runs with imaging on and off')
+    parser.add_argument('--niceness', type=int, help="the imaging thread's, above the loop's "
+                        '(default: the node\'s, 5)')
+    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    result_files.add_option(parser)
+    args = parser.parse_args(argv)
+    add_venv_prefix()
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    print(f'machine: {machine.line("ros-jazzy-rclpy")}')
+    rows = []
+    for pair in range(args.pairs):
+        for imaging in ((True, False) if pair % 2 == 0 else (False, True)):
+            rows.append(run(imaging, args.domain_id, args.niceness))
+            _print_row(rows[-1])
+    result = summary(rows)
+    ratios = [f'{key} {value:.3f} [{low:.3f}-{high:.3f}]' for (key, value), (low, high)
+              in zip(result['ratios'].items(), result['ranges'].values())]
+    print('on / off within each pair, median [range] (targets: rates and answered >= 0.99, p99 '
+          '<= 1.1): ' + ', '.join(ratios))
+    print(f'CPU: {result["cpu_on_percent"]:.0f} % of a core on, {result["cpu_off_percent"]:.0f} '
+          f'% off: imaging adds {result["cpu_added_percent"]:.0f} % at '
+          f'{result["frames_hz"]:.1f} frames/s, {1e3 * result["cpu_per_frame_s"]:.1f} ms a frame '
+          f'(the imager\'s own thread: {1e3 * result["frame_cpu_p50_s"]:.1f} ms)')
+    print(f'pose to image p99 {1e3 * result["pose_to_image_p99_s"]:.1f} ms at the operator, '
+          f'{1e3 * LINK["delay"]:.0f} ms of it the link\'s delay (target <= '
+          f'{50 + 1e3 * LINK["delay"]:.0f} ms); to publication at the remote site p99 '
+          f'{1e3 * result["pose_to_publication_p99_s"]:.1f} ms')
+    result_files.write(args.json, {'rows': rows, 'summary': result,
+                                   'niceness': 5 if args.niceness is None else args.niceness})
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,127 @@
+"""The ultrasound scanner at the patient's site: the probe's pose in, its B-mode image out.
+
+Takes ``robot/tcp_pose`` (PoseStamped, the robot's 1 kHz stream, handed over in the site's
+process) and at ``frame_rate`` publishes ``probe/image`` (sensor_msgs/Image, mono8) of the
+newest pose, stamped with that pose's time, in ``probe_frame`` (``ProbeImaging``). The frame is
+made in a thread of its own at a lower priority (``LatestWorker``): the executor's thread, which
+runs the site's 1 kHz loop, only hands the pose over. A pose that cannot be imaged gives a dark
+frame, and the reason is logged once a second; a scene or settings that cannot image stop the
+node at start, naming what to fix. The kernels are compiled (or loaded) at start, so that the
+first frame does not stall the site. Its report gives the frame time and the time from the
+pose's stamp to the frame's publication (p50, p99 over the last ``RECENT_FRAMES``).
+"""
+import collections
+import time
+from typing import Sequence
+
+from geometry_msgs.msg import PoseStamped
+import numpy as np
+from rclpy.node import Node
+from sensor_msgs.msg import Image
+
+from haptic_util.callback_errors import log_callback_error
+from haptic_util.cdr import MessageCodec
+from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
+from haptic_util.executor import run_nodes, StartupError
+from haptic_util.intra_process import stream_subscription
+from haptic_util.parameters import declare_parameters
+from haptic_util.paths import resolve_path
+from haptic_util.qos import FRAME_QOS
+from haptic_util.stamps import clock_ns
+from haptic_util.tally import Tally
+from ultrasound_sim.conversions import image_cdr
+from ultrasound_sim.latest_worker import LatestWorker
+from ultrasound_sim.params import ProbeImagerParams
+from ultrasound_sim.probe_imaging import ProbeImaging
+
+__all__ = ['ProbeImagerNode', 'main']
+
+POSE = MessageCodec(PoseStamped)
+RECENT_FRAMES = 300  # the report's frame times: about the last 10 s at 30 Hz
+
+
+class ProbeImagerNode(Node):
+    """Images the anatomy under the probe at the TCP's newest pose."""
+
+    def __init__(self, **kwargs):
+        super().__init__('probe_imager', **kwargs)
+        self.params = params = declare_parameters(self, ProbeImagerParams)
+        try:
+            self.imaging = ProbeImaging.from_scene_file(
+                resolve_path(params.scene_file, what='parameter scene_file'),
+                params.settings(), params.frame_id)
+        except ValueError as error:
+            raise StartupError(f'{self.get_name()}: {error}') from None
+        warm_up = self.imaging.warm_up()
+        self._pose = None  # the newest TCP pose's fields
+        self._offered = None  # the stamp of the pose last handed to the worker
+        self._published = 0
+        self._dark = Tally()
+        self._refused = Tally()
+        # (frame wall, frame CPU, pose stamp to publication) s, per frame
+        self._times = collections.deque(maxlen=RECENT_FRAMES)
+        self._clock = self.get_clock()
+        self._publisher = self.create_publisher(Image, 'probe/image', FRAME_QOS)
+        stream_subscription(self, POSE, 'robot/tcp_pose', self.on_pose, refused=self._refused)
+        self._worker = LatestWorker(self.make_frame, on_error=log_callback_error,
+                                    niceness=params.worker_niceness, name='probe_imager')
+        self.create_timer(1.0 / params.frame_rate, self.on_timer)
+        self.diagnostics = Diagnostics(self, self.report, 1.0)
+        settings = self.imaging.imager.settings
+        self.get_logger().info(
+            f'{settings.probe_type} probe at {settings.centre_frequency / 1e6:g} MHz, '
+            f'{1e3 * settings.depth:g} mm deep, {settings.scanlines} lines; '
+            f'{params.frame_rate:g} frames/s on probe/image (kernels ready in {warm_up:.2f} s)')
+
+    def on_pose(self, fields: Sequence) -> None:
+        self._pose = fields
+
+    def on_timer(self) -> None:
+        """Hand the newest pose to the worker, unless already imaged."""
+        pose = self._pose
+        if pose is None or (pose[0], pose[1]) == self._offered:
+            return
+        self._offered = (pose[0], pose[1])
+        self._worker.offer(pose)
+
+    def make_frame(self, pose: Sequence) -> None:
+        """Image one pose and publish it (in the worker's thread)."""
+        started, cpu = time.perf_counter(), time.thread_time()
+        imaged = self.imaging.image(pose[2], pose[3:6], pose[6:10])
+        if imaged.reason:
+            self._dark.add('dark frame', imaged.reason)
+        stamp_ns = pose[0] * 1_000_000_000 + pose[1]
+        self._publisher.publish(image_cdr(stamp_ns, self.params.probe_frame, imaged.image))
+        self._published += 1
+        self._times.append((time.perf_counter() - started, time.thread_time() - cpu,
+                            1e-9 * (clock_ns(self._clock) - stamp_ns)))
+
+    def report(self) -> Report:
+        self._dark.log_new(self.get_logger().warn)
+        self._refused.log_new(lambda line: self.get_logger().warn(f'poses refused: {line}'))
+        times = np.array(list(self._times)).reshape(-1, 3)
+        wall, cpu, latency = (np.percentile(times, (50, 99), axis=0) if len(times)
+                              else np.full((2, 3), np.nan)).T
+        values = {'published': self._published, 'dark': self._dark.total(),
+                  'replaced': self._worker.replaced, 'frame_p50_s': wall[0],
+                  'frame_p99_s': wall[1], 'frame_cpu_p50_s': cpu[0],
+                  'pose_to_publication_p50_s': latency[0],
+                  'pose_to_publication_p99_s': latency[1]}
+        if self._pose is None:
+            return Report(WARN, 'waiting for robot/tcp_pose', values)
+        return Report(OK, f'{self._published} frames; frame time p50 {1e3 * wall[0]:.1f} ms, '
+                      f'p99 {1e3 * wall[1]:.1f} ms; pose to publication p99 '
+                      f'{1e3 * latency[1]:.1f} ms', values)
+
+    def destroy_node(self) -> bool:
+        self._worker.close()
+        self.diagnostics.final()
+        return super().destroy_node()
+
+
+def main(args=None) -> int:
+    return run_nodes([ProbeImagerNode], args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
