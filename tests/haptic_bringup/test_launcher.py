@@ -59,7 +59,7 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
     loop = node_parameters(LoopConfig(record=str(tmp_path / 'bag'), composed=True))
     assert loop['recorder']['ros__parameters']['output'] == str(tmp_path / 'bag')
     assert loop['wand_driver']['ros__parameters']['wait_for_recorder'] is False  # no need
-    config = LoopConfig(teleop='model', record=str(tmp_path / 'scan'))
+    config = LoopConfig(teleop='model', record=str(tmp_path / 'scan'), imaging=True)
     sites = node_parameters(config)
     assert 'recorder' not in sites
     operator = sites['operator_recorder']['ros__parameters']
@@ -70,12 +70,13 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
     assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'probe_imager',
                                             'remote_recorder')
     assert operator['topics'][-1] == '/probe/image'  # recorded where it is seen
-    blind = LoopConfig(teleop='model', record=str(tmp_path / 'blind'), imaging=False)
+    blind = LoopConfig(teleop='model', record=str(tmp_path / 'blind'))  # no imaging by default
     assert site_nodes(blind, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
     assert '/probe/image' not in node_parameters(blind)['operator_recorder'][
         'ros__parameters']['topics']
     assert '/probe/image' not in teleop_endpoints(blind)[blind.remote_domain_id]
     assert teleop_endpoints(config)[config.remote_domain_id]['/probe/image'] == (1, 1)
     remote = site_config(site_args(['remote', '--listen', 'tls/0.0.0.0:7447', '--insecure',
-                                    '--no-imaging']))
-    assert remote.loop.imaging is False and parse_args(['--teleop', 'model']).imaging
+                                    '--imaging']))
+    assert remote.loop.imaging and parse_args(['--teleop', 'model', '--imaging']).imaging
+    assert not parse_args(['--teleop', 'model']).imaging

@@ -43,7 +43,7 @@ def session(tmp_path_factory):
     config = LoopConfig(teleop='model', duration=9.0, record=str(folder / 'bag'),
                         domain_id=session_domain_id(),
                         remote_domain=session_domain_id(second=True), run_dir=folder / 'launch',
-                        link={'delay': DELAY, 'jitter': 0.1 * DELAY})
+                        link={'delay': DELAY, 'jitter': 0.1 * DELAY}, imaging=True)
     with Loop(config) as loop:
         assert loop.wait(60.0) is not None, 'the scan did not end'
     typestore = typestore_with(custom_definitions())

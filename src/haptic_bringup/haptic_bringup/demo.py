@@ -76,7 +76,7 @@ def run_teleop(out: pathlib.Path, *, domain_id: int = 42) -> pathlib.Path:
     shutil.rmtree(run, ignore_errors=True)
     run.mkdir(parents=True)
     config = LoopConfig(teleop=TELEOP_SCHEME, link=dict(TELEOP_LINK), record=str(run / 'bag'),
-                        domain_id=domain_id, run_dir=run / 'launch')
+                        domain_id=domain_id, run_dir=run / 'launch', imaging=True)
     with Loop(config) as loop:
         ended = loop.wait(SCAN_DURATION + 30.0)
         if ended is None or ended.name != 'operator':

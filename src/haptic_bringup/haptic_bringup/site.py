@@ -179,8 +179,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='probability that the emulated link loses a message')
     parser.add_argument('--delay-trace', metavar='CSV',
                         help='replay one-way delays from a CSV (time,delay in s)')
-    parser.add_argument('--no-imaging', dest='imaging', action='store_false',
-                        help='remote: make no probe image (operator: record none)')
+    parser.add_argument('--imaging', action='store_true',
+                        help='remote: image the probe\'s view (operator: record it)')
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
