@@ -1,7 +1,7 @@
 """The telerobotic scan in lockstep, without ROS: the schemes' physics alone, reproducibly.
 
     .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.025 0.05 0.1 0.25] [--late]
-        [--json PATH]
+        [--model-step-rates 5 0] [--json PATH]
 
 The same pieces as the ROS run, driven by one clock at 1 kHz: the simulated wand with its
 scripted hand (the driver's ``SimulatedWand`` at 4 kHz, rendering the model locally or holding
@@ -13,8 +13,11 @@ What it shows is what the schemes do with a delay, free of a busy machine's timi
 that ``tdpa`` puts between them, the baseline that chatters. With ``--late`` the operator's site
 skips ticks as a busy machine makes it (the remote site keeps its own), and each case runs with
 the driver's hold of the newest answer (as the launcher sets it) and without (the baseline).
+``--model-step-rates`` runs ``model`` once per rate of the driver's easing of new models (N/s; 0:
+each at once, the baseline).
 """
 import argparse
+import itertools
 import math
 import sys
 
@@ -23,7 +26,7 @@ import numpy as np
 import result_files
 import teleop_scan
 
-from haptic_bringup.launcher import LATE_POSE_HOLD, SCAN_DURATION
+from haptic_bringup.launcher import LATE_POSE_HOLD, MODEL_STEP_RATE, SCAN_DURATION
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
@@ -58,7 +61,7 @@ LATE_FRACTION, LATE_LONGEST = 0.02, 0.08  # of the ticks, late by up to [s]
 ZERO = np.zeros(3)
 
 
-def _device(scheme: str):
+def _device(scheme: str, easing: float):
     """Build the driver's simulated wand and hand, rendering as the launcher sets ``scheme``."""
     wand = WandDriverParams()
     limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
@@ -72,7 +75,7 @@ def _device(scheme: str):
         renderer = LocalRenderer(
             force_limit=limits.force_limit, torque_limit=limits.torque_limit,
             passivity=PortPassivity(wand.passivity_max_damping), mass=[wand.device_mass] * 3,
-            contact_damping_ratio=wand.contact_damping_ratio)
+            contact_damping_ratio=wand.contact_damping_ratio, model_step_rate=easing)
         device.render_locally(renderer)
     return device, renderer
 
@@ -86,7 +89,8 @@ def _model(time: float, plane, tip) -> ContactModel:
 
 
 def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
-         duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0) -> dict:
+         duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0,
+         easing: float = MODEL_STEP_RATE) -> dict:
     """Run the scan; return the operator's and the remote site's per-tick arrays.
 
     ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``. ``ticks``: the tick
@@ -94,13 +98,14 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     does), None for every one; the remote site runs every tick. The site takes each answer as
     the driver does: held by ``AnswerDeadline(hold)`` (the driver's ``hold_while_late``), a
     wrench through the device port's passivity controller unless the scheme is ``direct``.
+    ``easing``: the driver's ``model_step_rate`` (N/s; 0: each model at once, the baseline).
     Returns ``time``, ``wand``, ``felt`` (applied since the tick before) at the operator's
     ticks, and ``remote_time``, ``patient``, ``tcp``.
     """
     leader_config = (LeaderConfig('tdpa', coupling=None) if scheme == PLAIN_TDPA
                      else LeaderConfig(scheme))
     scheme = leader_config.scheme
-    device, renderer = _device(scheme)
+    device, renderer = _device(scheme, easing)
     port = PortPassivity(WandDriverParams().passivity_max_damping if scheme == 'tdpa' else 0.0)
     answers = AnswerDeadline(hold)
     robot_config = ImpedanceRobotConfig()
@@ -189,6 +194,8 @@ def main(argv=None) -> int:
                         help=f"the operator's site ticks late ({100 * LATE_FRACTION:g} %% of its "
                         f'ticks, by up to {1e3 * LATE_LONGEST:g} ms): each case with the '
                         "driver's hold and without it (the baseline)")
+    parser.add_argument('--model-step-rates', nargs='+', type=float, default=[MODEL_STEP_RATE],
+                        help="model: the driver's easing of new models, N/s (0: at once)")
     result_files.add_option(parser)
     args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")} (no ROS: one clock, lockstep)')
@@ -197,12 +204,15 @@ def main(argv=None) -> int:
     rows = []
     for delay in args.delays:
         for scheme in args.schemes:
-            for hold in (LATE_POSE_HOLD, 0.0) if args.late else (0.0,):
+            rates = args.model_step_rates if scheme == 'model' else [MODEL_STEP_RATE]
+            for hold, rate in itertools.product((LATE_POSE_HOLD, 0.0) if args.late else (0.0,),
+                                                rates):
                 run = scan(scheme, delay, jitter=args.jitter * delay, loss=args.loss,
-                           ticks=ticks, hold=hold)
+                           ticks=ticks, hold=hold, easing=rate)
+                notes = ([f'late, hold {1e3 * hold:g} ms'] if args.late else []) + (
+                    [f'ease {rate:g}'] if len(rates) > 1 else [])
                 rows.append({'scheme': scheme, **teleop_scan.figures(as_series(run), delay),
-                             'site_streams': f'late, hold {1e3 * hold:g} ms'
-                             if args.late else ''})
+                             'site_streams': ', '.join(notes)})
                 teleop_scan.print_row(rows[-1])
     result_files.write(args.json, rows)
     return 0

@@ -62,3 +62,21 @@ def test_late_ticks_stay_passive_and_quiet_with_the_newest_answer_held(scheme):
     assert held['stable'], held
     assert held['peak_patient_n'] <= MAX_PATIENT_FORCE
     assert not expiring['stable'], expiring
+
+
+def test_model_updates_eased_in_reach_the_hand_without_a_jolt():
+    """At 250 ms one way each estimate reached the hand as a step: 2.8 N (scaled) at contact.
+
+    The smoothness measure (``teleop_scan.felt_steps``) must fail there on models switched at
+    once (the driver's ``model_step_rate`` 0), and the eased ones must take the jumps out,
+    passive. What remains at this delay (0.43 N) is the first estimate's normal turning 3.5°
+    from the skin's, which easing does not smooth.
+    """
+    stepped = figures('model', 0.25, duration=6.0, easing=0.0)
+    eased = figures('model', 0.25, duration=6.0)
+    assert not stepped['smooth'] and stepped['jumps'] >= 1, stepped
+    assert stepped['step_ratio_max'] > teleop_scan.SMOOTH_RATIO
+    assert eased['jumps'] == 0, eased
+    assert eased['felt_step_max_n'] < stepped['felt_step_max_n'] / 5.0
+    assert eased['step_ratio_p99'] <= teleop_scan.SMOOTH_RATIO
+    assert eased['stable'] and eased['net_work_j'] <= 0.0

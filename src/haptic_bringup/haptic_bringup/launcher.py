@@ -64,6 +64,7 @@ REMOTE_PREFIX = '/remote'  # where the remote site's topics go in its bag
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 LATE_POSE_HOLD = 0.5  # [s] past the stalls seen with the machine fully loaded (up to 0.45 s)
+MODEL_STEP_RATE = 5.0  # [N/s] at the hand: 17 N/s at the patient, above the scan's 13 (p99)
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
 # A session's bag holds what each site measured and what crossed the link, recorded where it
@@ -184,6 +185,8 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     same with it). While the driver's next pose is late, the answer to the newest one holds until
     it is sent, for at most ``LATE_POSE_HOLD``: an answer that expired inside a stretched tick let
     the hand fall in, and the next one threw it back out (``haptic_wand_driver.answer_deadline``).
+    Each new model eases in at ``MODEL_STEP_RATE`` (``haptic_wand_driver.model_easing``): at
+    once, every estimate's move since the last jolted the hand (issue 28).
     """
     scheme = config.teleop
     driver = options.setdefault('wand_driver', {})
@@ -194,6 +197,7 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     driver['rendering'] = 'local' if scheme == 'model' else 'remote'
     driver['passivity'] = scheme != 'direct'
     driver['hold_while_late'] = LATE_POSE_HOLD
+    driver['model_step_rate'] = MODEL_STEP_RATE
     for node in ('teleop_leader', 'teleop_follower'):
         options.setdefault(node, {})['scheme'] = scheme
     if config.record:
