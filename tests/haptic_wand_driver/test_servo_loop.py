@@ -91,7 +91,7 @@ def _row(wand: SimulatedWand, state, law: LocalRenderer) -> tuple:
     force, torque = wand.applied()
     return (*state.position, state.roll, state.yaw, *state.linear_velocity, state.roll_rate,
             state.yaw_rate, *force, *torque, law.passivity.energy, law.passivity.net_work,
-            *law.bound[[0, 2, 3, 4]])
+            *law.bound[[0, 2, 3, 4, 5, 6]])
 
 
 def _run(seed: int, ratio: float, hand: bool, rate: float = 0.0):

@@ -47,7 +47,8 @@ count, the damping cap per mass and period (``MAX_DAMPING_PER_MASS``), ``since``
 number, the model step rate; from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point,
 normal, stiffness, damping, tool point). ``bound`` is the planes' shift (m), the number of the take
 it was set for, the spring push the planes rendered in the last period (N; 0 when none), the
-factor on their stiffnesses, and the sum of those scaled (N/m; 0 when none).
+factor on their stiffnesses and the sum of those scaled (N/m; 0 when none), the factor on their
+dampings and the sum of those scaled (N·s/m; 0 when none).
 """
 import math
 from typing import Sequence
@@ -55,8 +56,8 @@ from typing import Sequence
 import numpy as np
 
 from haptic_wand_driver.contact_model import ContactModel, Kind, MAX_PLANES
-from haptic_wand_driver.model_easing import eased_scale, eased_shift, least_shift, \
-    matched_shift, scaled_model, spring_push, stored_energy, total_stiffness
+from haptic_wand_driver.model_easing import eased_level, eased_scale, eased_shift, least_shift, \
+    matched_shift, scaled_model, spring_push, stored_energy, total_damping, total_stiffness
 from haptic_wand_driver.orientation import roll_axis
 from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
 from haptic_wand_driver.wrench_input import saturate_components
@@ -103,7 +104,8 @@ class LocalRenderer:
         self.contact_damping_ratio = contact_damping_ratio
         self.model_step_rate = float(model_step_rate)
         self.packed = np.zeros((2, LAW_SIZE))  # (servo_loop's layout)
-        self.bound = np.array([0.0, -1.0, 0.0, 1.0, 0.0])  # shift, take, push, scale, stiffness
+        # shift, take, push, stiffness factor and sum, damping factor and sum
+        self.bound = np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0])
         self._held = ((*_NOTHING, 0),) * 2 + (-math.inf,)  # before since, from since, since
         self._takes = 0
         self.clear()
@@ -159,18 +161,18 @@ class LocalRenderer:
         limit = self.force_limit
         if wrench is not None and time + period <= deadline:
             force, torque = wrench
-            self.bound[2] = self.bound[4] = 0.0
+            self.bound[2] = self.bound[4] = self.bound[6] = 0.0
         elif (model is not None and model.kind == Kind.PLANES and time + period <= deadline
                 and model.valid(position)):
             x, y, z = roll_axis(coordinates[4])
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
             limit = min(self.force_limit, model.force_limit)
             shift = self._shift(model, take, coordinates, period)
-            force, torque = scaled_model(model, float(self.bound[3])).wrench(
+            force, torque = scaled_model(model, float(self.bound[3]), float(self.bound[5])).wrench(
                 position, velocity, coordinates[3], coordinates[4], spin,
                 self._contact_damping(period), limit, shift)
         else:
-            self.bound[2] = self.bound[4] = 0.0
+            self.bound[2] = self.bound[4] = self.bound[6] = 0.0
         force = self.passivity.control(force, position, velocity, period,
                                        time + period > deadline)
         return (saturate_components(force, limit),
@@ -181,7 +183,7 @@ class LocalRenderer:
         """Return the shift of ``model``'s planes this period.
 
         Set by the port's bound at the model's first period and kept; or, easing, matched to the
-        last period's stiffness and push at the first and eased from there (the stiffness factor
+        last period's stiffness, damping and push at the first and eased from there (the factors
         with it, in ``bound``), storing no more than the port absorbed or the planes held.
         """
         first = take != self.bound[1]
@@ -193,19 +195,23 @@ class LocalRenderer:
         if self.model_step_rate == 0.0:
             self.bound[:2] = (bounded_shift(springs, energy), take)
             return float(self.bound[0])
-        step, (shift, _, push, scale, stiff) = self.model_step_rate * period, self.bound.tolist()
-        total = total_stiffness(springs)
+        step = self.model_step_rate * period
+        shift, _, push, scale, stiff, damping_scale, damped = self.bound.tolist()
+        total, damping = total_stiffness(springs), total_damping(model)
         if first:
             scale = stiff / total if stiff > 0.0 and total > 0.0 else 1.0
+            damping_scale = damped / damping if damping > 0.0 else 1.0
             springs = [(d, scale * k) for d, k in springs]
             shift = matched_shift(springs, push)
         else:
             held = stored_energy([(d, scale * k) for d, k in springs], shift)
             scale = eased_scale(scale, step, push)
+            damping_scale = eased_level(damping_scale, step, push)
             springs = [(d, scale * k) for d, k in springs]
             eased = eased_shift(springs, shift, step)
             shift = max(eased, least_shift(springs, max(energy, held), min(eased, 0.0)))
-        self.bound[:] = (shift, take, spring_push(springs, shift), scale, scale * total)
+        self.bound[:] = (shift, take, spring_push(springs, shift), scale, scale * total,
+                         damping_scale, damping_scale * damping)
         return shift
 
     def _contact_damping(self, period: float):

@@ -172,6 +172,27 @@ def _total_stiffness(stiffnesses, count):
 
 
 @njit(cache=True, nogil=True)
+def _eased_scale(scale, step, push):
+    """Return ``scale`` moved toward 1 (``model_easing.eased_scale``)."""
+    if push <= 0.0:
+        return 1.0
+    change = step * scale / push
+    return min(scale + change, 1.0) if scale < 1.0 else max(scale - change, 1.0)
+
+
+@njit(cache=True, nogil=True)
+def _total_damping(law):
+    total = 0.0
+    for k in range(int(law[19])):
+        at = PLANES_AT + PLANE_SIZE * k
+        nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
+        along = law[at + 9] * nx * nx + law[at + 10] * ny * ny + law[at + 11] * nz * nz
+        if along > 0.0:
+            total += along
+    return total
+
+
+@njit(cache=True, nogil=True)
 def _shift(law, coordinates, books, bound, period):
     """Set ``bound`` for this period of the planes held (``LocalRenderer._shift``)."""
     rate = law[STEP_RATE]
@@ -185,10 +206,11 @@ def _shift(law, coordinates, books, bound, period):
     if rate == 0.0:
         bound[0], bound[1] = _least_shift(depths, stiffnesses, count, books[0], 0.0), law[SERIAL]
         return
-    step, shift, push, scale = rate * period, bound[0], bound[2], bound[3]
-    total = _total_stiffness(stiffnesses, count)
+    step, shift, push, scale, damping_scale = rate * period, bound[0], bound[2], bound[3], bound[5]
+    total, damping = _total_stiffness(stiffnesses, count), _total_damping(law)
     if first:
         scale = bound[4] / total if bound[4] > 0.0 and total > 0.0 else 1.0
+        damping_scale = bound[6] / damping if damping > 0.0 else 1.0
         for k in range(count):
             stiffnesses[k] = scale * stiffnesses[k]
         shift = _matched_shift(depths, stiffnesses, count, push)
@@ -197,11 +219,12 @@ def _shift(law, coordinates, books, bound, period):
         for k in range(count):
             if depths[k] - shift > 0.0:
                 held += 0.5 * (scale * stiffnesses[k]) * (depths[k] - shift) * (depths[k] - shift)
-        if push <= 0.0:
-            scale = 1.0
-        else:
-            change = step * scale / push
-            scale = min(scale + change, 1.0) if scale < 1.0 else max(scale - change, 1.0)
+        scale = _eased_scale(scale, step, push)
+        damping_scale = 1.0
+        if push > 0.0:
+            change = step / push
+            damping_scale = (min(bound[5] + change, 1.0) if bound[5] < 1.0
+                             else max(bound[5] - change, 1.0))
         for k in range(count):
             stiffnesses[k] = scale * stiffnesses[k]
         scaled = _total_stiffness(stiffnesses, count)
@@ -216,19 +239,21 @@ def _shift(law, coordinates, books, bound, period):
         if depths[k] - shift > 0.0:
             push += stiffnesses[k] * (depths[k] - shift)
     bound[0], bound[1], bound[2] = shift, law[SERIAL], push
-    bound[3], bound[4] = scale, scale * total
+    bound[3], bound[4], bound[5], bound[6] = scale, scale * total, damping_scale, (
+        damping_scale * damping)
 
 
 @njit(cache=True, nogil=True)
-def _scaled(law, scale):
-    """Return ``law`` with its planes' stiffnesses times ``scale`` (``scaled_model``)."""
-    if scale == 1.0:
+def _scaled(law, scale, damping_scale):
+    """Return ``law`` with its planes' stiffnesses and dampings scaled (``scaled_model``)."""
+    if scale == 1.0 and damping_scale == 1.0:
         return law
     scaled = law.copy()
     for k in range(int(law[19])):
         at = PLANES_AT + PLANE_SIZE * k
         for j in range(6, 9):
             scaled[at + j] = law[at + j] * scale
+            scaled[at + j + 3] = law[at + j + 3] * damping_scale
     return scaled
 
 
@@ -301,19 +326,19 @@ def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     mode, live = law[6], time + period <= law[DEADLINE]
     if mode == MODE_WRENCH and live:
         fx, fy, fz, tx, ty, tz = law[13], law[14], law[15], law[16], law[17], law[18]
-        bound[2] = bound[4] = 0.0
+        bound[2] = bound[4] = bound[6] = 0.0
     elif mode == MODE_PLANES and live:
         dx, dy, dz = coordinates[0] - law[10], coordinates[1] - law[11], coordinates[2] - law[12]
         if dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
             if law[8] < limit:
                 limit = law[8]
             _shift(law, coordinates, books, bound, period)
-            fx, fy, fz, tx, ty, tz = _planes(_scaled(law, bound[3]), coordinates, rates, limit,
-                                             period, bound[0])
+            fx, fy, fz, tx, ty, tz = _planes(_scaled(law, bound[3], bound[5]), coordinates,
+                                             rates, limit, period, bound[0])
         else:
-            bound[2] = bound[4] = 0.0
+            bound[2] = bound[4] = bound[6] = 0.0
     else:
-        bound[2] = bound[4] = 0.0
+        bound[2] = bound[4] = bound[6] = 0.0
     fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period, not live)
     fx, fy, fz = _saturate(fx, fy, fz, limit)
     tx, ty, tz = _saturate(tx, ty, tz, law[1])
@@ -373,5 +398,6 @@ def compile_now() -> None:
     """Compile ``advance`` for the types the wand passes (or load it from numba's cache)."""
     advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)),
             np.zeros((2, LAW_SIZE)),
-            np.zeros(11), np.array([0.0, -1.0, 0.0, 1.0, 0.0]), 1.0, 1.0, 0.0, 0, 1.0, np.zeros(6),
+            np.zeros(11), np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0]), 1.0, 1.0, 0.0, 0, 1.0,
+            np.zeros(6),
             np.empty(0, dtype=np.int64), False)

@@ -167,7 +167,8 @@ class Follower:
         return self.config.robot_stiffness * (self._tcp - self._target)
 
     def _learn(self, now: float, tcp_velocity) -> None:
-        estimate = self.estimator.update(now, self._force, self._tcp, tcp_velocity)
+        normal = None if self._surface is None else lambda: self._surface(self._tcp)[1]
+        estimate = self.estimator.update(now, self._force, self._tcp, tcp_velocity, normal)
         if estimate is not None and estimate.stiffness > 0.0:
             self._gains = self._as_commanded(estimate.stiffness, estimate.damping)
             self._plane = RemotePlane(estimate.point, estimate.normal, *self._gains)
