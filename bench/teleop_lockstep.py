@@ -1,7 +1,7 @@
 """The telerobotic scan in lockstep, without ROS: the schemes' physics alone, reproducibly.
 
-    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.025 0.05 0.1 0.25] [--late]
-        [--model-step-rates 5 0] [--json PATH]
+    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.01 0.025 0.05 0.1 0.25 0.5]
+        [--jitter 0.2] [--loss 0.05] [--late] [--model-step-rates 5 0] [--json PATH]
 
 The same pieces as the ROS run, driven by one clock at 1 kHz: the simulated wand with its
 scripted hand (the driver's ``SimulatedWand`` at 4 kHz, rendering the model locally or holding
@@ -14,7 +14,7 @@ that ``tdpa`` puts between them, the baseline that chatters. With ``--late`` the
 skips ticks as a busy machine makes it (the remote site keeps its own), and each case runs with
 the driver's hold of the newest answer (as the launcher sets it) and without (the baseline).
 ``--model-step-rates`` runs ``model`` once per rate of the driver's easing of new models (N/s; 0:
-each at once, the baseline).
+each at once, the baseline; both by default, the fix beside what it replaces).
 """
 import argparse
 import itertools
@@ -187,14 +187,15 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--schemes', nargs='+', default=list(SCHEMES), choices=SCHEMES)
     parser.add_argument('--delays', nargs='+', type=float,
-                        default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
-    parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
-    parser.add_argument('--loss', type=float, default=0.01)
+                        default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5])
+    parser.add_argument('--jitter', type=float, default=0.2, help='fraction of the delay')
+    parser.add_argument('--loss', type=float, default=0.05)
     parser.add_argument('--late', action='store_true',
                         help=f"the operator's site ticks late ({100 * LATE_FRACTION:g} %% of its "
                         f'ticks, by up to {1e3 * LATE_LONGEST:g} ms): each case with the '
                         "driver's hold and without it (the baseline)")
-    parser.add_argument('--model-step-rates', nargs='+', type=float, default=[MODEL_STEP_RATE],
+    parser.add_argument('--model-step-rates', nargs='+', type=float,
+                        default=[MODEL_STEP_RATE, 0.0],
                         help="model: the driver's easing of new models, N/s (0: at once)")
     result_files.add_option(parser)
     args = parser.parse_args(argv)
