@@ -26,7 +26,8 @@ import numpy as np
 import result_files
 import teleop_scan
 
-from haptic_bringup.launcher import LATE_POSE_HOLD, MODEL_STEP_RATE, SCAN_DURATION
+from haptic_bringup.launcher import LATE_POSE_HOLD, LINK_TIMEOUT, MODEL_STEP_RATE, \
+    SCAN_DURATION
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
@@ -41,7 +42,7 @@ from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.ft_sensor import ForceTorqueSensor
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
 from remote_probe.leader import Leader, LeaderConfig
-from remote_probe.link import EmulatedLink, LinkConfig
+from remote_probe.link import EmulatedLink, LinkConfig, silence_timeout
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
@@ -102,8 +103,9 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     Returns ``time``, ``wand``, ``felt`` (applied since the tick before) at the operator's
     ticks, and ``remote_time``, ``patient``, ``tcp``.
     """
-    leader_config = (LeaderConfig('tdpa', coupling=None) if scheme == PLAIN_TDPA
-                     else LeaderConfig(scheme))
+    timeout = silence_timeout(LINK_TIMEOUT, jitter)  # as the launcher sets both ends
+    leader_config = (LeaderConfig('tdpa', coupling=None, link_timeout=timeout)
+                     if scheme == PLAIN_TDPA else LeaderConfig(scheme, link_timeout=timeout))
     scheme = leader_config.scheme
     device, renderer = _device(scheme, easing)
     port = PortPassivity(WandDriverParams().passivity_max_damping if scheme == 'tdpa' else 0.0)
@@ -114,7 +116,8 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     sensor = ForceTorqueSensor()
     skin = PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])
     follower = Follower(FollowerConfig(scheme, robot_config.stiffness),
-                        PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness)),
+                        PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness,
+                                                   link_timeout=timeout)),
                         CommandLimits(robot_config.workspace_lower,
                                       robot_config.workspace_upper, HAND_SPEED),
                         ContactModelEstimator(), surface=lambda tcp: (skin.point, skin.normal))
