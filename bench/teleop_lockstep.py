@@ -91,7 +91,7 @@ def _model(time: float, plane, tip) -> ContactModel:
 
 def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
          duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0,
-         easing: float = MODEL_STEP_RATE) -> dict:
+         easing: float = MODEL_STEP_RATE, link_timeout: float | None = None) -> dict:
     """Run the scan; return the operator's and the remote site's per-tick arrays.
 
     ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``. ``ticks``: the tick
@@ -100,10 +100,11 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     the driver does: held by ``AnswerDeadline(hold)`` (the driver's ``hold_while_late``), a
     wrench through the device port's passivity controller unless the scheme is ``direct``.
     ``easing``: the driver's ``model_step_rate`` (N/s; 0: each model at once, the baseline).
+    ``link_timeout``: both ends' watchdogs (s); None waits out the jitter, as the launcher sets.
     Returns ``time``, ``wand``, ``felt`` (applied since the tick before) at the operator's
     ticks, and ``remote_time``, ``patient``, ``tcp``.
     """
-    timeout = silence_timeout(LINK_TIMEOUT, jitter)  # as the launcher sets both ends
+    timeout = silence_timeout(LINK_TIMEOUT, jitter) if link_timeout is None else link_timeout
     leader_config = (LeaderConfig('tdpa', coupling=None, link_timeout=timeout)
                      if scheme == PLAIN_TDPA else LeaderConfig(scheme, link_timeout=timeout))
     scheme = leader_config.scheme

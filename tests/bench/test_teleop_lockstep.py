@@ -89,3 +89,19 @@ def test_at_100_ms_the_eased_model_is_smooth_where_the_stepped_one_is_not():
     assert stepped['step_ratio_max'] > teleop_scan.SMOOTH_RATIO, stepped
     assert eased['smooth'], eased
     assert eased['stable'] and eased['transparency_percent'] <= stepped['transparency_percent']
+
+
+def test_at_500_ms_the_model_is_stable_and_transparent_once_the_watchdogs_wait_out_the_jitter():
+    """20 % jitter and 5 % loss: a message held back holds back those behind it for 200-300 ms.
+
+    With 100 ms watchdogs at both ends (the baseline) every such gap read as a dead link.
+    """
+    options = {'jitter': 0.1, 'loss': 0.05}
+    patient = teleop_lockstep.scan('model', 0.5, **options)
+    waited = teleop_scan.figures(teleop_lockstep.as_series(patient), 0.5)
+    hasty = teleop_scan.figures(teleop_lockstep.as_series(
+        teleop_lockstep.scan('model', 0.5, link_timeout=0.1, **options)), 0.5)
+    assert not hasty['stable'], hasty
+    assert waited['stable'] and waited['smooth'], waited
+    assert waited['transparency_percent'] <= 10.0
+    assert waited['peak_patient_n'] <= MAX_PATIENT_FORCE
