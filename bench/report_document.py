@@ -223,7 +223,9 @@ def _teleop_chapter(findings: Findings) -> list[str]:
         'between 1 ms ticks, scaled, over the patient\'s, in steady contact (> 3 N), and the '
         '*jumps* those changes over 1 N (smooth: both ratios ≤ 3, no jump). *ease 5* is the '
         'driver easing each new model in at 5 N/s, *ease 0* each taken at once (the code '
-        'before issue 28).',
+        'before issue 28); *time to force* from the first contact to 90 % of the mean contact '
+        'force, and the *peak rise* of the patient\'s force over 5 ms (the envelope bounds the '
+        'robot\'s spring to 40 N/s in contact).',
         '']
     parts += ['### In lockstep', '']
     parts += _stored(findings, 'teleop_lockstep', lambda rows: [

@@ -402,7 +402,7 @@ def teleop_section(rows: list) -> str:
         ['scheme', 'one-way delay (ms)', 'run', 'stable', 'net work on the hand (mJ)',
          'oscillation (%)', 'transparency error (N)', '(% of mean contact force)',
          'peak patient force (N)', 'tracking RMS (mm)', 'felt step ratio p99', '(max)',
-         'jumps > 1 N'],
+         'jumps > 1 N', 'time to force (s)', 'peak rise (N/s)'],
         [[r['scheme'], f'{1e3 * r["delay"]:g}',
           ', '.join(filter(None, (r['source'], r.get('site_streams', '')))),
           'yes' if r['stable'] else '**no**',
@@ -410,7 +410,9 @@ def teleop_section(rows: list) -> str:
           number(r['transparency_n'], '.2f'), number(r['transparency_percent'], '.1f'),
           f'{r["peak_patient_n"]:.2f}', f'{1e3 * r["tracking_m"]:.1f}',
           number(r.get('step_ratio_p99', np.nan), '.1f'),
-          number(r.get('step_ratio_max', np.nan), '.1f'), str(r.get('jumps', '–'))]
+          number(r.get('step_ratio_max', np.nan), '.1f'), str(r.get('jumps', '–')),
+          number(r.get('time_to_force_s', np.nan), '.2f'),
+          number(r.get('peak_rise_n_per_s', np.nan), '.0f')]
          for r in rows])
 
 

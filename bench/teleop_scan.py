@@ -22,7 +22,9 @@ applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor
   force / force_scale between consecutive 1 ms ticks against the same for the patient's force,
   as the ratio of their 99th percentiles and of their largest, and the count of felt **jumps**
   over 1 N. Smooth: both ratios ≤ 3 and no jump. A sonographer reads the tissue by differences
-  of a few tenths of a newton; a step the patient's force does not make is a jolt.
+  of a few tenths of a newton; a step the patient's force does not make is a jolt;
+- the patient's **force rise** (issue 28's envelope): the time from the first contact to 90 % of
+  the mean contact force, and the peak rate of rise of the patient's force over 5 ms.
 
 The jitter is given as a fraction of the delay (20 %, and 5 % loss: issue 28's harsher link, to
 500 ms one way). ``--delay-trace`` runs each scheme once more over a measured link: a CSV of
@@ -68,6 +70,7 @@ FIGURE_DELAY = 0.1  # [s] the delay whose runs are drawn with --json
 STEADY_CONTACT = 3.0  # [N] patient force above which the smoothness is judged
 JUMP = 1.0  # [N] a change of the felt force (scaled) between ticks that counts as a jolt
 SMOOTH_RATIO = 3.0  # the felt force's steps at most this many times the patient's
+RISE_WINDOW = 5e-3  # [s] the patient's rate of rise, over the F/T sensor's noise
 CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the sweep
 SITE_STREAMS = ('in-process', 'dds')
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
@@ -119,6 +122,22 @@ def felt_steps(felt: np.ndarray, patient: np.ndarray) -> dict:
             'smooth': max(p99, largest) <= SMOOTH_RATIO and jumps == 0}
 
 
+def force_rise(patient: np.ndarray, mean_contact: float) -> dict:
+    """Return the time (s) from first contact to 90 % of ``mean_contact`` and the peak rate.
+
+    ``patient`` is (n, 3) N on the 1 ms grid; the rate (N/s) is over ``RISE_WINDOW``.
+    """
+    norm = np.linalg.norm(patient, axis=1)
+    steps = round(RISE_WINDOW / GRID)
+    rate = float(np.max(norm[steps:] - norm[:-steps])) / RISE_WINDOW if len(norm) > steps else 0.0
+    touched = np.flatnonzero(norm > CONTACT)
+    if not touched.size or mean_contact <= 0.0:
+        return {'time_to_force_s': np.nan, 'peak_rise_n_per_s': rate}
+    reached = np.flatnonzero(norm[touched[0]:] >= 0.9 * mean_contact)
+    return {'time_to_force_s': float(reached[0]) * GRID if reached.size else np.nan,
+            'peak_rise_n_per_s': rate}
+
+
 def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
     """Compute what the module's docstring lists from the series ``read_scan`` returns."""
     pose_t, pose = scan['/wand/pose']
@@ -151,7 +170,8 @@ def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
             'lag_s': lag, 'mean_patient_n': mean_patient,
             'peak_patient_n': float(np.max(np.linalg.norm(patient, axis=1))),
             'tracking_m': tracking, 'contact_s': float(contact.sum() * GRID),
-            **felt_steps(felt_grid / force_scale, patient_grid)}
+            **felt_steps(felt_grid / force_scale, patient_grid),
+            **force_rise(patient_grid, mean_patient)}
 
 
 def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
@@ -203,7 +223,7 @@ def _cpu_seconds(process: psutil.Process) -> float:
 def print_header() -> None:
     print(f'{"scheme":>6} {"ms":>6} {"stable":>6} {"work mJ":>9} {"osc %":>6} '
           f'{"err N":>7} {"err %":>6} {"peak N":>7} {"track mm":>8} {"step p99":>8} '
-          f'{"step max":>8} {"jumps":>5}')
+          f'{"step max":>8} {"jumps":>5} {"rise s":>6} {"N/s":>5}')
 
 
 def print_row(r: dict) -> None:
@@ -211,7 +231,8 @@ def print_row(r: dict) -> None:
           f'{1e3 * r["net_work_j"]:9.1f} {r["oscillation_percent"]:6.1f} '
           f'{r["transparency_n"]:7.2f} {r["transparency_percent"]:6.1f} '
           f'{r["peak_patient_n"]:7.2f} {1e3 * r["tracking_m"]:8.2f} {r["step_ratio_p99"]:8.1f} '
-          f'{r["step_ratio_max"]:8.1f} {r["jumps"]:5d} {r.get("site_streams", "")}',
+          f'{r["step_ratio_max"]:8.1f} {r["jumps"]:5d} {r["time_to_force_s"]:6.2f} '
+          f'{r["peak_rise_n_per_s"]:5.0f} {r.get("site_streams", "")}',
           flush=True)
 
 
