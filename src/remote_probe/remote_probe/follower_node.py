@@ -18,7 +18,7 @@ from typing import Sequence
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
-from std_msgs.msg import Empty
+from std_msgs.msg import Empty, Float64
 
 from collision_engine import load_scene
 from haptic_msgs.msg import RobotImpedance
@@ -92,6 +92,7 @@ class FollowerNode(Node):
         self.create_subscription(RobotImpedance, 'robot/impedance', self.on_impedance,
                                  LATCHED_QOS)
         self.create_subscription(Empty, 'teleop/re_engage', self.on_re_engage, 1)
+        self.create_subscription(Float64, 'teleop/hold', self.on_hold, 1)
         self.create_timer(self._period, self.tick)
         rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == 'model'
                                         else FORCE_FEEDBACK_RATE)
@@ -142,6 +143,17 @@ class FollowerNode(Node):
             self.get_logger().warn('re-engaged: following' if following else
                                    're-engage refused: the probe still presses')
 
+    def on_hold(self, message: Float64) -> None:
+        """Hold the asked force (N) at the patient while the operator slides; <= 0 releases."""
+        if self.follower is None:
+            return
+        force = message.data if math.isfinite(message.data) else 0.0
+        holding = self.follower.hold_force(force)
+        self.get_logger().info(f'holding {force:g} N' if holding else
+                               'force-hold released' if force <= 0.0 else
+                               f'force-hold of {force:g} N refused: not in contact, or past '
+                               'the working limit')
+
     def on_tcp(self, fields: Sequence) -> None:
         now = self._now()
         position = np.array(fields[3:6], dtype=np.float64)
@@ -181,7 +193,7 @@ class FollowerNode(Node):
         if self.follower is None:
             return Report(*self._robot_problem, values)
         holding, stopped = self.follower.safety.holding, self.follower.safety.envelope.stopped
-        values.update(holding=holding, hard_stop=stopped,
+        values.update(holding=holding, hard_stop=stopped, force_hold=self.follower.hold.force,
                       session=f'{self.follower.admission.session:#x}')
         if stopped:
             return Report(ERROR, 'hard stop: holding and retracting until teleop/re_engage',
