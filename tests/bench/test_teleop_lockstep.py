@@ -105,3 +105,18 @@ def test_at_500_ms_the_model_is_stable_and_transparent_once_the_watchdogs_wait_o
     assert waited['stable'] and waited['smooth'], waited
     assert waited['transparency_percent'] <= 10.0
     assert waited['peak_patient_n'] <= MAX_PATIENT_FORCE
+
+
+def test_a_force_held_through_the_sweep_stays_within_half_a_newton_of_the_set_one():
+    """The remote site holds the force it measured as the sweep began, through a 500 ms link.
+
+    Read from the tissue's force; the operator's own hand, unheld, wanders by more (0.43 N).
+    """
+    options = {'jitter': 0.1, 'loss': 0.05}
+    held = teleop_lockstep.scan('model', 0.5, force_hold=teleop_lockstep.SWEEP, **options)
+    unheld = teleop_lockstep.scan('model', 0.5, **options)
+    error = teleop_lockstep.hold_error(held, *teleop_lockstep.SWEEP)
+    own = teleop_lockstep.hold_error(unheld, *teleop_lockstep.SWEEP)
+    assert 5.0 < error['held_n'] < 20.0
+    assert error['hold_error_max_n'] <= 0.5, error
+    assert own['hold_error_max_n'] > 10 * error['hold_error_max_n'], own
