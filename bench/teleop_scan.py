@@ -34,7 +34,8 @@ the project (none with its per-sample delays could be found in public reach). Ea
 process; its nodes hand their streams over in the process (``in-process``, the default) or
 through DDS (``dds``: the sites before intra-process delivery, their CPU's baseline). With both,
 each case runs once per way, one after the other. With ``--json`` the figure of the felt and
-the patient's force against time at 100 ms, one panel per scheme, is drawn beside the file (.png).
+the patient's force against time at 100 and 500 ms, a panel per scheme and delay, is drawn beside
+the file (.png).
 ``--model-step-rates`` runs ``model`` once per rate of the driver's easing of new models (N/s;
 0: each at once, the baseline), the rows marked ``ease N``.
 """
@@ -66,7 +67,7 @@ GRID = 1e-3  # [s]
 MEAN_WINDOW = 0.25  # [s] the felt force's own slow part
 STABLE_OSCILLATION = 10.0  # [%] of the mean felt force
 LAG_MARGIN = 0.2  # [s] the robot's own lag behind its target (its impedance, its speed limit)
-FIGURE_DELAY = 0.1  # [s] the delay whose runs are drawn with --json
+FIGURE_DELAYS = (0.1, 0.5)  # [s] the delays whose runs are drawn with --json
 STEADY_CONTACT = 3.0  # [N] patient force above which the smoothness is judged
 JUMP = 1.0  # [N] a change of the felt force (scaled) between ticks that counts as a jolt
 SMOOTH_RATIO = 3.0  # the felt force's steps at most this many times the patient's
@@ -263,15 +264,16 @@ def main(argv=None) -> int:
             for scheme in args.schemes:
                 rates = args.model_step_rates if scheme == 'model' else [None]
                 for site_streams, rate in itertools.product(args.site_streams, rates):
-                    drawn = (args.json and delay == FIGURE_DELAY and site_streams == 'in-process'
-                             and rate == rates[0])
-                    folder = pathlib.Path(kept) / scheme if drawn else None
+                    drawn = (args.json and delay in FIGURE_DELAYS
+                             and site_streams == 'in-process' and rate == rates[0])
+                    folder = pathlib.Path(kept) / f'{scheme}-{delay:g}' if drawn else None
                     rows.append(run(scheme, delay, jitter=args.jitter, loss=args.loss,
                                     domain_id=args.domain_id, site_streams=site_streams,
                                     keep=folder, model_step_rate=rate))
                     print_row(rows[-1])
                     if folder:
-                        traces[scheme] = read_scan(folder / 'bag')
+                        traces[f'{scheme}, {1e3 * delay:g} ms one way, over ROS 2'] = read_scan(
+                            folder / 'bag')
     if args.delay_trace:
         longest = float(DelayTrace.from_csv(args.delay_trace).delays.max())
         for scheme in args.schemes:
@@ -291,7 +293,7 @@ def main(argv=None) -> int:
     if traces:
         from report_figures import teleop_figure
 
-        teleop_figure(traces, FORCE_SCALE, FIGURE_DELAY, args.json.with_suffix('.png'))
+        teleop_figure(traces, FORCE_SCALE, args.json.with_suffix('.png'))
     return 0
 
 
