@@ -210,7 +210,8 @@ def _teleop_chapter(findings: Findings) -> list[str]:
         '## 6. Telerobotic scan', '',
         'The scripted sonographer approaches the patient phantom through the remote robot, '
         'presses at about 8 N, sweeps 8 cm along it and lifts, over a link of the given one-way '
-        'delay with 10 % jitter and 1 % loss, per bilateral scheme: *direct* (the F/T force, '
+        'delay with 20 % jitter and 5 % loss (stored runs before issue 28: 10 % and 1 %), per '
+        'bilateral scheme: *direct* (the F/T force, '
         'scaled by 0.3, the baseline), *tdpa* (time-domain passivity at both ports, energy sent '
         'over the link, the operator\'s controller acting through a virtual coupling; in '
         'lockstep also *tdpa-plain*, the controller on the wand itself: the baseline that '
@@ -223,7 +224,14 @@ def _teleop_chapter(findings: Findings) -> list[str]:
         'the hand ≤ 0 and an oscillation (RMS of the felt force about its 0.25 s mean, in '
         'contact) ≤ 10 % of it; *transparency* the RMS of felt / 0.3 − patient force at the '
         'lag that makes it least; *tracking* the RMS of the probe against the wand\'s path at '
-        'its best lag (it includes the robot\'s spring giving way to the patient\'s force).',
+        'its best lag (it includes the robot\'s spring giving way to the patient\'s force); '
+        'the *felt step ratio* the 99th percentile (and the largest) of the felt force\'s change '
+        'between 1 ms ticks, scaled, over the patient\'s, in steady contact (> 3 N), and the '
+        '*jumps* those changes over 1 N (smooth: both ratios ≤ 3, no jump). *ease 5* is the '
+        'driver easing each new model in at 5 N/s, *ease 0* each taken at once (the code '
+        'before issue 28); *time to force* from the first contact to 90 % of the mean contact '
+        'force, and the *peak rise* of the patient\'s force over 5 ms (the envelope bounds the '
+        'robot\'s spring to 40 N/s in contact).',
         '']
     parts += ['### In lockstep', '']
     parts += _stored(findings, 'teleop_lockstep', lambda rows: [

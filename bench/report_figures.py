@@ -244,12 +244,12 @@ def sweep_figure(rows: list, bound: float, path: Path) -> None:
     _save(figure, path)
 
 
-def teleop_figure(traces: dict, scale: float, delay: float, path: Path) -> None:
-    """Felt force / scale and the patient's force against time, one panel per scheme."""
+def teleop_figure(traces: dict, scale: float, path: Path) -> None:
+    """Felt force / scale and the patient's force against time, a panel per titled series."""
     plt = _pyplot()
     figure, panels = plt.subplots(len(traces), 1, figsize=(11, 2.6 * len(traces)), sharex=True,
                                   constrained_layout=True)
-    for axes, (scheme, series) in zip(np.atleast_1d(panels), traces.items()):
+    for axes, (title, series) in zip(np.atleast_1d(panels), traces.items()):
         start = series['/wand/pose'][0][0]
         felt_t, felt = series['/wand/applied_wrench']
         patient_t, patient = series['/remote/robot/ft_sensor/wrench']
@@ -258,7 +258,7 @@ def teleop_figure(traces: dict, scale: float, delay: float, path: Path) -> None:
         axes.plot(felt_t - start, felt[:, 2] / scale, c='C0', lw=0.8,
                   label=f'felt by the hand / {scale:g} (applied, z)')
         axes.set_ylabel('force, N')
-        axes.set_title(f'{scheme}, {1e3 * delay:g} ms one way, over ROS 2')
+        axes.set_title(title)
         axes.legend(fontsize=8, loc='upper right')
     np.atleast_1d(panels)[-1].set_xlabel('time since the first wand pose, s')
     _save(figure, path)

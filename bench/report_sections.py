@@ -395,17 +395,25 @@ def force_effect_section(cuboid: Recording, without: list | None, demo_dir: Path
 
 
 def teleop_section(rows: list) -> str:
-    """Tabulate each scheme's stability, transparency, patient force and tracking per delay."""
+    """Tabulate each scheme's stability, transparency, patient force, tracking, smoothness."""
     def number(value: float, fmt: str) -> str:
         return '–' if not np.isfinite(value) else format(value, fmt)
     return markdown_table(
         ['scheme', 'one-way delay (ms)', 'run', 'stable', 'net work on the hand (mJ)',
          'oscillation (%)', 'transparency error (N)', '(% of mean contact force)',
-         'peak patient force (N)', 'tracking RMS (mm)'],
-        [[r['scheme'], f'{1e3 * r["delay"]:g}', r['source'], 'yes' if r['stable'] else '**no**',
+         'peak patient force (N)', 'tracking RMS (mm)', 'felt step ratio p99', '(max)',
+         'jumps > 1 N', 'time to force (s)', 'peak rise (N/s)'],
+        [[r['scheme'], f'{1e3 * r["delay"]:g}',
+          ', '.join(filter(None, (r['source'], r.get('site_streams', '')))),
+          'yes' if r['stable'] else '**no**',
           f'{1e3 * r["net_work_j"]:+.1f}', f'{r["oscillation_percent"]:.1f}',
           number(r['transparency_n'], '.2f'), number(r['transparency_percent'], '.1f'),
-          f'{r["peak_patient_n"]:.2f}', f'{1e3 * r["tracking_m"]:.1f}'] for r in rows])
+          f'{r["peak_patient_n"]:.2f}', f'{1e3 * r["tracking_m"]:.1f}',
+          number(r.get('step_ratio_p99', np.nan), '.1f'),
+          number(r.get('step_ratio_max', np.nan), '.1f'), str(r.get('jumps', '–')),
+          number(r.get('time_to_force_s', np.nan), '.2f'),
+          number(r.get('peak_rise_n_per_s', np.nan), '.0f')]
+         for r in rows])
 
 
 def teleop_load_section(rows: list) -> str:

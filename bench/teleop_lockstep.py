@@ -1,6 +1,7 @@
 """The telerobotic scan in lockstep, without ROS: the schemes' physics alone, reproducibly.
 
-    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.025 0.05 0.1 0.25] [--late]
+    .venv/bin/python bench/teleop_lockstep.py [--delays 0 0.01 0.025 0.05 0.1 0.25 0.5]
+        [--jitter 0.2] [--loss 0.05] [--late] [--model-step-rates 5 0] [--force-hold]
         [--json PATH]
 
 The same pieces as the ROS run, driven by one clock at 1 kHz: the simulated wand with its
@@ -13,8 +14,14 @@ What it shows is what the schemes do with a delay, free of a busy machine's timi
 that ``tdpa`` puts between them, the baseline that chatters. With ``--late`` the operator's site
 skips ticks as a busy machine makes it (the remote site keeps its own), and each case runs with
 the driver's hold of the newest answer (as the launcher sets it) and without (the baseline).
+``--model-step-rates`` runs ``model`` once per rate of the driver's easing of new models (N/s; 0:
+each at once, the baseline; both by default, the fix beside what it replaces). With
+``--force-hold`` each delay runs ``model`` once more with the remote site holding, through the
+sweep, the force it measured as the sweep began; its force error beside the hand's own (the
+patient's force about its mean over the same sweep, unheld).
 """
 import argparse
+import itertools
 import math
 import sys
 
@@ -23,7 +30,8 @@ import numpy as np
 import result_files
 import teleop_scan
 
-from haptic_bringup.launcher import LATE_POSE_HOLD, SCAN_DURATION
+from haptic_bringup.launcher import LATE_POSE_HOLD, LINK_TIMEOUT, MODEL_STEP_RATE, \
+    SCAN_DURATION
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
@@ -38,14 +46,14 @@ from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.ft_sensor import ForceTorqueSensor
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
 from remote_probe.leader import Leader, LeaderConfig
-from remote_probe.link import EmulatedLink, LinkConfig
+from remote_probe.link import EmulatedLink, LinkConfig, silence_timeout
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.teleop import CommandLimits, HAND_SPEED
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
-__all__ = ['as_series', 'late_ticks', 'scan', 'SCHEMES']
+__all__ = ['as_series', 'hold_error', 'late_ticks', 'scan', 'SCHEMES']
 
 PLAIN_TDPA = 'tdpa-plain'  # TDPA's controller on the wand itself: the baseline of the coupling
 SCHEMES = ('direct', PLAIN_TDPA, 'tdpa', 'model')
@@ -55,10 +63,11 @@ SKIN = -0.025  # [m] the phantom's front, under the probe's start
 TICK = 1e-3  # [s]
 MODEL_LIFETIME = LeaderParams().model_lifetime  # [s]
 LATE_FRACTION, LATE_LONGEST = 0.02, 0.08  # of the ticks, late by up to [s]
+SWEEP = (5.0, 16.0)  # [s] the scan's sweep along the patient, pressed (scan.yaml)
 ZERO = np.zeros(3)
 
 
-def _device(scheme: str):
+def _device(scheme: str, easing: float):
     """Build the driver's simulated wand and hand, rendering as the launcher sets ``scheme``."""
     wand = WandDriverParams()
     limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
@@ -72,7 +81,7 @@ def _device(scheme: str):
         renderer = LocalRenderer(
             force_limit=limits.force_limit, torque_limit=limits.torque_limit,
             passivity=PortPassivity(wand.passivity_max_damping), mass=[wand.device_mass] * 3,
-            contact_damping_ratio=wand.contact_damping_ratio)
+            contact_damping_ratio=wand.contact_damping_ratio, model_step_rate=easing)
         device.render_locally(renderer)
     return device, renderer
 
@@ -86,7 +95,9 @@ def _model(time: float, plane, tip) -> ContactModel:
 
 
 def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
-         duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0) -> dict:
+         duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0,
+         easing: float = MODEL_STEP_RATE, link_timeout: float | None = None,
+         force_hold: tuple | None = None) -> dict:
     """Run the scan; return the operator's and the remote site's per-tick arrays.
 
     ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``. ``ticks``: the tick
@@ -94,13 +105,18 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     does), None for every one; the remote site runs every tick. The site takes each answer as
     the driver does: held by ``AnswerDeadline(hold)`` (the driver's ``hold_while_late``), a
     wrench through the device port's passivity controller unless the scheme is ``direct``.
+    ``easing``: the driver's ``model_step_rate`` (N/s; 0: each model at once, the baseline).
+    ``link_timeout``: both ends' watchdogs (s); None waits out the jitter, as the launcher sets.
+    ``force_hold``: (start, end) s, the remote site holding the force it measured at the start
+    (``Follower.hold_force``) until the end; the run then has ``held`` (N).
     Returns ``time``, ``wand``, ``felt`` (applied since the tick before) at the operator's
     ticks, and ``remote_time``, ``patient``, ``tcp``.
     """
-    leader_config = (LeaderConfig('tdpa', coupling=None) if scheme == PLAIN_TDPA
-                     else LeaderConfig(scheme))
+    timeout = silence_timeout(LINK_TIMEOUT, jitter) if link_timeout is None else link_timeout
+    leader_config = (LeaderConfig('tdpa', coupling=None, link_timeout=timeout)
+                     if scheme == PLAIN_TDPA else LeaderConfig(scheme, link_timeout=timeout))
     scheme = leader_config.scheme
-    device, renderer = _device(scheme)
+    device, renderer = _device(scheme, easing)
     port = PortPassivity(WandDriverParams().passivity_max_damping if scheme == 'tdpa' else 0.0)
     answers = AnswerDeadline(hold)
     robot_config = ImpedanceRobotConfig()
@@ -109,7 +125,8 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     sensor = ForceTorqueSensor()
     skin = PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])
     follower = Follower(FollowerConfig(scheme, robot_config.stiffness),
-                        PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness)),
+                        PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness,
+                                                   link_timeout=timeout)),
                         CommandLimits(robot_config.workspace_lower,
                                       robot_config.workspace_upper, HAND_SPEED),
                         ContactModelEstimator(), surface=lambda tcp: (skin.point, skin.normal))
@@ -120,7 +137,7 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     count = round(duration / TICK)
     operating = np.ones(count + 1, dtype=bool) if ticks is None else np.isin(
         np.arange(count + 1), ticks)
-    operator_rows, remote_rows = [], []
+    operator_rows, remote_rows, held = [], [], np.nan
     state, remote = device.read(0.0), robot.read(0.0)
     for k in range(1, count):
         now = k * TICK
@@ -132,6 +149,11 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
                 to_robot.send(now, command)
         for delivery in to_robot.deliver(now):
             follower.receive(now, delivery.payload)
+        if force_hold is not None and k == round(force_hold[0] / TICK):
+            follower.hold_force(None)
+            held = follower.hold.force
+        elif force_hold is not None and k == round(force_hold[1] / TICK):
+            follower.hold_force(0.0)
         reading = sensor.measure(now, remote.external_force).force
         robot.command(follower.target(now, remote.position, remote.velocity, reading, TICK))
         to_operator.send(now, follower.feedback(now))
@@ -155,7 +177,21 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     operator, remote_table = np.array(operator_rows), np.array(remote_rows)
     return {'time': operator[:, 0], 'wand': operator[:, 1:4], 'felt': operator[:, 4:7],
             'remote_time': remote_table[:, 0], 'patient': remote_table[:, 1:4],
-            'tcp': remote_table[:, 4:7]}
+            'tcp': remote_table[:, 4:7], 'held': held}
+
+
+def hold_error(run: dict, start: float, end: float, settle: float = 0.5) -> dict:
+    """Return the patient's force against the held one (N) from ``settle`` s after ``start``.
+
+    Without a hold (``held`` NaN), against the force's own mean over the same window: what the
+    operator's hand keeps by itself.
+    """
+    window = (run['remote_time'] >= start + settle) & (run['remote_time'] < end)
+    force = np.linalg.norm(run['patient'][window], axis=1)
+    held = run['held'] if np.isfinite(run['held']) else float(np.mean(force))
+    error = force - held
+    return {'held_n': held, 'hold_error_max_n': float(np.max(np.abs(error))),
+            'hold_error_rms_n': float(np.sqrt(np.mean(error ** 2)))}
 
 
 def late_ticks(duration: float, seed: int, *, late: float = LATE_FRACTION,
@@ -184,13 +220,18 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--schemes', nargs='+', default=list(SCHEMES), choices=SCHEMES)
     parser.add_argument('--delays', nargs='+', type=float,
-                        default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25])
-    parser.add_argument('--jitter', type=float, default=0.1, help='fraction of the delay')
-    parser.add_argument('--loss', type=float, default=0.01)
+                        default=[0.0, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5])
+    parser.add_argument('--jitter', type=float, default=0.2, help='fraction of the delay')
+    parser.add_argument('--loss', type=float, default=0.05)
     parser.add_argument('--late', action='store_true',
                         help=f"the operator's site ticks late ({100 * LATE_FRACTION:g} %% of its "
                         f'ticks, by up to {1e3 * LATE_LONGEST:g} ms): each case with the '
                         "driver's hold and without it (the baseline)")
+    parser.add_argument('--model-step-rates', nargs='+', type=float,
+                        default=[MODEL_STEP_RATE, 0.0],
+                        help="model: the driver's easing of new models, N/s (0: at once)")
+    parser.add_argument('--force-hold', action='store_true',
+                        help='model once more per delay, the force held through the sweep')
     result_files.add_option(parser)
     args = parser.parse_args(argv)
     print(f'machine: {machine.line("numpy")} (no ROS: one clock, lockstep)')
@@ -199,13 +240,28 @@ def main(argv=None) -> int:
     rows = []
     for delay in args.delays:
         for scheme in args.schemes:
-            for hold in (LATE_POSE_HOLD, 0.0) if args.late else (0.0,):
+            rates = args.model_step_rates if scheme == 'model' else [MODEL_STEP_RATE]
+            for hold, rate in itertools.product((LATE_POSE_HOLD, 0.0) if args.late else (0.0,),
+                                                rates):
                 run = scan(scheme, delay, jitter=args.jitter * delay, loss=args.loss,
-                           ticks=ticks, hold=hold)
+                           ticks=ticks, hold=hold, easing=rate)
+                notes = ([f'late, hold {1e3 * hold:g} ms'] if args.late else []) + (
+                    [f'ease {rate:g}'] if len(rates) > 1 else [])
                 rows.append({'scheme': scheme, **teleop_scan.figures(as_series(run), delay),
-                             'site_streams': f'late, hold {1e3 * hold:g} ms'
-                             if args.late else ''})
+                             'site_streams': ', '.join(notes), **hold_error(run, *SWEEP)})
                 teleop_scan.print_row(rows[-1])
+        if args.force_hold:
+            run = scan('model', delay, jitter=args.jitter * delay, loss=args.loss, ticks=ticks,
+                       force_hold=SWEEP)
+            rows.append({'scheme': 'model', **teleop_scan.figures(as_series(run), delay),
+                         'site_streams': 'force held', **hold_error(run, *SWEEP)})
+            teleop_scan.print_row(rows[-1])
+    print('\nThe patient\'s force through the sweep against the held one (unheld: its mean):')
+    for r in rows:
+        if r['scheme'] == 'model':
+            print(f'{1e3 * r["delay"]:6.0f} ms {r["site_streams"]:>18} held {r["held_n"]:5.2f} N'
+                  f'  error max {r["hold_error_max_n"]:5.2f} N'
+                  f'  rms {r["hold_error_rms_n"]:5.2f} N')
     result_files.write(args.json, rows)
     return 0
 

@@ -45,10 +45,10 @@ class _Python:
         return self.law.wrench(*args)
 
 
-def _renderer(ratio: float) -> LocalRenderer:
+def _renderer(ratio: float, rate: float = 0.0) -> LocalRenderer:
     return LocalRenderer(force_limit=8.0, torque_limit=0.3,
                          passivity=PortPassivity(max_damping=50.0), mass=(0.15, 0.12, 0.18),
-                         contact_damping_ratio=ratio)
+                         contact_damping_ratio=ratio, model_step_rate=rate)
 
 
 def _random_plane(rng, tip):
@@ -91,11 +91,11 @@ def _row(wand: SimulatedWand, state, law: LocalRenderer) -> tuple:
     force, torque = wand.applied()
     return (*state.position, state.roll, state.yaw, *state.linear_velocity, state.roll_rate,
             state.yaw_rate, *force, *torque, law.passivity.energy, law.passivity.net_work,
-            law.bound[0])
+            *law.bound[[0, 2, 3, 4, 5, 6]])
 
 
-def _run(seed: int, ratio: float, hand: bool):
-    laws = [_renderer(ratio), _renderer(ratio)]
+def _run(seed: int, ratio: float, hand: bool, rate: float = 0.0):
+    laws = [_renderer(ratio, rate), _renderer(ratio, rate)]
     wands = [_wand(laws[0], hand), _wand(_Python(laws[1]), hand)]
     assert wands[0]._compiled is not None and wands[1]._compiled is None  # the two paths
     rng = np.random.default_rng(seed)
@@ -115,9 +115,11 @@ def _run(seed: int, ratio: float, hand: bool):
 
 
 @pytest.mark.parametrize('seed', range(6))
-@pytest.mark.parametrize('ratio', [0.0, 1.0])
-def test_the_compiled_loop_gives_its_reference_trajectory_float_for_float(seed, ratio):
-    (compiled, reference), (edges, reference_edges) = _run(seed, ratio, hand=seed % 3 != 2)
+@pytest.mark.parametrize('ratio, rate', [(0.0, 0.0), (1.0, 0.0), (1.0, 5.0), (0.0, 50.0)])
+def test_the_compiled_loop_gives_its_reference_trajectory_float_for_float(seed, ratio, rate):
+    """With the models switched at once, and eased in (``model_easing``)."""
+    (compiled, reference), (edges, reference_edges) = _run(seed, ratio, hand=seed % 3 != 2,
+                                                           rate=rate)
     assert np.array_equal(compiled, reference)
     assert edges == reference_edges
 
@@ -132,6 +134,14 @@ def test_the_runs_compared_press_rotate_saturate_and_wake_the_passivity():
     assert np.linalg.norm(force, axis=1).max() > 7.9  # at the renderer's limits
     assert np.abs(compiled[:, 16]).max() > 0.0  # the passivity's books moved
     assert compiled[:, 18].max() > 0.0  # models met inside were moved out by the port's bound
+
+
+def test_the_eased_runs_compared_match_pushes_scale_stiffnesses_and_shift_both_ways():
+    (compiled, _), _ = _run(0, 1.0, hand=True, rate=5.0)
+    shift, push, scale = compiled[:, 18], compiled[:, 19], compiled[:, 20]
+    assert shift.min() < 0.0 < shift.max()
+    assert push.max() > 0.0
+    assert scale.min() < 1.0 < scale.max()
 
 
 @pytest.mark.parametrize('seed', range(3))

@@ -354,3 +354,17 @@ def test_a_deadline_already_past_renders_no_force():
     wand.read(1.0)
     wand.apply([5.0, 0.0, 0.0], [0.0, 0.0, 0.0], until=0.5)
     assert wand.read(1.1).linear_velocity.tolist() == [0.0, 0.0, 0.0]
+
+
+def test_a_tick_inside_one_servo_period_reports_the_force_the_hand_still_feels():
+    """Two reads within one substep: nothing rendered in between, the force still held."""
+    wand = SimulatedWand(SimulatedWandConfig(step=0.00025))
+    wand.read(0.0)
+    wand.apply(np.array([0.0, 0.0, 2.0]), np.zeros(3))
+    wand.read(0.001)
+    assert wand.applied()[0][2] == pytest.approx(2.0)
+    wand.read(0.0011)  # no substep since
+    assert wand.applied()[0][2] == pytest.approx(2.0)
+    wand.apply(np.zeros(3), np.zeros(3))
+    wand.read(0.002)
+    assert wand.applied()[0][2] == 0.0

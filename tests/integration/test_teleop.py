@@ -24,11 +24,13 @@ from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import (bags, published_counts, read_vectors, reported,
                                     SITE_PUBLISHERS, topic_counts)
 from haptic_util.qos import HAPTIC_STREAM_QOS
+from remote_probe.link import silence_timeout
 
 DELAY = 0.05  # [s] one way
 FORCE_SCALE = 0.3  # the leader's default
 MAX_PATIENT_FORCE = 20.0  # [N] the follower's default
-LINK_TIMEOUT = 0.1  # [s] the leader's and the follower's default
+JITTER = 0.1 * DELAY  # [s]
+LINK_TIMEOUT = silence_timeout(0.1, JITTER)  # [s] both ends', as the launcher sets them
 MODEL_LIFETIME = 0.010  # [s] the leader's default
 PRESSING = (6.0, 8.0)  # [s] after the first pose: the scan holds its press, then sweeps
 STREAMS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
@@ -40,7 +42,7 @@ def teleop(folder: pathlib.Path, scheme: str = 'model', duration: float = 9.0, *
     config = LoopConfig(teleop=scheme, duration=duration, record=str(folder / 'bag'),
                         domain_id=session_domain_id(),
                         remote_domain=session_domain_id(second=True), run_dir=folder / 'launch',
-                        link={'delay': DELAY, 'jitter': 0.1 * DELAY, 'loss': 0.01, **link})
+                        link={'delay': DELAY, 'jitter': JITTER, 'loss': 0.01, **link})
     return Loop(config)
 
 

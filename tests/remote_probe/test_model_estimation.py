@@ -103,3 +103,19 @@ def test_nan_samples_and_a_clock_going_back_are_refused():
     estimator.update(1.0, [0.0, 0.0, 5.0], np.zeros(3), np.zeros(3))
     with pytest.raises(ValueError, match='must not go back'):
         estimator.update(0.5, [0.0, 0.0, 5.0], np.zeros(3), np.zeros(3))
+
+
+def test_a_contact_that_begins_tilted_by_noise_starts_from_the_surfaces_normal():
+    """A first force at the threshold, tilted 10° by the sensor's noise: the known surface's
+    normal keeps the estimate's normal on the skin's from the first sample on."""
+    tilt = np.radians(10.0)
+    first = 0.6 * np.array([math.sin(tilt), 0.0, math.cos(tilt)])
+    force = 3.0 * np.array([0.0, 0.0, 1.0])
+    angles = []
+    for normal in (None, lambda: np.array([0.0, 0.0, 1.0])):
+        estimator = ContactModelEstimator()
+        estimator.update(0.0, first, np.zeros(3), np.zeros(3), normal)
+        estimate = estimator.update(0.001, force, np.zeros(3), np.zeros(3), normal)
+        angles.append(math.degrees(math.acos(estimate.normal[2])))
+    assert angles[0] > 5.0  # from the first force: still tilted
+    assert angles[1] < 1e-9

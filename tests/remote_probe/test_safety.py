@@ -51,7 +51,7 @@ def test_the_target_is_kept_within_the_spring_reach_of_the_tcp():
 @pytest.mark.parametrize('start_height', [0.0, 0.01, 0.05, 0.2])
 def test_a_target_deep_in_the_patient_never_presses_past_the_limit(start_height):
     site = RemoteSite([0.0, 0.0, start_height], force_margin=0.0)
-    forces = site.run(2.0, lambda t: [0.0, 0.0, -0.3])
+    forces = site.run(3.0, lambda t: [0.0, 0.0, -0.3])  # 0.8 s to come down, 1 s of ramp
     assert forces.max() <= 20.0
     assert forces[-1] == pytest.approx(20.0, rel=1e-3)  # and it does press up to the limit
 

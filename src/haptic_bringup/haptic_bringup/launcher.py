@@ -42,6 +42,7 @@ from haptic_bringup.discovery import GraphWatcher
 from haptic_bringup.processes import (clean_stale_shm, shm_segments, start_child,
                                       stop_children, wait_any_exit)
 from haptic_util.executor import end_process
+from remote_probe.link import silence_timeout
 
 __all__ = ['LoopConfig', 'Loop', 'main', 'loop_environment', 'NODES']
 
@@ -67,6 +68,8 @@ REMOTE_PREFIX = '/remote'  # where the remote site's topics go in its bag
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 LATE_POSE_HOLD = 0.5  # [s] past the stalls seen with the machine fully loaded (up to 0.45 s)
+MODEL_STEP_RATE = 5.0  # [N/s] at the hand: 17 N/s at the patient, above the scan's 13 (p99)
+LINK_TIMEOUT = 0.1  # [s] both ends' watchdogs on a link without jitter (their defaults)
 TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
 IMAGE = '/probe/image'
 TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',
@@ -195,6 +198,9 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     same with it). While the driver's next pose is late, the answer to the newest one holds until
     it is sent, for at most ``LATE_POSE_HOLD``: an answer that expired inside a stretched tick let
     the hand fall in, and the next one threw it back out (``haptic_wand_driver.answer_deadline``).
+    Each new model eases in at ``MODEL_STEP_RATE`` (``haptic_wand_driver.model_easing``): at
+    once, every estimate's move since the last jolted the hand (issue 28). Both ends' watchdogs
+    wait out the link's jitter (``remote_probe.link.silence_timeout``).
     """
     scheme = config.teleop
     driver = options.setdefault('wand_driver', {})
@@ -205,8 +211,10 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     driver['rendering'] = 'local' if scheme == 'model' else 'remote'
     driver['passivity'] = scheme != 'direct'
     driver['hold_while_late'] = LATE_POSE_HOLD
+    driver['model_step_rate'] = MODEL_STEP_RATE
+    timeout = silence_timeout(LINK_TIMEOUT, float(config.link.get('jitter', 0.0)))
     for node in ('teleop_leader', 'teleop_follower'):
-        options.setdefault(node, {})['scheme'] = scheme
+        options.setdefault(node, {}).update(scheme=scheme, link_timeout=timeout)
     if config.record:
         session = pathlib.Path(config.record).resolve()
         options[OPERATOR_RECORDER] = {'output': str(session / 'operator'), 'topics': [

@@ -24,6 +24,11 @@ far as the port's books require (``port_passivity.bounded_shift``), and keeps th
 model's life. A model that comes after a late tick, the one before expired and the hand in
 deeper, then gives back no more than the hand put in.
 
+Smooth at any update rate, with ``model_step_rate`` > 0 (``model_easing``): a new model's planes
+start as stiff as the last period's and where they push as much, and ease to the model at that
+many N/s of push, held every period to the port's bound. 0 switches at once, as above (the
+baseline).
+
 A model renders from the servo period that holds its ``since`` (the device's clock when it
 arrived), and what was held before renders the periods until then: so a device that runs its
 periods after the fact (the simulated wand, on each read) switches where a real one would,
@@ -39,9 +44,11 @@ run in the thread that calls ``take``: the packing is not atomic), rewritten by 
 the force and torque limits, the contact damping ratio, the mass (3); the mode (``MODE_*``), the
 deadline, the model's force limit, valid radius and tip (3), the held wrench (6), the plane
 count, the damping cap per mass and period (``MAX_DAMPING_PER_MASS``), ``since``, the take's
-number; from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point, normal, stiffness,
-damping, tool point). ``bound`` is the shift the port's bound set (m) and the number of the take
-it was set for.
+number, the model step rate; from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point,
+normal, stiffness, damping, tool point). ``bound`` is the planes' shift (m), the number of the take
+it was set for, the spring push the planes rendered in the last period (N; 0 when none), the
+factor on their stiffnesses and the sum of those scaled (N/m; 0 when none), the factor on their
+dampings and the sum of those scaled (N·s/m; 0 when none).
 """
 import math
 from typing import Sequence
@@ -49,17 +56,20 @@ from typing import Sequence
 import numpy as np
 
 from haptic_wand_driver.contact_model import ContactModel, Kind, MAX_PLANES
+from haptic_wand_driver.model_easing import eased_level, eased_scale, eased_shift, least_shift, \
+    matched_shift, scaled_model, spring_push, stored_energy, total_damping, total_stiffness
 from haptic_wand_driver.orientation import roll_axis
 from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
 from haptic_wand_driver.wrench_input import saturate_components
 
 __all__ = ['DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE',
-           'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE']
+           'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE',
+           'STEP_RATE']
 
 _ZERO = (0.0, 0.0, 0.0)
 MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
 MODE_NONE, MODE_WRENCH, MODE_PLANES = 0.0, 1.0, 2.0  # what ``packed`` holds
-DEADLINE, SINCE, SERIAL, PLANES_AT, PLANE_SIZE = 7, 21, 22, 23, 15
+DEADLINE, SINCE, SERIAL, STEP_RATE, PLANES_AT, PLANE_SIZE = 7, 21, 22, 23, 24, 15
 LAW_SIZE = PLANES_AT + MAX_PLANES * PLANE_SIZE
 _NOTHING = (None, None, -math.inf)  # (model, wrench, deadline) held
 
@@ -77,18 +87,25 @@ class LocalRenderer:
         The device's apparent mass per axis, for the contact damping.
     contact_damping_ratio : float
         Damping ratio of the contact on the device's mass (0: the material's damping alone).
+    model_step_rate : float, N/s
+        How fast a new model's spring push eases in (``model_easing``); 0: at once.
     """
 
     def __init__(self, *, force_limit: float, torque_limit: float, passivity: PortPassivity,
-                 mass: Sequence[float] = (0.0, 0.0, 0.0),
-                 contact_damping_ratio: float = 0.0) -> None:
+                 mass: Sequence[float] = (0.0, 0.0, 0.0), contact_damping_ratio: float = 0.0,
+                 model_step_rate: float = 0.0) -> None:
+        if not (model_step_rate >= 0.0 and math.isfinite(model_step_rate)):
+            raise ValueError(f'model_step_rate must be a finite number >= 0 N/s, got '
+                             f'{model_step_rate!r}')
         self.force_limit = force_limit
         self.torque_limit = torque_limit
         self.passivity = passivity
         self.mass = tuple(mass)
         self.contact_damping_ratio = contact_damping_ratio
+        self.model_step_rate = float(model_step_rate)
         self.packed = np.zeros((2, LAW_SIZE))  # (servo_loop's layout)
-        self.bound = np.array([0.0, -1.0])  # the shift of the planes, the take it is for
+        # shift, take, push, stiffness factor and sum, damping factor and sum
+        self.bound = np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0])
         self._held = ((*_NOTHING, 0),) * 2 + (-math.inf,)  # before since, from since, since
         self._takes = 0
         self.clear()
@@ -127,7 +144,7 @@ class LocalRenderer:
         self.packed[0, :PLANES_AT + len(planes)] = (
             self.force_limit, self.torque_limit, self.contact_damping_ratio, *self.mass, mode,
             held[2], force_limit, valid_radius, *tip, *wrench, count, MAX_DAMPING_PER_MASS,
-            since, self._takes, *planes)
+            since, self._takes, self.model_step_rate, *planes)
         self._held = (self._held[1], (*held, self._takes), since)
 
     def wrench(self, time: float, coordinates: Sequence[float], rates: Sequence[float],
@@ -144,27 +161,58 @@ class LocalRenderer:
         limit = self.force_limit
         if wrench is not None and time + period <= deadline:
             force, torque = wrench
+            self.bound[2] = self.bound[4] = self.bound[6] = 0.0
         elif (model is not None and model.kind == Kind.PLANES and time + period <= deadline
                 and model.valid(position)):
             x, y, z = roll_axis(coordinates[4])
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
             limit = min(self.force_limit, model.force_limit)
-            force, torque = model.wrench(position, velocity, coordinates[3], coordinates[4],
-                                         spin, self._contact_damping(period), limit,
-                                         self._shift(model, take, coordinates))
+            shift = self._shift(model, take, coordinates, period)
+            force, torque = scaled_model(model, float(self.bound[3]), float(self.bound[5])).wrench(
+                position, velocity, coordinates[3], coordinates[4], spin,
+                self._contact_damping(period), limit, shift)
+        else:
+            self.bound[2] = self.bound[4] = self.bound[6] = 0.0
         force = self.passivity.control(force, position, velocity, period,
                                        time + period > deadline)
         return (saturate_components(force, limit),
                 saturate_components(torque, self.torque_limit))
 
-    def _shift(self, model: ContactModel, take: int, coordinates: Sequence[float]) -> float:
-        """Return the shift of ``model``'s planes, set by the port's bound at its first period."""
-        if take != self.bound[1]:
-            self.passivity.observe(coordinates[:3])
-            self.bound[:] = (bounded_shift(model.springs(coordinates, coordinates[3],
-                                                         coordinates[4]),
-                                           self.passivity.energy), take)
-        return float(self.bound[0])
+    def _shift(self, model: ContactModel, take: int, coordinates: Sequence[float],
+               period: float) -> float:
+        """Return the shift of ``model``'s planes this period.
+
+        Set by the port's bound at the model's first period and kept; or, easing, matched to the
+        last period's stiffness, damping and push at the first and eased from there (the factors
+        with it, in ``bound``), storing no more than the port absorbed or the planes held.
+        """
+        first = take != self.bound[1]
+        if not (first or self.model_step_rate > 0.0):
+            return float(self.bound[0])
+        self.passivity.observe(coordinates[:3])
+        springs = model.springs(coordinates, coordinates[3], coordinates[4])
+        energy = self.passivity.energy
+        if self.model_step_rate == 0.0:
+            self.bound[:2] = (bounded_shift(springs, energy), take)
+            return float(self.bound[0])
+        step = self.model_step_rate * period
+        shift, _, push, scale, stiff, damping_scale, damped = self.bound.tolist()
+        total, damping = total_stiffness(springs), total_damping(model)
+        if first:
+            scale = stiff / total if stiff > 0.0 and total > 0.0 else 1.0
+            damping_scale = damped / damping if damping > 0.0 else 1.0
+            springs = [(d, scale * k) for d, k in springs]
+            shift = matched_shift(springs, push)
+        else:
+            held = stored_energy([(d, scale * k) for d, k in springs], shift)
+            scale = eased_scale(scale, step, push)
+            damping_scale = eased_level(damping_scale, step, push)
+            springs = [(d, scale * k) for d, k in springs]
+            eased = eased_shift(springs, shift, step)
+            shift = max(eased, least_shift(springs, max(energy, held), min(eased, 0.0)))
+        self.bound[:] = (shift, take, spring_push(springs, shift), scale, scale * total,
+                         damping_scale, damping_scale * damping)
+        return shift
 
     def _contact_damping(self, period: float):
         """Return the per-plane damping for this servo period (None when the ratio is zero)."""

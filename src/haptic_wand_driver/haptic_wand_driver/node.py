@@ -120,7 +120,8 @@ class WandDriverNode(Node):
         renderer = LocalRenderer(
             force_limit=limits.force_limit, torque_limit=limits.torque_limit,
             passivity=self.passivity, mass=[self.params.device_mass] * 3,
-            contact_damping_ratio=self.params.contact_damping_ratio)
+            contact_damping_ratio=self.params.contact_damping_ratio,
+            model_step_rate=self.params.model_step_rate)
         try:
             self.device.render_locally(renderer)
         except LocalRenderingUnsupported as error:

@@ -33,6 +33,9 @@ class WandDriverParams:
     contact_damping_ratio: float = parameter(1.0, 'local rendering: damping ratio of a contact '
                                              'on the device\'s mass, added along the normal '
                                              '(0: the material\'s alone)', low=0.0, high=5.0)
+    model_step_rate: float = parameter(0.0, 'local rendering: a new contact model eases in at '
+                                       'most this fast (spring push; 0: at once)', unit='N/s',
+                                       low=0.0)
     servo_rate: float = parameter(4000.0, 'simulated device: its servo rate (the dynamics '
                                   'substep)', unit='Hz', low=100.0, high=100000.0)
     force_limit: float = parameter(10.0, 'device force limit (saturation)', unit='N', low=0.0)

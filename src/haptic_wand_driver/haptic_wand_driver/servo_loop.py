@@ -13,7 +13,8 @@ before its loop starts. Its inputs, float64 arrays:
 * ``packed`` (2, n): the renderer's settings and what it holds, from a period on and before it
   (``LocalRenderer.packed``, whose layout ``local_rendering`` defines);
 * ``books``: the port's passivity (``PortPassivity.books``);
-* ``bound``: the shift of the planes and the take it was set for (``LocalRenderer.bound``);
+* ``bound``: the shift of the planes, the take it was set for and the last period's spring push
+  (``LocalRenderer.bound``; ``model_easing`` when the law eases its models in);
 * ``joints`` (5, 6): per joint, the hand's stiffness and damping, the inverse inertia, the
   damping decay per period and the workspace stops (lower, upper);
 * ``targets`` (n, 2, 5): the hand's target and its rate at each period.
@@ -24,7 +25,7 @@ from numba import njit
 import numpy as np
 
 from haptic_wand_driver.local_rendering import (DEADLINE, LAW_SIZE, MODE_PLANES, MODE_WRENCH,
-                                                PLANE_SIZE, PLANES_AT, SERIAL, SINCE)
+                                                PLANE_SIZE, PLANES_AT, SERIAL, SINCE, STEP_RATE)
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
 
 __all__ = ['advance', 'compile_now']
@@ -92,36 +93,168 @@ def _depth(law, at, coordinates, ax, ay, az):
 
 
 @njit(cache=True, nogil=True)
-def _bounded_shift(law, coordinates, energy):
-    """Return the planes' shift that stores at most ``energy`` (``bounded_shift``)."""
+def _springs(law, coordinates, depths, stiffnesses):
+    """Fill each plane's depth and stiffness along its normal (``ContactModel.springs``)."""
     roll, yaw = coordinates[3], coordinates[4]
     cr, sr, cy, sy = math.cos(roll), math.sin(roll), math.cos(yaw), math.sin(yaw)
-    depths, stiffnesses = np.empty(3), np.empty(3)
-    behind = 0
     for k in range(int(law[19])):
         at = PLANES_AT + PLANE_SIZE * k
         ax, ay, az = _arm(law, at, cr, sr, cy, sy)
-        depth = _depth(law, at, coordinates, ax, ay, az)
+        depths[k] = _depth(law, at, coordinates, ax, ay, az)
         nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
-        stiffness = law[at + 6] * nx * nx + law[at + 7] * ny * ny + law[at + 8] * nz * nz
-        if not (depth > 0.0 and stiffness > 0.0):
+        stiffnesses[k] = law[at + 6] * nx * nx + law[at + 7] * ny * ny + law[at + 8] * nz * nz
+
+
+@njit(cache=True, nogil=True)
+def _deepest_first(depths, stiffnesses, count, lowest, sorted_depths, sorted_stiffnesses,
+                   behind_only):
+    """Sort the springs as sorted(reverse=True) does, depths less ``lowest``; return how many.
+
+    ``behind_only``: only those behind (depth above ``lowest``); else all; with stiffness > 0.
+    """
+    kept = 0
+    for k in range(count):
+        depth, stiffness = depths[k] - lowest, stiffnesses[k]
+        if not (stiffness > 0.0 and (depth > 0.0 or not behind_only)):
             continue
-        j = behind  # deepest first, as sorted() orders the (depth, stiffness) pairs
-        while j > 0 and (depths[j - 1] < depth
-                         or (depths[j - 1] == depth and stiffnesses[j - 1] < stiffness)):
-            depths[j], stiffnesses[j] = depths[j - 1], stiffnesses[j - 1]
+        j = kept
+        while j > 0 and (sorted_depths[j - 1] < depth
+                         or (sorted_depths[j - 1] == depth
+                             and sorted_stiffnesses[j - 1] < stiffness)):
+            sorted_depths[j] = sorted_depths[j - 1]
+            sorted_stiffnesses[j] = sorted_stiffnesses[j - 1]
             j -= 1
-        depths[j], stiffnesses[j] = depth, stiffness
-        behind += 1
+        sorted_depths[j], sorted_stiffnesses[j] = depth, stiffness
+        kept += 1
+    return kept
+
+
+@njit(cache=True, nogil=True)
+def _least_shift(depths, stiffnesses, count, energy, lowest):
+    """Return the least shift from ``lowest`` storing at most ``energy`` (``least_shift``)."""
+    d, k = np.empty(3), np.empty(3)
+    behind = _deepest_first(depths, stiffnesses, count, lowest, d, k, True)
     a = b = c = 0.0
     for m in range(behind):
-        a += stiffnesses[m]
-        b += stiffnesses[m] * depths[m]
-        c += stiffnesses[m] * depths[m] * depths[m]
+        a += k[m]
+        b += k[m] * d[m]
+        c += k[m] * d[m] * d[m]
         shift = (b - math.sqrt(max(b * b - a * (c - 2.0 * energy), 0.0))) / a
-        if m + 1 == behind or shift >= depths[m + 1]:
+        if m + 1 == behind or shift >= d[m + 1]:
+            return max(shift, 0.0) + lowest
+    return 0.0 + lowest
+
+
+@njit(cache=True, nogil=True)
+def _matched_shift(depths, stiffnesses, count, push):
+    """Return the shift at which the springs push ``push`` (``model_easing.matched_shift``)."""
+    d, k = np.empty(3), np.empty(3)
+    kept = _deepest_first(depths, stiffnesses, count, 0.0, d, k, False)
+    a = b = 0.0
+    for m in range(kept):
+        a += k[m]
+        b += k[m] * d[m]
+        shift = (b - push) / a
+        if m + 1 == kept or shift >= d[m + 1]:
+            if push > 0.0:
+                return shift
             return max(shift, 0.0)
     return 0.0
+
+
+@njit(cache=True, nogil=True)
+def _total_stiffness(stiffnesses, count):
+    total = 0.0
+    for k in range(count):
+        if stiffnesses[k] > 0.0:
+            total += stiffnesses[k]
+    return total
+
+
+@njit(cache=True, nogil=True)
+def _eased_scale(scale, step, push):
+    """Return ``scale`` moved toward 1 (``model_easing.eased_scale``)."""
+    if push <= 0.0:
+        return 1.0
+    change = step * scale / push
+    return min(scale + change, 1.0) if scale < 1.0 else max(scale - change, 1.0)
+
+
+@njit(cache=True, nogil=True)
+def _total_damping(law):
+    total = 0.0
+    for k in range(int(law[19])):
+        at = PLANES_AT + PLANE_SIZE * k
+        nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
+        along = law[at + 9] * nx * nx + law[at + 10] * ny * ny + law[at + 11] * nz * nz
+        if along > 0.0:
+            total += along
+    return total
+
+
+@njit(cache=True, nogil=True)
+def _shift(law, coordinates, books, bound, period):
+    """Set ``bound`` for this period of the planes held (``LocalRenderer._shift``)."""
+    rate = law[STEP_RATE]
+    first = law[SERIAL] != bound[1]
+    if not (first or rate > 0.0):
+        return
+    _observe(books, coordinates)
+    depths, stiffnesses = np.empty(3), np.empty(3)
+    count = int(law[19])
+    _springs(law, coordinates, depths, stiffnesses)
+    if rate == 0.0:
+        bound[0], bound[1] = _least_shift(depths, stiffnesses, count, books[0], 0.0), law[SERIAL]
+        return
+    step, shift, push, scale, damping_scale = rate * period, bound[0], bound[2], bound[3], bound[5]
+    total, damping = _total_stiffness(stiffnesses, count), _total_damping(law)
+    if first:
+        scale = bound[4] / total if bound[4] > 0.0 and total > 0.0 else 1.0
+        damping_scale = bound[6] / damping if damping > 0.0 else 1.0
+        for k in range(count):
+            stiffnesses[k] = scale * stiffnesses[k]
+        shift = _matched_shift(depths, stiffnesses, count, push)
+    else:
+        held = 0.0
+        for k in range(count):
+            if depths[k] - shift > 0.0:
+                held += 0.5 * (scale * stiffnesses[k]) * (depths[k] - shift) * (depths[k] - shift)
+        scale = _eased_scale(scale, step, push)
+        damping_scale = 1.0
+        if push > 0.0:
+            change = step / push
+            damping_scale = (min(bound[5] + change, 1.0) if bound[5] < 1.0
+                             else max(bound[5] - change, 1.0))
+        for k in range(count):
+            stiffnesses[k] = scale * stiffnesses[k]
+        scaled = _total_stiffness(stiffnesses, count)
+        eased = 0.0
+        if scaled != 0.0:
+            change = step / scaled
+            eased = max(shift - change, 0.0) if shift > 0.0 else min(shift + change, 0.0)
+        floor = _least_shift(depths, stiffnesses, count, max(books[0], held), min(eased, 0.0))
+        shift = floor if floor > eased else eased
+    push = 0.0
+    for k in range(count):
+        if depths[k] - shift > 0.0:
+            push += stiffnesses[k] * (depths[k] - shift)
+    bound[0], bound[1], bound[2] = shift, law[SERIAL], push
+    bound[3], bound[4], bound[5], bound[6] = scale, scale * total, damping_scale, (
+        damping_scale * damping)
+
+
+@njit(cache=True, nogil=True)
+def _scaled(law, scale, damping_scale):
+    """Return ``law`` with its planes' stiffnesses and dampings scaled (``scaled_model``)."""
+    if scale == 1.0 and damping_scale == 1.0:
+        return law
+    scaled = law.copy()
+    for k in range(int(law[19])):
+        at = PLANES_AT + PLANE_SIZE * k
+        for j in range(6, 9):
+            scaled[at + j] = law[at + j] * scale
+            scaled[at + j + 3] = law[at + j + 3] * damping_scale
+    return scaled
 
 
 @njit(cache=True, nogil=True)
@@ -193,15 +326,19 @@ def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     mode, live = law[6], time + period <= law[DEADLINE]
     if mode == MODE_WRENCH and live:
         fx, fy, fz, tx, ty, tz = law[13], law[14], law[15], law[16], law[17], law[18]
+        bound[2] = bound[4] = bound[6] = 0.0
     elif mode == MODE_PLANES and live:
         dx, dy, dz = coordinates[0] - law[10], coordinates[1] - law[11], coordinates[2] - law[12]
         if dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
             if law[8] < limit:
                 limit = law[8]
-            if law[SERIAL] != bound[1]:  # the port's bound, at the model's first period
-                _observe(books, coordinates)
-                bound[0], bound[1] = _bounded_shift(law, coordinates, books[0]), law[SERIAL]
-            fx, fy, fz, tx, ty, tz = _planes(law, coordinates, rates, limit, period, bound[0])
+            _shift(law, coordinates, books, bound, period)
+            fx, fy, fz, tx, ty, tz = _planes(_scaled(law, bound[3], bound[5]), coordinates,
+                                             rates, limit, period, bound[0])
+        else:
+            bound[2] = bound[4] = bound[6] = 0.0
+    else:
+        bound[2] = bound[4] = bound[6] = 0.0
     fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period, not live)
     fx, fy, fz = _saturate(fx, fy, fz, limit)
     tx, ty, tz = _saturate(tx, ty, tz, law[1])
@@ -261,5 +398,6 @@ def compile_now() -> None:
     """Compile ``advance`` for the types the wand passes (or load it from numba's cache)."""
     advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)),
             np.zeros((2, LAW_SIZE)),
-            np.zeros(11), np.zeros(2), 1.0, 1.0, 0.0, 0, 1.0, np.zeros(6),
+            np.zeros(11), np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0]), 1.0, 1.0, 0.0, 0, 1.0,
+            np.zeros(6),
             np.empty(0, dtype=np.int64), False)

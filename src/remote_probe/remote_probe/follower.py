@@ -24,6 +24,9 @@ with the gains last learnt (the estimator's prior before any contact): without i
 model would reach the operator a round trip after the touch, with the wand already that far
 in (18 mm at 100 ms in the scripted scan), and the hand would first feel the patient there.
 
+Force-hold (``hold_force``, ``remote_probe.force_hold``): the target follows the operator along
+the surface and presses the set force along the contact's normal, until released.
+
 A sensor reading with NaN is not used: the feedback carries zero force and no plane until a good
 reading comes, and the safety goes on with the last good force.
 
@@ -40,6 +43,7 @@ import numpy as np
 
 from remote_probe._checks import finite_number
 from remote_probe.admission import Admission, Refusal
+from remote_probe.force_hold import ForceHold, HoldConfig
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.safety import PatientSafety
 from remote_probe.tdpa import RobotPassivity
@@ -116,6 +120,8 @@ class Follower:
         self._tcp = np.zeros(3)
         self._plane: RemotePlane | None = None
         self._surface = surface
+        self.hold = ForceHold(HoldConfig(), config.robot_stiffness,
+                              safety.envelope.working_limit)
         if self.estimator is not None:
             prior = self.estimator.config
             self._gains = self._as_commanded(prior.initial_stiffness, prior.initial_damping)
@@ -145,9 +151,16 @@ class Follower:
                 self._learn(now, tcp_velocity)
         if self._target is None:
             self._target = self._tcp.copy()
-        goal = self._goal(dt)
+        goal = self.hold.target(self._goal(dt), self._tcp, self._force, dt)
         self._target = self.safety.safe_target(now, goal, self._tcp, self._force)
         return self._target
+
+    def hold_force(self, force: float | None) -> bool:
+        """Hold ``force`` N at the patient (None: the force measured now; <= 0: release).
+
+        Return whether it holds (refused out of contact or past the working limit).
+        """
+        return self.hold.set(force, self._force)
 
     def _goal(self, dt: float) -> np.ndarray:
         """Return where the operator's command asks the TCP to be."""
@@ -167,7 +180,8 @@ class Follower:
         return self.config.robot_stiffness * (self._tcp - self._target)
 
     def _learn(self, now: float, tcp_velocity) -> None:
-        estimate = self.estimator.update(now, self._force, self._tcp, tcp_velocity)
+        normal = None if self._surface is None else lambda: self._surface(self._tcp)[1]
+        estimate = self.estimator.update(now, self._force, self._tcp, tcp_velocity, normal)
         if estimate is not None and estimate.stiffness > 0.0:
             self._gains = self._as_commanded(estimate.stiffness, estimate.damping)
             self._plane = RemotePlane(estimate.point, estimate.normal, *self._gains)

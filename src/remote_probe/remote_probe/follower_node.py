@@ -18,6 +18,7 @@ from typing import Sequence
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
+from std_msgs.msg import Empty, Float64
 
 from collision_engine import load_scene
 from haptic_msgs.msg import RobotImpedance
@@ -36,7 +37,7 @@ from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.link_messages import (COMMAND, command_from_fields, command_session, FEEDBACK,
                                         feedback_fields, impedance_report)
 from remote_probe.model_estimation import ContactModelEstimator
-from remote_probe.params import FollowerParams
+from remote_probe.params import envelope, FollowerParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 
 __all__ = ['FollowerNode', 'main', 'take_command']
@@ -59,7 +60,8 @@ class FollowerNode(Node):
                 robot_stiffness=params.robot_stiffness,
                 max_patient_force=params.max_patient_force, force_margin=params.force_margin,
                 link_timeout=params.link_timeout, release_force=params.release_force,
-                retract_speed=params.retract_speed, rejoin_speed=params.rejoin_speed))
+                retract_speed=params.retract_speed, rejoin_speed=params.rejoin_speed,
+                envelope=envelope(params, params.hard_stop_force)))
             self._surface = None
             if params.scene_file:
                 self._surface = surface_projection(load_scene(
@@ -89,6 +91,8 @@ class FollowerNode(Node):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
         self.create_subscription(RobotImpedance, 'robot/impedance', self.on_impedance,
                                  LATCHED_QOS)
+        self.create_subscription(Empty, 'teleop/re_engage', self.on_re_engage, 1)
+        self.create_subscription(Float64, 'teleop/hold', self.on_hold, 1)
         self.create_timer(self._period, self.tick)
         rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == 'model'
                                         else FORCE_FEEDBACK_RATE)
@@ -132,6 +136,24 @@ class FollowerNode(Node):
         else:
             self.follower.limits = report.limits
 
+    def on_re_engage(self, _: Empty) -> None:
+        """Follow again after a hard stop, once the probe has let go (a deliberate act)."""
+        if self._safety.envelope.stopped:
+            following = self._safety.re_engage()
+            self.get_logger().warn('re-engaged: following' if following else
+                                   're-engage refused: the probe still presses')
+
+    def on_hold(self, message: Float64) -> None:
+        """Hold the asked force (N) at the patient while the operator slides; <= 0 releases."""
+        if self.follower is None:
+            return
+        force = message.data if math.isfinite(message.data) else 0.0
+        holding = self.follower.hold_force(force)
+        self.get_logger().info(f'holding {force:g} N' if holding else
+                               'force-hold released' if force <= 0.0 else
+                               f'force-hold of {force:g} N refused: not in contact, or past '
+                               'the working limit')
+
     def on_tcp(self, fields: Sequence) -> None:
         now = self._now()
         position = np.array(fields[3:6], dtype=np.float64)
@@ -170,8 +192,12 @@ class FollowerNode(Node):
                   **{f'refused: {kind}': n for kind, n in self._refused.counts.items()}}
         if self.follower is None:
             return Report(*self._robot_problem, values)
-        holding = self.follower.safety.holding
-        values.update(holding=holding, session=f'{self.follower.admission.session:#x}')
+        holding, stopped = self.follower.safety.holding, self.follower.safety.envelope.stopped
+        values.update(holding=holding, hard_stop=stopped, force_hold=self.follower.hold.force,
+                      session=f'{self.follower.admission.session:#x}')
+        if stopped:
+            return Report(ERROR, 'hard stop: holding and retracting until teleop/re_engage',
+                          values)
         return Report(WARN if holding else OK,
                       'link silent: holding and retracting' if holding else 'following', values)
 

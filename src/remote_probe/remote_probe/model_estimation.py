@@ -9,7 +9,11 @@ own rate: here a plane (point, outward normal) with a linear stiffness and dampi
 From the F/T sensor's force and the TCP's position and velocity while in contact:
 
 - the **normal** is the direction of the measured force (the tissue pushes out), low-passed at
-  ``normal_bandwidth``;
+  ``normal_bandwidth``, from the surface's own normal where this site knows it (a depth camera,
+  the phantom's mesh). Started from the contact's first force instead, at 0.5 N, the sensor's
+  noise tilted the first estimate by 3-8° from the skin's (the scan's lockstep at 250 ms), and
+  the plane the operator felt turned as much in one update: a jolt of up to 1.2 N sideways,
+  scaled;
 - along it, the force is fitted as F = k·s + c·ṡ + b by recursive least squares with
   exponential forgetting, where s is how far the TCP has gone in since the contact began, the
   sum of its steps along the normal of each moment. k and c are the tissue's stiffness and
@@ -121,7 +125,8 @@ class ContactModelEstimator:
         self._last_position = np.zeros(3)
         self._last_time: float | None = None
 
-    def update(self, time: float, force, position, velocity) -> ContactEstimate | None:
+    def update(self, time: float, force, position, velocity,
+               surface_normal=None) -> ContactEstimate | None:
         """Learn from one sample; return the estimate, or None while there is no contact.
 
         Parameters
@@ -131,6 +136,9 @@ class ContactModelEstimator:
             The measured force on the probe.
         position, velocity : (3,) float, m and m/s
             The TCP's.
+        surface_normal : callable or None
+            Returns the surface's outward unit normal (3,) under the TCP, where the normal's
+            filter starts at a contact's first sample; None: from that sample's force.
         """
         time = finite_number(time, 'ContactModelEstimator.update time')
         force = finite_vector(force, 3, 'ContactModelEstimator.update force')
@@ -145,7 +153,8 @@ class ContactModelEstimator:
             self._force = self._motion = None  # the next contact starts afresh from its force
             return None
         if self._force is None:
-            self._force = FirstOrderLowPass(self.config.normal_bandwidth, force)
+            self._force = FirstOrderLowPass(self.config.normal_bandwidth,
+                                            _first_normal(force, surface_normal))
             self._depth, self._last_position = 0.0, position
         average = self._force.update(elapsed, force)
         normal = average / np.linalg.norm(average)
@@ -175,3 +184,15 @@ class ContactModelEstimator:
         surface_depth = -offset / stiffness if stiffness > 0.0 else self._depth
         point = position + (self._depth - surface_depth) * normal
         return ContactEstimate(point, normal, float(stiffness), float(damping))
+
+
+def _first_normal(force: np.ndarray, surface_normal) -> np.ndarray:
+    """Return where the normal's filter starts: the force turned onto the surface's normal.
+
+    The force itself when no normal is known, or when the surface's faces away from it.
+    """
+    if surface_normal is None:
+        return force
+    normal = finite_vector(surface_normal(), 3, 'ContactModelEstimator surface normal')
+    along = float(force @ normal)
+    return normal * along if along > 0.0 else force

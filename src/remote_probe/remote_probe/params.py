@@ -3,11 +3,19 @@ from dataclasses import dataclass
 
 from haptic_util.parameters import parameter
 from remote_probe.admission import AdmissionConfig
+from remote_probe.force_envelope import EnvelopeConfig
 from remote_probe.leader import LeaderConfig
 from remote_probe.safety import SafetyConfig
 from remote_probe.teleop import HAND_SPEED, SCHEMES
 
-__all__ = ['FollowerParams', 'LeaderParams', 'PatientBoundParams', 'SimulatedRobotParams']
+__all__ = ['envelope', 'FollowerParams', 'LeaderParams', 'PatientBoundParams',
+           'SimulatedRobotParams']
+
+
+def envelope(params, hard_stop: float = float('inf')) -> EnvelopeConfig:
+    """Return the force envelope ``params`` (a ``PatientBoundParams``) set, with ``hard_stop``."""
+    return EnvelopeConfig(hard_stop=hard_stop, rise_rate=params.rise_rate,
+                          contact_ramp=params.contact_ramp, contact_force=params.contact_force)
 
 
 @dataclass(frozen=True)
@@ -23,6 +31,13 @@ class PatientBoundParams:
                                      'force', unit='N', low=0.0)
     retract_speed: float = parameter(SafetyConfig.retract_speed, 'retraction speed', unit='m/s',
                                      low=1e-4)
+    rise_rate: float = parameter(EnvelopeConfig.rise_rate, 'in contact, the robot\'s spring '
+                                 'rises at most this fast', unit='N/s', low=1e-3)
+    contact_ramp: float = parameter(EnvelopeConfig.contact_ramp, 'after the first touch, the '
+                                    'spring stays under a ramp to the limit this long (0: none)',
+                                    unit='s', low=0.0)
+    contact_force: float = parameter(EnvelopeConfig.contact_force, 'a measured force above this '
+                                     'is contact (for the rate and the ramp)', unit='N', low=0.0)
 
 
 @dataclass(frozen=True)
@@ -75,6 +90,9 @@ class FollowerParams(PatientBoundParams):
     rejoin_speed: float = parameter(SafetyConfig.rejoin_speed, 'once commands come again, the '
                                     'target goes back to the operator\'s this fast', unit='m/s',
                                     low=1e-4)
+    hard_stop_force: float = parameter(EnvelopeConfig.hard_stop, 'a measured force this high '
+                                       'holds and retracts the robot until teleop/re_engage',
+                                       unit='N', low=0.1)
     drift_rate: float = parameter(2.0, 'tdpa: drift compensation rate', unit='1/s', low=0.0)
     sensor_timeout: float = parameter(0.05, 'no F/T wrench or TCP pose for this long: no force '
                                       'is fed back', unit='s', low=0.001)

@@ -37,7 +37,7 @@ from remote_probe._checks import finite_floats, nonzero_floats
 from remote_probe.ft_sensor import ForceTorqueSensor, ForceTorqueSensorConfig
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
 from remote_probe.link_messages import impedance_message
-from remote_probe.params import SimulatedRobotParams
+from remote_probe.params import envelope, SimulatedRobotParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.tissue import HuntCrossley, SceneSurface, Tissue
 
@@ -70,7 +70,8 @@ class SimulatedRobotNode(Node):
             self.guard = PatientSafety(SafetyConfig(
                 robot_stiffness=params.stiffness, max_patient_force=params.max_patient_force,
                 force_margin=params.force_margin, link_timeout=params.target_timeout,
-                release_force=params.release_force, retract_speed=params.retract_speed))
+                release_force=params.release_force, retract_speed=params.retract_speed,
+                envelope=envelope(params)))
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self._start = time.monotonic()

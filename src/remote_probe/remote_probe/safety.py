@@ -22,6 +22,9 @@ that protect the patient must hold at the robot's side, on its own measurements,
 - **Rejoining.** When messages come again, the target goes from where the robot held to the
   operator's at ``rejoin_speed``, not in one step: the robot and the operator meet again without
   a jump, however far apart the silence left them.
+- **The clinical envelope** (``remote_probe.force_envelope``): in contact the spring rises at a
+  bounded rate and under a ramp after the first touch; a measured force at the hard stop holds
+  and retracts the robot as a silence does, until the operator re-engages (``re_engage``).
 """
 
 from dataclasses import dataclass
@@ -30,6 +33,7 @@ import math
 import numpy as np
 
 from remote_probe._checks import finite_number, finite_vector
+from remote_probe.force_envelope import EnvelopeConfig, ForceEnvelope, toward_within
 
 __all__ = ['LinkWatchdog', 'PatientSafety', 'SafetyConfig', 'within_force_bound']
 
@@ -54,6 +58,8 @@ class SafetyConfig:
     retract_speed : float, m/s
     rejoin_speed : float, m/s
         How fast the target goes back to the operator's once the link is heard again.
+    envelope : EnvelopeConfig
+        The hard stop, the rate of rise and the ramp at first contact.
     """
 
     robot_stiffness: float
@@ -63,6 +69,7 @@ class SafetyConfig:
     release_force: float = 1.0
     retract_speed: float = 0.02
     rejoin_speed: float = 0.05
+    envelope: EnvelopeConfig = EnvelopeConfig()
 
     def __post_init__(self):
         for name in ('robot_stiffness', 'max_patient_force', 'link_timeout', 'retract_speed',
@@ -124,11 +131,22 @@ class PatientSafety:
         self._hold: np.ndarray | None = None  # the held target while the link is silent
         self._rejoin: np.ndarray | None = None  # the target on its way back to the operator's
         self._last_tick: float | None = None
+        self.envelope = ForceEnvelope(config.envelope,
+                                      config.max_patient_force - config.force_margin)
+        self._measured = math.inf  # [N] the last force measured
+        self._target: np.ndarray | None = None  # the last target commanded
 
     @property
     def holding(self) -> bool:
-        """True while the robot holds (and retracts) because the link is silent."""
+        """True while the robot holds (and retracts): the link is silent, or it stopped."""
         return self._hold is not None
+
+    def re_engage(self) -> bool:
+        """Follow the operator again after a hard stop, once the probe has let go.
+
+        Return whether it follows (False while the measured force is above the contact's).
+        """
+        return self.envelope.re_engage(self._measured)
 
     def heard(self, time: float) -> None:
         """Note a message from the operator received at ``time`` s."""
@@ -153,17 +171,27 @@ class PatientSafety:
         measured_force = finite_vector(measured_force, 3, 'PatientSafety.safe_target force')
         elapsed = 0.0 if self._last_tick is None else max(now - self._last_tick, 0.0)
         self._last_tick = now
-        if self.watchdog.silent(now):
+        self._measured = float(np.linalg.norm(measured_force))
+        stopped = self.envelope.trip(self._measured)
+        if stopped or self.watchdog.silent(now):
             self._hold = tcp if self._hold is None else self._hold
             self._hold = target = self._retracted(self._hold, measured_force, elapsed)
-            if self.watchdog.heard_any:  # a silence after following, not the start
+            if self.watchdog.heard_any or stopped:  # not the start: rejoin from here
                 self._rejoin = self._hold
         else:
             self._hold = None
             if self._rejoin is not None:
-                self._rejoin = _toward(self._rejoin, target, self.config.rejoin_speed * elapsed)
+                # From the target last commanded: the envelope may have held it short.
+                self._rejoin = _toward(self._target if self._target is not None
+                                       else self._rejoin, target,
+                                       self.config.rejoin_speed * elapsed)
                 target = target if self._rejoin is None else self._rejoin
-        return within_force_bound(target, tcp, self.config.spring_reach)
+        target = within_force_bound(target, tcp, self.config.spring_reach)
+        reach = self.envelope.allowed(now, elapsed, self._measured) / self.config.robot_stiffness
+        previous = tcp if self._target is None else self._target
+        self._target = target = toward_within(previous, target, tcp, reach)
+        self.envelope.commanded(self.config.robot_stiffness * float(np.linalg.norm(target - tcp)))
+        return target
 
     def _retracted(self, hold: np.ndarray, measured_force: np.ndarray,
                    elapsed: float) -> np.ndarray:

@@ -1,0 +1,144 @@
+"""Easing a new contact model into the hand: no step, and still no more energy than was put in.
+
+Why: a model-mediated link sends a new estimate of the contact every few milliseconds. Each one
+moves the plane or changes its stiffness a little, and rendered at once the felt force steps by
+what the estimate moved since the last one came (in the telerobotic scan at 250 ms one way, 2.8 N
+in one tick, scaled to the patient, where the patient's force changed by 0.02 N). A sonographer
+reads tissue by differences of a few tenths of a newton: a step the patient's force did not make
+is a jolt.
+
+So a new model's planes start as stiff and as damped as the planes rendered the period before
+(their stiffnesses scaled by one factor, their dampings by another) and shifted along their
+normals to where they push (their springs, the sum of k·depth over the planes behind) what those
+pushed: the force and the stored energy go on from where they were. The factors and the shift
+then ease toward the model as it is, each at most ``rate`` N/s of spring push (the damping's
+factor by the push's share of the step, from zero when the planes before had none), and the
+hand's own motion is felt at once, as before. The damping matters at a lift-off: the estimate's
+damping moves between updates (from nothing to some), and on a hand moving at 3 cm/s that
+stepped the felt force by 0.09 N (scaled) in a tick. Scaling the stiffness matters too: an
+estimate that turns softer at the same push stores more
+energy than the port absorbed, and the bound below would cut the force at once (in the scan at
+250 ms, 0.5 N in a tick at the first contact). A model that comes after nothing was rendered (a
+first contact, a lapse) starts from zero push, a ramp.
+
+Passive: the switch itself stores what the planes before stored (the same push on the same
+stiffness), and each period's easing may raise the stored energy only up to what the port has
+absorbed in this contact (``port_passivity.bounded_shift``, here also inward of the model when
+the new estimate pushes less than the old one did), as passive set-position modulation does (Lee
+and Huang, IEEE T-RO 2010); beyond, the shift holds. The hand's own motion into the planes is
+not bounded again: that is the spring it feels.
+
+``springs`` are each plane's (depth of its tool point behind it, stiffness along its normal), m and
+N/m (``ContactModel.springs``); a shift is m, outward along the normals. ``servo_loop`` computes
+the same floats, compiled.
+"""
+import dataclasses
+
+from haptic_wand_driver.contact_model import ContactModel
+from haptic_wand_driver.port_passivity import bounded_shift
+
+__all__ = ['eased_level', 'eased_scale', 'eased_shift', 'least_shift', 'matched_shift',
+           'scaled_model', 'spring_push', 'stored_energy', 'total_damping', 'total_stiffness']
+
+
+def total_stiffness(springs) -> float:
+    """Return the sum of the planes' stiffnesses along their normals (N/m), in plane order."""
+    total = 0.0
+    for _, k in springs:
+        if k > 0.0:
+            total += k
+    return total
+
+
+def spring_push(springs, shift: float) -> float:
+    """Return the planes' spring push (N) with the planes moved out by ``shift``."""
+    push = 0.0
+    for depth, stiffness in springs:
+        if depth - shift > 0.0:
+            push += stiffness * (depth - shift)
+    return push
+
+
+def total_damping(model: ContactModel) -> float:
+    """Return the sum of the planes' dampings along their normals (N·s/m), in plane order."""
+    total = 0.0
+    for plane in model.planes:
+        n, c = plane.normal, plane.damping
+        along = c[0] * n[0] * n[0] + c[1] * n[1] * n[1] + c[2] * n[2] * n[2]
+        if along > 0.0:
+            total += along
+    return total
+
+
+def stored_energy(springs, shift: float) -> float:
+    """Return the energy (J) the planes' springs store, moved out by ``shift``."""
+    energy = 0.0
+    for depth, stiffness in springs:
+        if depth - shift > 0.0:
+            energy += 0.5 * stiffness * (depth - shift) * (depth - shift)
+    return energy
+
+
+def matched_shift(springs, push: float) -> float:
+    """Return the shift at which the planes' springs push ``push`` (N).
+
+    Negative when they push less than that as they are. With nothing to match (zero push), the
+    planes are moved just onto the tool (not inward of the model).
+    """
+    behind = sorted(((d, k) for d, k in springs if k > 0.0), reverse=True)
+    a = b = 0.0
+    for m, (depth, stiffness) in enumerate(behind):
+        a += stiffness
+        b += stiffness * depth
+        shift = (b - push) / a
+        if m + 1 == len(behind) or shift >= behind[m + 1][0]:
+            return shift if push > 0.0 else max(shift, 0.0)
+    return 0.0
+
+
+def least_shift(springs, energy: float, lowest: float) -> float:
+    """Return the least shift, from ``lowest`` on, at which the planes store at most ``energy``."""
+    return bounded_shift([(d - lowest, k) for d, k in springs], energy) + lowest
+
+
+def eased_shift(springs, shift: float, push_step: float) -> float:
+    """Return ``shift`` moved toward zero by what changes the springs' push by ``push_step``."""
+    stiffness = total_stiffness(springs)
+    if stiffness == 0.0:
+        return 0.0
+    step = push_step / stiffness
+    return max(shift - step, 0.0) if shift > 0.0 else min(shift + step, 0.0)
+
+
+def eased_scale(scale: float, push_step: float, push: float) -> float:
+    """Return the stiffness factor ``scale`` moved toward 1, changing ``push`` by ``push_step``.
+
+    1 at once when nothing pushes.
+    """
+    if push <= 0.0:
+        return 1.0
+    step = push_step * scale / push
+    return min(scale + step, 1.0) if scale < 1.0 else max(scale - step, 1.0)
+
+
+def eased_level(level: float, push_step: float, push: float) -> float:
+    """Return the damping factor ``level`` moved toward 1 by ``push_step`` / ``push``.
+
+    A force ``damping × speed`` no larger than the push then changes by ``push_step`` at most; 1
+    at once when nothing pushes.
+    """
+    if push <= 0.0:
+        return 1.0
+    step = push_step / push
+    return min(level + step, 1.0) if level < 1.0 else max(level - step, 1.0)
+
+
+def scaled_model(model: ContactModel, scale: float, damping_scale: float) -> ContactModel:
+    """Return ``model`` with its planes' stiffnesses times ``scale``, dampings times the other."""
+    if scale == 1.0 and damping_scale == 1.0:
+        return model
+    return dataclasses.replace(model, planes=tuple(plane._replace(
+        stiffness=(plane.stiffness[0] * scale, plane.stiffness[1] * scale,
+                   plane.stiffness[2] * scale),
+        damping=(plane.damping[0] * damping_scale, plane.damping[1] * damping_scale,
+                 plane.damping[2] * damping_scale)) for plane in model.planes))
