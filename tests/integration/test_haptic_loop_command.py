@@ -9,6 +9,7 @@ import time
 
 from domains import session_domain_id
 import pytest
+from test_teleop import wait_for_the_first_pose
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.recorder import custom_definitions
@@ -38,14 +39,18 @@ def test_a_ctrl_c_stops_the_command_cleanly_and_the_bag_holds_everything_publish
         tmp_path, flags, layout, processes):
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     output = tmp_path / 'output.txt'
+    domain = session_domain_id()
     with output.open('w') as out:
         command = subprocess.Popen(
             [sys.executable, '-m', 'haptic_bringup.launcher', *flags, '--experiment', 'cuboid',
              '--record', str(tmp_path / 'bag'), '--run-dir', str(tmp_path / 'launch'),
-             '--domain-id', str(session_domain_id())],
+             '--domain-id', str(domain)],
             env=env, stdout=out, stderr=subprocess.STDOUT, text=True, start_new_session=True)
         try:
             assert closed(output, command), output.read_text()[-3000:]
+            # The loop closes at discovery; the wand moves once its recorder is ready, which on a
+            # busy machine came more than RUNNING later (a CI run recorded no pose at all).
+            wait_for_the_first_pose(domain, START_TIMEOUT)
             time.sleep(RUNNING)
             interrupted = time.time()
             os.killpg(command.pid, signal.SIGINT)
