@@ -24,6 +24,7 @@ from collision_engine.probe import query_probe
 from force_renderer.contact import Contact
 from force_renderer.node import _face
 from force_renderer.probe import ProbeSpringDamper
+from haptic_contract.collision_state import contact_fields
 
 __all__ = ['main', 'run']
 
@@ -69,9 +70,9 @@ def run(poses: int = 2000) -> list[dict]:
 
         def force(data):
             fields = STATE.decode(data)
-            contact = Contact.from_floats(fields[5], tuple(fields[7:10]), tuple(fields[10:13]),
-                                          tuple(fields[16:19]), fields[3], 0.0, fields[4],
-                                          _face(fields))
+            _, name, status, distance, point, normal, tip = contact_fields(fields)
+            contact = Contact.from_floats(distance, tuple(point), tuple(normal), tuple(tip), name,
+                                          0.0, status, _face(fields))
             law.force(contact, (0.0, 0.0, 0.0))
             law.torque(contact)
             law.planes(contact)

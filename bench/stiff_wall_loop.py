@@ -33,8 +33,8 @@ from haptic_bringup.contacts import contact_intervals
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import applied_work, read_session
+from haptic_contract.contact_model import ContactModel, Kind, Plane
 from haptic_util.paths import package_file
-from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
 from haptic_wand_driver.device import DeviceLimits
 from haptic_wand_driver.experiments import make_script, surface_projection
 from haptic_wand_driver.local_rendering import LocalRenderer

@@ -24,9 +24,10 @@ import result_files
 import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD, SCAN_DURATION
+from haptic_contract.contact_model import ContactModel, Kind, Plane
+from haptic_contract.teleop import CommandLimits, HAND_SPEED
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
-from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
 from haptic_wand_driver.device import DeviceLimits
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import OperatorHand
@@ -42,7 +43,6 @@ from remote_probe.link import EmulatedLink, LinkConfig
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
-from remote_probe.teleop import CommandLimits, HAND_SPEED
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
 __all__ = ['as_series', 'late_ticks', 'scan', 'SCHEMES']

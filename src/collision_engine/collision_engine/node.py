@@ -22,6 +22,7 @@ from collision_engine.conversions import (invalid_state, InvalidPose, POSE, STAT
 from collision_engine.markers import contact_markers, scene_markers
 from collision_engine.params import CollisionNodeParams
 from collision_engine.probe import query_probe
+from haptic_contract.streams import header as stamped_header
 from haptic_msgs.msg import CollisionStateArray
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
@@ -67,7 +68,7 @@ class CollisionNode(Node):
             self.create_timer(1.0 / self.params.marker_rate, self.publish_markers)
 
     def on_pose(self, pose: Sequence) -> None:
-        header = (pose[0], pose[1], pose[2])
+        header = stamped_header(pose)
         disagreements = self.scene.cross_validation_disagreements
         try:
             tip, orientation = tip_pose(pose, self.scene.frame_id)

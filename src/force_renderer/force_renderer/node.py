@@ -12,13 +12,13 @@ leaf values within one process.
 """
 from typing import Sequence
 
-from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
+from geometry_msgs.msg import Point
 import numpy as np
 from rclpy.node import Node
 from visualization_msgs.msg import Marker
 
 from force_renderer.contact import Contact, FaceContact
-from force_renderer.local_model import local_model, MAX_PLANES
+from force_renderer.local_model import local_model
 from force_renderer.materials import PerObjectLaw
 from force_renderer.params import ForceRendererParams
 from force_renderer.passivity import passivity_warning
@@ -27,8 +27,10 @@ from force_renderer.probe import ProbeSpringDamper
 from force_renderer.proxy import GodObjectProxy
 from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
-from haptic_msgs.msg import CollisionState, ContactModel
-from haptic_util.cdr import MessageCodec
+from haptic_contract.collision_state import contact_fields, face_fields, STATE, \
+    STATUS_NOT_CONVERGED
+from haptic_contract.contact_model import MODEL, model_fields
+from haptic_contract.streams import stamp_ns, TWIST, TWIST_LINEAR, WRENCH
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
@@ -40,14 +42,7 @@ from haptic_util.tally import Tally
 
 __all__ = ['ForceNode', 'main']
 
-MODEL = MessageCodec(ContactModel)
-PLANE_FIELDS = 15  # leaves of a ContactPlane
-STATE = MessageCodec(CollisionState)
-TWIST = MessageCodec(TwistStamped)
-WRENCH = MessageCodec(WrenchStamped)
 _ZERO = (0.0, 0.0, 0.0)
-_ORIENTATION = STATE.fields.index('orientation.x')
-_FACE = STATE.fields.index('contact_distance')  # then the points and the normals
 
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -133,23 +128,21 @@ class ForceNode(Node):
         return PerObjectLaw(laws, SpringDamper(*default)), gains
 
     def on_twist(self, fields: Sequence) -> None:
-        sec, nanosec, _, vx, vy, vz, _, _, _ = fields
-        self._twist = (sec * 1_000_000_000 + nanosec, (vx, vy, vz))
+        self._twist = (stamp_ns(fields), tuple(fields[TWIST_LINEAR]))
 
     def on_state(self, fields: Sequence) -> None:
-        (sec, nanosec, frame, name, status, distance, _, px, py, pz, nx, ny, nz, _, _, _,
-         tx, ty, tz) = fields[:19]
-        stamp_ns = sec * 1_000_000_000 + nanosec
-        self._approximate += status == CollisionState.STATUS_NOT_CONVERGED
-        self._contact = Contact.from_floats(distance, (px, py, pz), (nx, ny, nz), (tx, ty, tz),
-                                            name, stamp_ns * 1e-9, status, _face(fields))
-        self._header = (sec, nanosec, frame)
-        self.render(self._velocity(stamp_ns))
+        header, name, status, distance, point, normal, tip = contact_fields(fields)
+        stamp = stamp_ns(fields)
+        self._approximate += status == STATUS_NOT_CONVERGED
+        self._contact = Contact.from_floats(distance, point, normal, tip, name, stamp * 1e-9,
+                                            status, _face(fields))
+        self._header = header
+        self.render(self._velocity(stamp))
 
-    def _velocity(self, stamp_ns: int):
-        """Return the twist of the state's pose, or None (the pipeline then estimates it)."""
+    def _velocity(self, stamp: int):
+        """Return the twist of the pose stamped ``stamp`` (ns), or None (then it is estimated)."""
         twist = self._twist
-        if twist is None or abs(twist[0] - stamp_ns) > self.params.watchdog_timeout * 1e9:
+        if twist is None or abs(twist[0] - stamp) > self.params.watchdog_timeout * 1e9:
             return None
         return twist[1]
 
@@ -171,14 +164,10 @@ class ForceNode(Node):
 
     def _model_fields(self, model) -> tuple:
         """Return the leaf fields of the ContactModel of ``model`` and the current contact."""
-        planes = [value for plane in model.planes
-                  for value in (*plane[0], *plane[1], *plane[2], *plane[3],
-                                *(plane[4] if len(plane) > 4 else _ZERO))]
-        planes += [0.0] * (PLANE_FIELDS * MAX_PLANES - len(planes))
-        tip = self._contact.tip.tolist()
-        return (*self._header, self._contact.object, model.kind, len(model.planes), *planes,
-                self.params.force_limit, self.params.model_lifetime, model.valid_radius, *tip,
-                *self._force, *self._torque)
+        return model_fields(self._header, self._contact.object, model.kind, model.planes,
+                            self.params.force_limit, self.params.model_lifetime,
+                            model.valid_radius, self._contact.tip.tolist(),
+                            (*self._force, *self._torque))
 
     def check_stale(self) -> None:
         """Publish zero force while the collision state is stale (after the first one)."""
@@ -227,14 +216,13 @@ class ForceNode(Node):
 
 def _face(fields: list) -> FaceContact | None:
     """Return the tool's face from a CollisionState's leaves, or None when it has no tool."""
-    distance, points, normals = fields[_FACE:_FACE + 3]
+    distance, points, normals, orientation = face_fields(fields)
     if not distance:
         return None
     from collision_engine.probe import rotation_matrix
 
     return FaceContact(np.array(distance), np.array(points).reshape(-1, 3),
-                       np.array(normals).reshape(-1, 3),
-                       rotation_matrix(fields[_ORIENTATION:_ORIENTATION + 4]))
+                       np.array(normals).reshape(-1, 3), rotation_matrix(orientation))
 
 
 def main(args=None) -> int:

@@ -12,13 +12,13 @@ import pathlib
 import time
 from typing import Sequence
 
-from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
-from haptic_msgs.msg import ContactModel as ContactModelMessage
-from haptic_util.cdr import MessageCodec
+from haptic_contract.contact_model import ContactModel, Kind, MODEL, ModelRefused
+from haptic_contract.streams import frame, POSE, stamp_ns, TWIST, WRENCH, WRENCH_FORCE, \
+    WRENCH_TORQUE
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
@@ -28,7 +28,6 @@ from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.answer_deadline import AnswerDeadline
-from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
 from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
 from haptic_wand_driver.experiments import make_script, needs_scene, surface_projection
 from haptic_wand_driver.local_rendering import LocalRenderer
@@ -40,11 +39,6 @@ from haptic_wand_driver.simulated import SimulatedWandConfig
 from haptic_wand_driver.wrench_input import Refusal, WrenchCommand
 
 __all__ = ['WandDriverNode', 'main']
-
-MODEL = MessageCodec(ContactModelMessage)
-POSE = MessageCodec(PoseStamped)
-TWIST = MessageCodec(TwistStamped)
-WRENCH = MessageCodec(WrenchStamped)
 
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 IN_FLIGHT_GRACE = 0.05  # [s] after the last pose, for its answer to arrive
@@ -246,23 +240,23 @@ class WandDriverNode(Node):
     def on_wrench(self, wrench: Sequence) -> None:
         """Apply a wrench (remote rendering): held, kept passive, until its deadline."""
         now_ns = clock_ns(self.get_clock())
-        stamp_ns = wrench[0] * 1_000_000_000 + wrench[1]
-        if not self._answered(stamp_ns, now_ns):
+        stamp = stamp_ns(wrench)
+        if not self._answered(stamp, now_ns):
             return
         now = now_ns * 1e-9
         state = self._state = self.device.read(self._device_time())  # acts from now on
-        refusal = self._take(wrench, stamp_ns * 1e-9, now)
+        refusal = self._take(wrench, stamp * 1e-9, now)
         if refusal is not None:
             self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
         else:
-            self.answers.taken(stamp_ns * 1e-9, self.params.wrench_timeout)
+            self.answers.taken(stamp * 1e-9, self.params.wrench_timeout)
         self._apply(now, state)
 
     def on_model(self, fields: Sequence) -> None:
         """Hand a contact model to the device's renderer; a bad one gives zero force."""
         now_ns = clock_ns(self.get_clock())
-        stamp_ns = fields[0] * 1_000_000_000 + fields[1]
-        if not self._answered(stamp_ns, now_ns):
+        stamp = stamp_ns(fields)
+        if not self._answered(stamp, now_ns):
             return
         try:
             model = ContactModel.from_fields(fields, self.params.frame_id)
@@ -276,7 +270,7 @@ class WandDriverNode(Node):
         self._model_stamp = model.stamp
         since = self._arrival()
         # From the nanoseconds, as the pose's was: seconds plus nanoseconds round otherwise.
-        self.answers.taken(stamp_ns * 1e-9, model.valid_for)
+        self.answers.taken(stamp * 1e-9, model.valid_for)
         deadline = self.answers.deadline - self._ros_minus_device()
         if model.kind == Kind.UNAVAILABLE:
             self.renderer.take_wrench(model.held_wrench[:3], model.held_wrench[3:], deadline,
@@ -331,12 +325,11 @@ class WandDriverNode(Node):
 
     def _take(self, wrench: list, stamp: float, now: float) -> Refusal | None:
         """Hand a received wrench (``WRENCH`` leaves) to the command; return why it was refused."""
-        frame = wrench[2]
-        if frame != self.params.frame_id:
+        if frame(wrench) != self.params.frame_id:
             self.wrench.clear()
             return Refusal('wrench in an unknown frame', f'wrench ignored and force zeroed: '
-                           f'frame_id {frame!r} is not {self.params.frame_id!r}')
-        return self.wrench.update(wrench[3:6], wrench[6:9], stamp, now)
+                           f'frame_id {frame(wrench)!r} is not {self.params.frame_id!r}')
+        return self.wrench.update(wrench[WRENCH_FORCE], wrench[WRENCH_TORQUE], stamp, now)
 
     def on_recorder_ready(self, msg: Bool) -> None:
         self._recorder_ready = msg.data

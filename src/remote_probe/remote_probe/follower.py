@@ -38,13 +38,13 @@ from typing import Callable
 
 import numpy as np
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
+from haptic_contract.teleop import (Command, command_refusal, CommandLimits, Feedback, new_session,
+                                    RemotePlane, SCHEMES)
 from remote_probe.admission import Admission, Refusal
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.safety import PatientSafety
 from remote_probe.tdpa import RobotPassivity
-from remote_probe.teleop import (Command, command_refusal, CommandLimits, Feedback, new_session,
-                                 RemotePlane, SCHEMES)
 
 __all__ = ['Follower', 'FollowerConfig']
 

@@ -45,12 +45,12 @@ import math
 
 import numpy as np
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
+from haptic_contract.teleop import (Command, Feedback, feedback_refusal, new_session, RemotePlane,
+                                    SCHEMES)
 from remote_probe.admission import Admission, Refusal
 from remote_probe.link import RoundTripEstimator
 from remote_probe.tdpa import OperatorPassivity
-from remote_probe.teleop import Command, Feedback, feedback_refusal, new_session, RemotePlane, \
-    SCHEMES
 from remote_probe.virtual_coupling import CouplingConfig, VirtualCoupling
 from remote_probe.workspace_map import WorkspaceMap
 

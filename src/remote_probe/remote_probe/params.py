@@ -1,11 +1,11 @@
 """The ROS parameters of the telerobotic nodes, in one place (see config/*.yaml)."""
 from dataclasses import dataclass
 
+from haptic_contract.teleop import HAND_SPEED, SCHEMES
 from haptic_util.parameters import parameter
 from remote_probe.admission import AdmissionConfig
 from remote_probe.leader import LeaderConfig
 from remote_probe.safety import SafetyConfig
-from remote_probe.teleop import HAND_SPEED, SCHEMES
 
 __all__ = ['FollowerParams', 'LeaderParams', 'PatientBoundParams', 'SimulatedRobotParams']
 
