@@ -6,7 +6,7 @@ driver's tick. This is the same arithmetic in the same order, compiled: the Pyth
 (``SimulatedWand`` with any other law, which calls ``LocalRenderer.wrench``) is its reference,
 and the tests hold the two to the same trajectory, force and energy books.
 
-Its kernels go through the project's one numba decorator (``collision_engine._jit.jit``). The
+Its kernels go through the project's one numba decorator (``haptic_util.jit``). The
 module is self-contained (numba caches a kernel by its own file, so a kernel here must not call
 one elsewhere): ``_saturate`` and ``_plane_force`` repeat ``haptic_contract.plane_law``'s
 ``saturate_components`` and ``unilateral_spring_damper``, the references their tests hold them
@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from collision_engine._jit import jit
+from haptic_util.jit import jit
 from haptic_wand_driver.local_rendering import (DEADLINE, LAW_SIZE, MODE_PLANES, MODE_WRENCH,
                                                 PLANE_SIZE, PLANES_AT, SERIAL, SINCE)
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
