@@ -27,9 +27,11 @@ from force_renderer.probe import ProbeSpringDamper
 from force_renderer.proxy import GodObjectProxy
 from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
-from haptic_contract.collision_state import contact_fields, face_fields, STATE, \
-    STATUS_NOT_CONVERGED
+from haptic_contract.collision_state import (contact_fields, face_fields, STATE,
+                                             STATUS_NOT_CONVERGED)
 from haptic_contract.contact_model import MODEL, model_fields
+from haptic_contract.graph import (COLLISION_STATE, WAND_CONTACT_MODEL, WAND_FORCE_MARKER,
+                                   WAND_TWIST, WAND_WRENCH)
 from haptic_contract.streams import stamp_ns, TWIST, TWIST_LINEAR, WRENCH
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
@@ -75,17 +77,17 @@ class ForceNode(Node):
         self._refused = Tally()  # input that was no message of its type
         self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
         self._force = self._torque = _ZERO
-        self._wrench_pub = stream_publisher(self, WRENCH, 'wand/wrench')
-        self._model_pub = stream_publisher(self, MODEL, 'wand/contact_model')
-        stream_subscription(self, STATE, 'collision/state', self.on_state,
+        self._wrench_pub = stream_publisher(self, WRENCH, WAND_WRENCH)
+        self._model_pub = stream_publisher(self, MODEL, WAND_CONTACT_MODEL)
+        stream_subscription(self, STATE, COLLISION_STATE, self.on_state,
                             refused=self._refused)
         uses_damping = any(max(damping) > 0.0 for _, damping in gains)
         if uses_damping and params.velocity_source == 'twist':
-            stream_subscription(self, TWIST, 'wand/twist', self.on_twist, refused=self._refused)
+            stream_subscription(self, TWIST, WAND_TWIST, self.on_twist, refused=self._refused)
         self.create_timer(params.watchdog_timeout / 2, self.check_stale)
         self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
         if params.marker_rate > 0:
-            self._marker_pub = self.create_publisher(Marker, 'wand/force_marker', MARKER_QOS)
+            self._marker_pub = self.create_publisher(Marker, WAND_FORCE_MARKER, MARKER_QOS)
             self.create_timer(1.0 / params.marker_rate, self.publish_marker)
         passivity = 'on' if params.passivity else 'off'
         self.get_logger().info(f'{params.law} law, passivity {passivity}, '

@@ -33,9 +33,10 @@ from typing import Optional
 import yaml
 
 from haptic_bringup.launcher import (link_parameters, Loop, loop_environment, LoopConfig,
-                                     node_parameters, site_nodes, teleop_endpoints, TO_OPERATOR,
-                                     TO_REMOTE)
+                                     node_parameters, site_nodes, teleop_endpoints)
 from haptic_bringup.processes import start_child
+from haptic_contract.graph import TO_OPERATOR, TO_REMOTE
+from haptic_contract.teleop import Scheme, SCHEMES
 from site_gateway.certs import init_ca, issue
 
 __all__ = ['GATEWAY_MODULE', 'SiteConfig', 'Site', 'gateway_argv', 'gateway_parameters',
@@ -163,7 +164,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument('--certs', metavar='DIR', help="this site's files from haptic_certs")
     parser.add_argument('--insecure', action='store_true',
                         help='plaintext tcp/ endpoints, no certificates (warned at every start)')
-    parser.add_argument('--scheme', choices=('direct', 'tdpa', 'model'), default='model',
+    parser.add_argument('--scheme', choices=SCHEMES, default=Scheme.MODEL.value,
                         help='bilateral scheme, the same on both sites (default: model)')
     parser.add_argument('--experiment', help="operator: the operator's script (default: the "
                         'scripted scan)')

@@ -9,6 +9,7 @@ uses it: finite, and within what the physics allows. A number far outside that i
 operator or a hard press but a broken or hostile peer, and one absurd value (a speed of 1e308
 m/s) used once poisons every energy book after it.
 """
+import enum
 import math
 import secrets
 from typing import NamedTuple
@@ -16,12 +17,23 @@ from typing import NamedTuple
 import numpy as np
 
 __all__ = ['Command', 'CommandLimits', 'Feedback', 'HAND_SPEED', 'Refusal', 'RemotePlane',
-           'SCHEMES', 'command_refusal', 'feedback_refusal', 'new_session']
+           'SCHEMES', 'Scheme', 'command_refusal', 'feedback_refusal', 'new_session']
 
-SCHEMES = ('direct', 'tdpa', 'model')
-"""The bilateral schemes: direct force reflection (the baseline), time-domain passivity on both
-ports (Artigas et al. 2011), and model-mediated teleoperation (the device renders the remote
-site's estimate of the contact)."""
+
+class Scheme(enum.StrEnum):
+    """The bilateral schemes, by the names a parameter and the command line give them.
+
+    Direct force reflection (the baseline), time-domain passivity on both ports (Artigas et al.
+    2011), and model-mediated teleoperation (the device renders the remote site's estimate of
+    the contact).
+    """
+
+    DIRECT = 'direct'
+    TDPA = 'tdpa'
+    MODEL = 'model'
+
+
+SCHEMES = tuple(scheme.value for scheme in Scheme)  # the names, as plain strings
 
 HAND_SPEED = 5.0  # [m/s] no hand moves a wand faster (fast jabs reach 1-2 m/s)
 MAX_FEEDBACK_FORCE = 500.0  # [N] beyond the range of any F/T sensor that holds a probe

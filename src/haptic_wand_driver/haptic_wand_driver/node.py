@@ -17,8 +17,10 @@ from rclpy.node import Node
 from std_msgs.msg import Bool
 
 from haptic_contract.contact_model import ContactModel, Kind, MODEL, ModelRefused
-from haptic_contract.streams import frame, POSE, stamp_ns, TWIST, WRENCH, WRENCH_FORCE, \
-    WRENCH_TORQUE
+from haptic_contract.graph import (WAND_APPLIED_WRENCH, WAND_CONTACT_MODEL, WAND_POSE, WAND_TWIST,
+                                   WAND_WRENCH)
+from haptic_contract.streams import (frame, POSE, stamp_ns, TWIST, WRENCH, WRENCH_FORCE,
+                                     WRENCH_TORQUE)
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
@@ -89,15 +91,15 @@ class WandDriverNode(Node):
         self._refused = Tally()  # wrenches not taken, by fault
         self._reported = (time.monotonic(), 0, 0)  # when, poses and answers at the last report
         self._recorder_ready = False
-        self._pose_pub = stream_publisher(self, POSE, 'wand/pose')
-        self._twist_pub = stream_publisher(self, TWIST, 'wand/twist')
-        self._applied_pub = stream_publisher(self, WRENCH, 'wand/applied_wrench')
+        self._pose_pub = stream_publisher(self, POSE, WAND_POSE)
+        self._twist_pub = stream_publisher(self, TWIST, WAND_TWIST)
+        self._applied_pub = stream_publisher(self, WRENCH, WAND_APPLIED_WRENCH)
         # One answer per pose: the model when the device renders it (a model carries the wrench
         # of a law that has none), else the wrench. A stream it does not use costs a core's
         # percent or more at 1 kHz, for the publisher and for this node.
-        answers = ((MODEL, 'wand/contact_model', self.on_model)
+        answers = ((MODEL, WAND_CONTACT_MODEL, self.on_model)
                    if self.renderer is not None else
-                   (WRENCH, 'wand/wrench', self.on_wrench))
+                   (WRENCH, WAND_WRENCH, self.on_wrench))
         self._answer_sub = stream_subscription(self, *answers, refused=self._refused)
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)

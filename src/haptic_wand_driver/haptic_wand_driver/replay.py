@@ -15,13 +15,14 @@ from pathlib import Path
 import numpy as np
 
 from haptic_contract.checks import finite_number
+from haptic_contract.graph import absolute, WAND_POSE
 from haptic_contract.wand import PitchError, roll_yaw_from_quaternion
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState, Workspace
 from haptic_wand_driver.pose_table import PoseFileError, PoseTable, read_pose_csv
 
 __all__ = ['DEFAULT_POSE_TOPIC', 'ReplayDevice', 'ReplayError', 'read_bag_poses']
 
-DEFAULT_POSE_TOPIC = '/wand/pose'
+DEFAULT_POSE_TOPIC = absolute(WAND_POSE)
 _POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
 _BAG_FILE_SUFFIXES = ('.mcap', '.db3')
 

@@ -19,7 +19,10 @@ import numpy as np
 from rclpy.node import Node
 
 from collision_engine import load_scene
+from haptic_contract.graph import (ROBOT_FT_WRENCH, ROBOT_IMPEDANCE, ROBOT_TARGET_POSE,
+                                   ROBOT_TCP_POSE, TELEOP_COMMAND, TELEOP_FEEDBACK)
 from haptic_contract.streams import POSE, POSE_POSITION, WRENCH, WRENCH_FORCE
+from haptic_contract.teleop import Scheme
 from haptic_contract.teleop_fields import (COMMAND, command_from_fields, command_session, FEEDBACK,
                                            feedback_fields, impedance_report)
 from haptic_msgs.msg import RobotImpedance
@@ -77,17 +80,17 @@ class FollowerNode(Node):
         self._force = np.zeros(3)
         self._refused = Tally()
         self._sent = 0
-        self._target_pub = stream_publisher(self, POSE, 'robot/target_pose')
-        self._feedback_pub = stream_publisher(self, FEEDBACK, 'teleop/feedback')
-        stream_subscription(self, COMMAND, 'teleop/command', self.on_command,
+        self._target_pub = stream_publisher(self, POSE, ROBOT_TARGET_POSE)
+        self._feedback_pub = stream_publisher(self, FEEDBACK, TELEOP_FEEDBACK)
+        stream_subscription(self, COMMAND, TELEOP_COMMAND, self.on_command,
                             refused=self._refused, qos=LINK_QOS)
-        for codec, topic, callback in ((POSE, 'robot/tcp_pose', self.on_tcp),
-                                       (WRENCH, 'robot/ft_sensor/wrench', self.on_wrench)):
+        for codec, topic, callback in ((POSE, ROBOT_TCP_POSE, self.on_tcp),
+                                       (WRENCH, ROBOT_FT_WRENCH, self.on_wrench)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
-        self.create_subscription(RobotImpedance, 'robot/impedance', self.on_impedance,
+        self.create_subscription(RobotImpedance, ROBOT_IMPEDANCE, self.on_impedance,
                                  LATCHED_QOS)
         self.create_timer(self._period, self.tick)
-        rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == 'model'
+        rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == Scheme.MODEL
                                         else FORCE_FEEDBACK_RATE)
         self.create_timer(1.0 / rate, self.send_feedback)
         self.diagnostics = Diagnostics(self, self.report, 1.0)

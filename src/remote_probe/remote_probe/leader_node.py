@@ -16,9 +16,11 @@ from rclpy.node import Node
 from std_msgs.msg import Bool
 
 from haptic_contract.contact_model import Kind, MODEL, model_fields
+from haptic_contract.graph import (TELEOP_CLUTCH, TELEOP_COMMAND, TELEOP_FEEDBACK,
+                                   WAND_CONTACT_MODEL, WAND_POSE, WAND_TWIST, WAND_WRENCH)
 from haptic_contract.streams import (frame, POSE, POSE_POSITION, stamp_ns, TWIST, TWIST_LINEAR,
                                      WRENCH)
-from haptic_contract.teleop import feedback_refusal
+from haptic_contract.teleop import feedback_refusal, Scheme
 from haptic_contract.teleop_fields import COMMAND, command_fields, FEEDBACK, feedback_from_fields
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
@@ -65,16 +67,16 @@ class LeaderNode(Node):
         self._refused = Tally()
         self._answers = 0
         self._withheld = 0  # poses whose command was not sent: the feedback was silent
-        self._command_pub = stream_publisher(self, COMMAND, 'teleop/command')
-        answer = ((MODEL, 'wand/contact_model') if params.scheme == 'model'
-                  else (WRENCH, 'wand/wrench'))
+        self._command_pub = stream_publisher(self, COMMAND, TELEOP_COMMAND)
+        answer = ((MODEL, WAND_CONTACT_MODEL) if params.scheme == Scheme.MODEL
+                  else (WRENCH, WAND_WRENCH))
         self._answer_pub = stream_publisher(self, *answer)
-        for codec, topic, callback in ((POSE, 'wand/pose', self.on_pose),
-                                       (TWIST, 'wand/twist', self.on_twist)):
+        for codec, topic, callback in ((POSE, WAND_POSE, self.on_pose),
+                                       (TWIST, WAND_TWIST, self.on_twist)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
-        stream_subscription(self, FEEDBACK, 'teleop/feedback', self.on_feedback,
+        stream_subscription(self, FEEDBACK, TELEOP_FEEDBACK, self.on_feedback,
                             refused=self._refused, qos=LINK_QOS)
-        self.create_subscription(Bool, 'teleop/clutch', self.on_clutch, LATCHED_QOS)
+        self.create_subscription(Bool, TELEOP_CLUTCH, self.on_clutch, LATCHED_QOS)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         self.get_logger().info(f'{params.scheme} scheme: force x{params.force_scale:g}, '
                                f'motion x{params.position_scale:g}; waiting for the robot')
@@ -137,7 +139,7 @@ class LeaderNode(Node):
         else:
             self._command_pub.publish(command_fields(command, self.params.robot_frame))
         now = self._now()
-        if self.params.scheme == 'model':
+        if self.params.scheme == Scheme.MODEL:
             self._answer(stamp_ns, self.leader.plane(now, position), position)
         else:
             self._answer(stamp_ns, self.leader.force(now, position, velocity,
@@ -147,7 +149,7 @@ class LeaderNode(Node):
         """Publish the wrench or model for the pose ``stamp_ns``; None: zero force, no model."""
         header = (*divmod(stamp_ns, 1_000_000_000), self.params.frame_id)
         self._answers += 1
-        if self.params.scheme != 'model':
+        if self.params.scheme != Scheme.MODEL:
             force = (0.0, 0.0, 0.0) if answer is None else tuple(answer.tolist())
             self._answer_pub.publish((*header, *force, 0.0, 0.0, 0.0))
             return

@@ -1,7 +1,7 @@
 """The ROS parameters of the telerobotic nodes, in one place (see config/*.yaml)."""
 from dataclasses import dataclass
 
-from haptic_contract.teleop import HAND_SPEED, SCHEMES
+from haptic_contract.teleop import HAND_SPEED, Scheme, SCHEMES
 from haptic_util.parameters import parameter
 from remote_probe.admission import AdmissionConfig
 from remote_probe.leader import LeaderConfig
@@ -58,7 +58,7 @@ class SimulatedRobotParams(PatientBoundParams):
 
 @dataclass(frozen=True)
 class FollowerParams(PatientBoundParams):
-    scheme: str = parameter('model', 'bilateral scheme', choices=SCHEMES)
+    scheme: str = parameter(Scheme.MODEL.value, 'bilateral scheme', choices=SCHEMES)
     rate: float = parameter(1000.0, 'control rate: a target per tick', unit='Hz', low=1.0,
                             high=10000.0)
     feedback_rate: float = parameter(0.0, 'feedback over the link; 0: 1 kHz for direct and '
@@ -97,7 +97,7 @@ class FollowerParams(PatientBoundParams):
 
 @dataclass(frozen=True)
 class LeaderParams:
-    scheme: str = parameter('model', 'bilateral scheme', choices=SCHEMES)
+    scheme: str = parameter(Scheme.MODEL.value, 'bilateral scheme', choices=SCHEMES)
     force_scale: float = parameter(0.3, 'felt force per patient force', low=1e-3, high=10.0)
     position_scale: float = parameter(1.0, 'robot motion per wand motion', low=1e-3, high=10.0)
     link_timeout: float = parameter(0.1, 'no feedback for this long: zero force', unit='s',

@@ -23,6 +23,8 @@ from rclpy.node import Node
 
 from collision_engine import load_scene
 from haptic_contract.checks import finite_components, nonzero_components
+from haptic_contract.graph import (ROBOT_FT_WRENCH, ROBOT_IMPEDANCE, ROBOT_TARGET_POSE,
+                                   ROBOT_TCP_POSE)
 from haptic_contract.streams import frame, POSE, POSE_ORIENTATION, POSE_POSITION, WRENCH
 from haptic_contract.teleop_fields import impedance_message
 from haptic_msgs.msg import RobotImpedance
@@ -74,13 +76,13 @@ class SimulatedRobotNode(Node):
         self._measured = np.zeros(3)  # the sensor's latest force
         self._refused = Tally()
         self._published = 0
-        self._pose_pub = stream_publisher(self, POSE, 'robot/tcp_pose')
-        self._wrench_pub = stream_publisher(self, WRENCH, 'robot/ft_sensor/wrench')
-        stream_subscription(self, POSE, 'robot/target_pose', self.on_target,
+        self._pose_pub = stream_publisher(self, POSE, ROBOT_TCP_POSE)
+        self._wrench_pub = stream_publisher(self, WRENCH, ROBOT_FT_WRENCH)
+        stream_subscription(self, POSE, ROBOT_TARGET_POSE, self.on_target,
                             refused=self._refused)
         self.create_timer(1.0 / params.rate, self.tick)
         config = self.robot.config
-        self.create_publisher(RobotImpedance, 'robot/impedance', LATCHED_QOS).publish(
+        self.create_publisher(RobotImpedance, ROBOT_IMPEDANCE, LATCHED_QOS).publish(
             impedance_message(params.frame_id, stiffness=config.stiffness,
                               max_speed=config.max_speed,
                               workspace_lower=config.workspace_lower,
