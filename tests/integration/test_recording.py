@@ -17,7 +17,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 import yaml
 
-from haptic_bringup import bag as bag_tool
+from haptic_bringup import bag_tool
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import Loop, loop_environment, LoopConfig
 from haptic_bringup.recorder import custom_definitions
