@@ -23,7 +23,6 @@ context in the process's own ``ROS_DOMAIN_ID``, then the two sites' contexts are
 It stands for the network between the sites, so it talks to them as a remote peer would: over
 UDP on 127.0.0.1, never Fast DDS's shared memory (``haptic_util.transport`` says why).
 """
-from dataclasses import dataclass
 import functools
 import math
 import time
@@ -39,56 +38,19 @@ from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_process, StartupError
-from haptic_util.parameters import declare_parameters, parameter
+from haptic_util.parameters import declare_parameters
 from haptic_util.qos import HAPTIC_STREAM_QOS
 from haptic_util.transport import loopback_udp
 from remote_probe.link import DelayTrace, EmulatedLink, LinkConfig
+from remote_probe.params import LinkBridgeParams, LinkStageParams
 from remote_probe.relay import check_no_loop, message_class, parse_routes, Relay
 
-__all__ = ['LinkBridgeParams', 'LinkStageParams', 'ReleaseTimer', 'emulated_link', 'join_sites',
-           'main', 'read_parameters']
+__all__ = ['ReleaseTimer', 'emulated_link', 'join_sites', 'main', 'read_parameters']
 
 NODE_NAME = 'link_bridge'
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 LATE_WARNING = 1e-3  # [s] release lateness p99 above which the bridge itself distorts the link
 _STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() reads
-
-
-@dataclass(frozen=True)
-class LinkStageParams:
-    """The emulated link's parameters, shared by the bridge and the site gateway."""
-
-    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
-                             high=10.0)
-    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
-                              "message's delay", unit='s', low=0.0, high=10.0)
-    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
-    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
-                              'holds back those behind it)')
-    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
-                          low=0)
-    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
-                                 'from each direction\'s first message, instead of delay; '
-                                 'empty: none')
-
-
-@dataclass(frozen=True)
-class LinkBridgeParams(LinkStageParams):
-    """The bridge's parameters (see config/link_bridge.yaml); the link is the same both ways."""
-
-    operator_domain: int = parameter(0, 'DDS domain of the operator site (wand, force '
-                                     'rendering)', low=0, high=232)
-    remote_domain: int = parameter(1, 'DDS domain of the remote site (robot, sensor, patient)',
-                                   low=0, high=232)
-    to_remote: tuple[str, ...] = parameter(
-        ('robot/target_pose:geometry_msgs/msg/PoseStamped',),
-        "topics relayed from the operator's domain to the remote one, 'topic:pkg/msg/Type'; "
-        "[''] for none (rclpy cannot declare an empty list of strings)")
-    to_operator: tuple[str, ...] = parameter(
-        ('robot/tcp_pose:geometry_msgs/msg/PoseStamped',
-         'robot/ft_sensor/wrench:geometry_msgs/msg/WrenchStamped'),
-        "topics relayed from the remote domain to the operator's, 'topic:pkg/msg/Type'; "
-        "[''] for none")
 
 
 def emulated_link(params: LinkStageParams, direction: str, node_name: str) -> EmulatedLink:

@@ -159,8 +159,8 @@ class LeaderNode(Node):
             (answer.damping,) * 3),)
         self._answer_pub.publish(model_fields(
             header, 'patient', Kind.PLANES if planes else Kind.FREE, planes,
-            self.params.force_limit, self.params.model_lifetime, self.params.model_radius, tip,
-            _ZERO_WRENCH))
+            self.params.force_limit, self.params.model_lifetime, self.params.model_valid_radius,
+            tip, _ZERO_WRENCH))
 
     def on_clutch(self, msg: Bool) -> None:
         if self.leader is None or self._pending is None:

@@ -1,13 +1,16 @@
-"""The ROS parameters of the telerobotic nodes, in one place (see config/*.yaml)."""
+"""The ROS parameters of the telerobotic nodes and the link bridge (see config/*.yaml)."""
 from dataclasses import dataclass
 
+from haptic_contract.graph import ROBOT_FT_WRENCH, ROBOT_TARGET_POSE, ROBOT_TCP_POSE
+from haptic_contract.shared_defaults import FORCE_LIMIT
 from haptic_contract.teleop import HAND_SPEED, Scheme, SCHEMES
 from haptic_util.parameters import parameter
 from remote_probe.admission import AdmissionConfig
 from remote_probe.leader import LeaderConfig
 from remote_probe.safety import SafetyConfig
 
-__all__ = ['FollowerParams', 'LeaderParams', 'PatientBoundParams', 'SimulatedRobotParams']
+__all__ = ['FollowerParams', 'LeaderParams', 'LinkBridgeParams', 'LinkStageParams',
+           'PatientBoundParams', 'SimulatedRobotParams']
 
 
 @dataclass(frozen=True)
@@ -112,12 +115,13 @@ class LeaderParams:
                                                unit='N*s/m', low=0.0, high=1e3)
     frame_id: str = parameter('world', 'the wand\'s frame')
     robot_frame: str = parameter('base_link', 'the robot\'s base frame, of the link\'s messages')
-    force_limit: float = parameter(10.0, 'force limit sent with the contact model', unit='N',
-                                   low=0.0)
+    force_limit: float = parameter(FORCE_LIMIT, 'force limit sent with the contact model',
+                                   unit='N', low=0.0)
     model_lifetime: float = parameter(0.010, 'a rendered model holds this long after its '
                                       'pose\'s stamp', unit='s', low=0.0005, high=1.0)
-    model_radius: float = parameter(0.01, 'a rendered model holds this far from the wand',
-                                    unit='m', low=1e-4, high=1.0)
+    model_valid_radius: float = parameter(0.01, 'a rendered model holds this far from the wand '
+                                          '(its valid_radius; the remote site decides where '
+                                          'there is a plane)', unit='m', low=1e-4, high=1.0)
     rejoin_speed: float = parameter(LeaderConfig.rejoin_speed, 'model: after a silence, the '
                                     'shift it left is given back this fast, at the robot',
                                     unit='m/s', low=1e-4)
@@ -130,3 +134,40 @@ class LeaderParams:
     session_timeout: float = parameter(AdmissionConfig.session_timeout, 'the remote site\'s '
                                        'silence after which another may take over', unit='s',
                                        low=0.01)
+
+
+@dataclass(frozen=True)
+class LinkStageParams:
+    """The emulated link's parameters, shared by the bridge and the site gateway."""
+
+    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
+                             high=10.0)
+    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
+                              "message's delay", unit='s', low=0.0, high=10.0)
+    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
+    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
+                              'holds back those behind it)')
+    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
+                          low=0)
+    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
+                                 'from each direction\'s first message, instead of delay; '
+                                 'empty: none')
+
+
+@dataclass(frozen=True)
+class LinkBridgeParams(LinkStageParams):
+    """The bridge's parameters (see config/link_bridge.yaml); the link is the same both ways."""
+
+    operator_domain: int = parameter(0, 'DDS domain of the operator site (wand, force '
+                                     'rendering)', low=0, high=232)
+    remote_domain: int = parameter(1, 'DDS domain of the remote site (robot, sensor, patient)',
+                                   low=0, high=232)
+    to_remote: tuple[str, ...] = parameter(
+        (f'{ROBOT_TARGET_POSE}:geometry_msgs/msg/PoseStamped',),
+        "topics relayed from the operator's domain to the remote one, 'topic:pkg/msg/Type'; "
+        "[''] for none (rclpy cannot declare an empty list of strings)")
+    to_operator: tuple[str, ...] = parameter(
+        (f'{ROBOT_TCP_POSE}:geometry_msgs/msg/PoseStamped',
+         f'{ROBOT_FT_WRENCH}:geometry_msgs/msg/WrenchStamped'),
+        "topics relayed from the remote domain to the operator's, 'topic:pkg/msg/Type'; "
+        "[''] for none")
