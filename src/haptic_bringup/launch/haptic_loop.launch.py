@@ -28,9 +28,9 @@ from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
-from haptic_contract.graph import LOOP_RECORDER, NODES as LOOP_NODES
+from haptic_contract.graph import EXECUTABLES, LOOP_RECORDER, NODES as LOOP_NODES
 
-NODES = tuple((entry.package, entry.executable, name) for name, entry in LOOP_NODES.items())
+NODES = tuple((entry.package, EXECUTABLES[name], name) for name, entry in LOOP_NODES.items())
 
 
 def _config(package: str) -> str:

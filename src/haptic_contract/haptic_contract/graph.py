@@ -8,15 +8,14 @@ of the loop and of the two telerobotic sites. Strings only: nothing here imports
 from typing import NamedTuple
 
 __all__ = ['COLLISION_MARKERS', 'COLLISION_NEARBY', 'COLLISION_STATE', 'DIAGNOSTICS',
-           'LATCHED_TOPICS', 'LOOP_RECORDER', 'LOOP_TOPICS', 'NODES', 'NodeEntry',
-           'OPERATOR_RECORDED', 'OPERATOR_RECORDER', 'OPERATOR_SITE', 'PUBLISHERS',
-           'RECORDERS', 'RELIABLE_TOPICS', 'REMOTE_PREFIX', 'REMOTE_RECORDED',
-           'REMOTE_RECORDER', 'REMOTE_SITE', 'ROBOT_FT_WRENCH', 'ROBOT_IMPEDANCE',
-           'ROBOT_TARGET_POSE', 'ROBOT_TCP_POSE', 'SCENE_DESCRIPTION', 'SITE_PUBLISHERS',
-           'STREAMS', 'TELEOP_CLUTCH', 'TELEOP_COMMAND', 'TELEOP_FEEDBACK', 'TELEOP_NODES',
-           'TO_OPERATOR', 'TO_REMOTE', 'TOPIC_TYPES', 'WAND_APPLIED_WRENCH',
-           'WAND_CONTACT_MODEL', 'WAND_FORCE_MARKER', 'WAND_POSE', 'WAND_TWIST', 'WAND_WRENCH',
-           'absolute']
+           'EXECUTABLES', 'LATCHED_TOPICS', 'LOOP_RECORDER', 'LOOP_TOPICS', 'NODES', 'NodeEntry',
+           'OPERATOR_RECORDED', 'OPERATOR_RECORDER', 'OPERATOR_SITE', 'PUBLISHERS', 'RECORDERS',
+           'RELIABLE_TOPICS', 'REMOTE_PREFIX', 'REMOTE_RECORDED', 'REMOTE_RECORDER', 'REMOTE_SITE',
+           'ROBOT_FT_WRENCH', 'ROBOT_IMPEDANCE', 'ROBOT_TARGET_POSE', 'ROBOT_TCP_POSE',
+           'SCENE_DESCRIPTION', 'SITE_PUBLISHERS', 'STREAMS', 'TELEOP_CLUTCH', 'TELEOP_COMMAND',
+           'TELEOP_FEEDBACK', 'TELEOP_NODES', 'TOPIC_TYPES', 'TO_OPERATOR', 'TO_REMOTE',
+           'WAND_APPLIED_WRENCH', 'WAND_CONTACT_MODEL', 'WAND_FORCE_MARKER', 'WAND_POSE',
+           'WAND_TWIST', 'WAND_WRENCH', 'absolute']
 
 # The loop: the wand's state out, the engine's answer, the renderer's wrench or model back.
 WAND_POSE = 'wand/pose'
@@ -75,31 +74,28 @@ LOOP_TOPICS = tuple(absolute(topic) for topic in (
 
 
 class NodeEntry(NamedTuple):
-    """A node: its package, its executable there, and its module (with ``main``) and class."""
+    """A node: its package, and its module (with ``main``) and class there."""
 
     package: str
-    executable: str
     module: str
     cls: str
 
 
 # By node name: the loop's, and a telerobotic session's.
 NODES = {
-    'wand_driver': NodeEntry('haptic_wand_driver', 'wand_driver', 'haptic_wand_driver.node',
-                             'WandDriverNode'),
-    'collision_engine': NodeEntry('collision_engine', 'collision_node', 'collision_engine.node',
-                                  'CollisionNode'),
-    'force_renderer': NodeEntry('force_renderer', 'force_node', 'force_renderer.node',
-                                'ForceNode'),
+    'wand_driver': NodeEntry('haptic_wand_driver', 'haptic_wand_driver.node', 'WandDriverNode'),
+    'collision_engine': NodeEntry('collision_engine', 'collision_engine.node', 'CollisionNode'),
+    'force_renderer': NodeEntry('force_renderer', 'force_renderer.node', 'ForceNode'),
 }
 TELEOP_NODES = {
-    'teleop_leader': NodeEntry('remote_probe', 'teleop_leader', 'remote_probe.leader_node',
-                               'LeaderNode'),
-    'sim_robot': NodeEntry('remote_probe', 'sim_robot', 'remote_probe.robot_node',
-                           'SimulatedRobotNode'),
-    'teleop_follower': NodeEntry('remote_probe', 'teleop_follower',
-                                 'remote_probe.follower_node', 'FollowerNode'),
+    'teleop_leader': NodeEntry('remote_probe', 'remote_probe.leader_node', 'LeaderNode'),
+    'sim_robot': NodeEntry('remote_probe', 'remote_probe.robot_node', 'SimulatedRobotNode'),
+    'teleop_follower': NodeEntry('remote_probe', 'remote_probe.follower_node', 'FollowerNode'),
 }
+# Each node's executable in its package (``ros2 run``, the launch files), by node name.
+EXECUTABLES = {'wand_driver': 'wand_driver', 'collision_engine': 'collision_node',
+               'force_renderer': 'force_node', 'teleop_leader': 'teleop_leader',
+               'sim_robot': 'sim_robot', 'teleop_follower': 'teleop_follower'}
 # Each telerobotic site is one process.
 OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
