@@ -21,10 +21,8 @@ import numpy as np
 from collision_engine import load_scene
 from collision_engine.conversions import STATE, tool_state
 from collision_engine.probe import query_probe
-from force_renderer.contact import Contact
-from force_renderer.node import _face
+from force_renderer.assembly import state_contact
 from force_renderer.probe import ProbeSpringDamper
-from haptic_contract.collision_state import contact_fields
 
 __all__ = ['main', 'run']
 
@@ -70,9 +68,7 @@ def run(poses: int = 2000) -> list[dict]:
 
         def force(data):
             fields = STATE.decode(data)
-            _, name, status, distance, point, normal, tip = contact_fields(fields)
-            contact = Contact.from_floats(distance, tuple(point), tuple(normal), tuple(tip), name,
-                                          0.0, status, _face(fields))
+            _, _, contact = state_contact(fields)
             law.force(contact, (0.0, 0.0, 0.0))
             law.torque(contact)
             law.planes(contact)

@@ -28,13 +28,12 @@ from haptic_contract.contact_model import ContactModel, Kind, Plane
 from haptic_contract.teleop import CommandLimits, HAND_SPEED
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
-from haptic_wand_driver.device import DeviceLimits
-from haptic_wand_driver.local_rendering import LocalRenderer
+from haptic_wand_driver.assembly import local_renderer, port_passivity, simulated_wand_config
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
 from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.scripts import WaypointScript
-from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from haptic_wand_driver.simulated import SimulatedWand
 from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.ft_sensor import ForceTorqueSensor
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
@@ -61,18 +60,12 @@ ZERO = np.zeros(3)
 def _device(scheme: str):
     """Build the driver's simulated wand and hand, rendering as the launcher sets ``scheme``."""
     wand = WandDriverParams()
-    limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
     hand = OperatorHand(WaypointScript.from_file(package_file(SCAN)),
                         stiffness=wand.hand_stiffness, damping=wand.hand_damping)
-    device = SimulatedWand(SimulatedWandConfig(
-        mass=[wand.device_mass] * 3, damping=[wand.device_damping] * 3,
-        step=1.0 / wand.servo_rate, limits=limits), operator=hand)
+    device = SimulatedWand(simulated_wand_config(wand), operator=hand)
     renderer = None
     if scheme == 'model':
-        renderer = LocalRenderer(
-            force_limit=limits.force_limit, torque_limit=limits.torque_limit,
-            passivity=PortPassivity(wand.passivity_max_damping), mass=[wand.device_mass] * 3,
-            contact_damping_ratio=wand.contact_damping_ratio)
+        renderer = local_renderer(wand, device.limits, port_passivity(wand))
         device.render_locally(renderer)
     return device, renderer
 

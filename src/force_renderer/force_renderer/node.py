@@ -13,22 +13,14 @@ leaf values within one process.
 from typing import Sequence
 
 from geometry_msgs.msg import Point
-import numpy as np
 from rclpy.node import Node
 from visualization_msgs.msg import Marker
 
-from force_renderer.contact import Contact, FaceContact
+from force_renderer.assembly import force_law, force_pipeline, passivity_warnings, state_contact
 from force_renderer.local_model import local_model
-from force_renderer.materials import PerObjectLaw
 from force_renderer.params import ForceRendererParams
-from force_renderer.passivity import passivity_warning
-from force_renderer.pipeline import ForcePipeline, PipelineConfig
-from force_renderer.probe import ProbeSpringDamper
-from force_renderer.proxy import GodObjectProxy
-from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
-from haptic_contract.collision_state import (contact_fields, face_fields, STATE,
-                                             STATUS_NOT_CONVERGED)
+from haptic_contract.collision_state import STATE, STATUS_NOT_CONVERGED
 from haptic_contract.contact_model import MODEL, model_fields
 from haptic_contract.graph import (COLLISION_STATE, WAND_CONTACT_MODEL, WAND_FORCE_MARKER,
                                    WAND_TWIST, WAND_WRENCH)
@@ -37,7 +29,6 @@ from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.paths import resolve_path
 from haptic_util.qos import MARKER_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
@@ -57,18 +48,12 @@ class ForceNode(Node):
         super().__init__('force_renderer', **kwargs)
         self.params = params = declare_parameters(self, ForceRendererParams)
         try:
-            law, gains = self._law(params)
+            law, gains = force_law(params, announce=self.get_logger().info)
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
-        self.pipeline = ForcePipeline(law, PipelineConfig(
-            force_limit=params.force_limit, passivity=params.passivity,
-            max_damping=params.max_damping, servo_period=params.servo_period,
-            timeout=params.watchdog_timeout))
-        for stiffness, damping in gains:
-            warning = passivity_warning(stiffness, params.device_damping, params.servo_period,
-                                        damping)
-            if warning:
-                self.get_logger().warn(warning)
+        self.pipeline = force_pipeline(params, law)
+        for warning in passivity_warnings(params, gains):
+            self.get_logger().warn(warning)
         self._contact = None
         self._header = None
         self._twist = None
@@ -93,52 +78,12 @@ class ForceNode(Node):
         self.get_logger().info(f'{params.law} law, passivity {passivity}, '
                                f'force limit {params.force_limit:g} N')
 
-    def _law(self, params: ForceRendererParams):
-        """Build the force law; return it and every (stiffness, damping) it renders with."""
-        default = (params.stiffness, params.damping)
-        if not params.scene_file:
-            if params.law != 'normal':
-                raise ValueError(f'law {params.law!r} needs parameter scene_file')
-            return SpringDamper(*default), [default]
-        scene_path = resolve_path(params.scene_file, what='parameter scene_file')
-        from collision_engine import read_scene
-        spec = read_scene(scene_path)
-        materials = {o.name: (tuple(o.material.stiffness), tuple(o.material.damping))
-                     for o in spec.objects if o.material is not None}
-        gains = [default, *materials.values()]
-        if spec.tool is not None:
-            if params.law != 'normal':
-                raise ValueError(f'law {params.law!r} renders a point tip, and the scene '
-                                 f'{scene_path} mounts a tool: use the normal law')
-            laws = {name: ProbeSpringDamper(*gain) for name, gain in materials.items()}
-            return PerObjectLaw(laws, ProbeSpringDamper(*default)), gains
-        if params.law == 'proxy':
-            from collision_engine import load_scene
-            scene = load_scene(scene_path, announce=self.get_logger().info)  # warmed up
-
-            def signed_distance(point):
-                result = scene.query(point)
-                return result.distance, result.normal
-            return GodObjectProxy(*default, signed_distance), [default]
-        if params.law == 'centroid':
-            from force_renderer.centroids import vertex_centroids
-            centroids = vertex_centroids(spec)
-            laws = {name: CentroidSpringDamper(*materials.get(name, default), centroid)
-                    for name, centroid in centroids.items()}
-            return PerObjectLaw(laws, SpringDamper(*default)), gains
-        laws = {name: SpringDamper(*gain) for name, gain in materials.items()}
-        return PerObjectLaw(laws, SpringDamper(*default)), gains
-
     def on_twist(self, fields: Sequence) -> None:
         self._twist = (stamp_ns(fields), tuple(fields[TWIST_LINEAR]))
 
     def on_state(self, fields: Sequence) -> None:
-        header, name, status, distance, point, normal, tip = contact_fields(fields)
-        stamp = stamp_ns(fields)
-        self._approximate += status == STATUS_NOT_CONVERGED
-        self._contact = Contact.from_floats(distance, point, normal, tip, name, stamp * 1e-9,
-                                            status, _face(fields))
-        self._header = header
+        self._header, stamp, self._contact = state_contact(fields)
+        self._approximate += self._contact.status == STATUS_NOT_CONVERGED
         self.render(self._velocity(stamp))
 
     def _velocity(self, stamp: int):
@@ -214,17 +159,6 @@ class ForceNode(Node):
         self.diagnostics.final()
         self.get_logger().info(f'published {self._published} wrenches')
         return super().destroy_node()
-
-
-def _face(fields: list) -> FaceContact | None:
-    """Return the tool's face from a CollisionState's leaves, or None when it has no tool."""
-    distance, points, normals, orientation = face_fields(fields)
-    if not distance:
-        return None
-    from collision_engine.probe import rotation_matrix
-
-    return FaceContact(np.array(distance), np.array(points).reshape(-1, 3),
-                       np.array(normals).reshape(-1, 3), rotation_matrix(orientation))
 
 
 def main(args=None) -> int:

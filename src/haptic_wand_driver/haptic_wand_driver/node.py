@@ -25,19 +25,15 @@ from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.paths import resolve_path
 from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.answer_deadline import AnswerDeadline
-from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
-from haptic_wand_driver.experiments import make_script, needs_scene, surface_projection
+from haptic_wand_driver.assembly import local_renderer, make_wand, port_passivity
+from haptic_wand_driver.device import LocalRenderingUnsupported
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.loop_stats import LoopStats
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
-from haptic_wand_driver.port_passivity import PortPassivity
-from haptic_wand_driver.simulated import SimulatedWandConfig
 from haptic_wand_driver.wrench_input import Refusal, WrenchCommand
 
 __all__ = ['WandDriverNode', 'main']
@@ -64,7 +60,7 @@ class WandDriverNode(Node):
         super().__init__('wand_driver', **kwargs)
         self.params = params = declare_parameters(self, WandDriverParams)
         try:
-            self.device = self._make_device(params)
+            self.device = make_wand(params, announce=self.get_logger().info)
         except ValueError as error:  # includes DeviceUnavailableError and script/replay errors
             raise StartupError(f'{self.get_name()}: {error}') from None
         limits = self.device.limits
@@ -76,7 +72,7 @@ class WandDriverNode(Node):
         self.stats = LoopStats(record=self._record)
         # The observer always runs (its books are the port's energy figures); the controller acts
         # only when enabled.
-        self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
+        self.passivity = port_passivity(params)
         self.renderer = self._local_renderer() if params.rendering == 'local' else None
         self.answers = AnswerDeadline(params.hold_while_late)
         self._applied = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))  # the wrench the device holds
@@ -112,39 +108,13 @@ class WandDriverNode(Node):
 
     def _local_renderer(self) -> LocalRenderer | None:
         """Return the device's servo-rate law, or None (logged) if the device cannot run one."""
-        limits = self.device.limits
-        renderer = LocalRenderer(
-            force_limit=limits.force_limit, torque_limit=limits.torque_limit,
-            passivity=self.passivity, mass=[self.params.device_mass] * 3,
-            contact_damping_ratio=self.params.contact_damping_ratio)
+        renderer = local_renderer(self.params, self.device.limits, self.passivity)
         try:
             self.device.render_locally(renderer)
         except LocalRenderingUnsupported as error:
             self.get_logger().warn(f'rendering local: {error}; it applies the wrench instead')
             return None
         return renderer
-
-    def _make_device(self, params: WandDriverParams):
-        if params.device == 'replay':
-            replay = resolve_path(params.replay_file, what='parameter replay_file')
-            return make_device('replay', path=replay, loop=params.replay_loop)
-        if params.device != 'simulated':
-            return make_device(params.device)
-        project = None
-        if needs_scene(params.experiment):
-            from collision_engine import load_scene  # only the scripted experiments need it
-
-            project = surface_projection(load_scene(
-                resolve_path(params.scene_file, what='parameter scene_file'),
-                announce=self.get_logger().info))
-        config = SimulatedWandConfig(
-            mass=[params.device_mass] * 3, damping=[params.device_damping] * 3,
-            step=1.0 / params.servo_rate,
-            limits=DeviceLimits(force_limit=params.force_limit,
-                                torque_limit=params.torque_limit))
-        hand = OperatorHand(make_script(params.experiment, project),
-                            stiffness=params.hand_stiffness, damping=params.hand_damping)
-        return make_device('simulated', config=config, operator=hand)
 
     def ready(self) -> bool:
         """Whether every consumer is connected, so no pose of the session is lost to discovery."""
