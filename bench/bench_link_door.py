@@ -19,13 +19,13 @@ import time
 import machine
 import numpy as np
 
+from haptic_contract.teleop import Command, CommandLimits, HAND_SPEED
+from haptic_contract.teleop_fields import COMMAND, command_fields
 from haptic_util.cdr import MalformedMessage
 from remote_probe.admission import Admission, AdmissionConfig
 from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.follower_node import take_command
-from remote_probe.link_messages import COMMAND, command_fields
 from remote_probe.safety import PatientSafety, SafetyConfig
-from remote_probe.teleop import Command, CommandLimits, HAND_SPEED
 
 __all__ = ['main', 'rows']
 

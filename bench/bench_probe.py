@@ -21,8 +21,7 @@ import numpy as np
 from collision_engine import load_scene
 from collision_engine.conversions import STATE, tool_state
 from collision_engine.probe import query_probe
-from force_renderer.contact import Contact
-from force_renderer.node import _face
+from force_renderer.assembly import state_contact
 from force_renderer.probe import ProbeSpringDamper
 
 __all__ = ['main', 'run']
@@ -69,9 +68,7 @@ def run(poses: int = 2000) -> list[dict]:
 
         def force(data):
             fields = STATE.decode(data)
-            contact = Contact.from_floats(fields[5], tuple(fields[7:10]), tuple(fields[10:13]),
-                                          tuple(fields[16:19]), fields[3], 0.0, fields[4],
-                                          _face(fields))
+            _, _, contact = state_contact(fields)
             law.force(contact, (0.0, 0.0, 0.0))
             law.torque(contact)
             law.planes(contact)

@@ -33,14 +33,14 @@ from haptic_bringup.contacts import contact_intervals
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import applied_work, read_session
+from haptic_contract.contact_model import ContactModel, Kind, Plane
 from haptic_util.paths import package_file
-from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
+from haptic_wand_driver.assembly import local_renderer, port_passivity
 from haptic_wand_driver.device import DeviceLimits
 from haptic_wand_driver.experiments import make_script, surface_projection
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
-from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
 
 __all__ = ['compare', 'ideal_depth', 'run', 'main']
@@ -115,10 +115,8 @@ def ideal_depth(stiffness: float, *, duration: float = 6.0, rate: float = IDEAL_
     device = SimulatedWand(SimulatedWandConfig(
         mass=[wand.device_mass] * 3, damping=[wand.device_damping] * 3, step=1.0 / rate,
         limits=limits), operator=hand)
-    device.render_locally(_ContinuousWall(LocalRenderer(
-        force_limit=limits.force_limit, torque_limit=limits.torque_limit,
-        passivity=PortPassivity(wand.passivity_max_damping), mass=[wand.device_mass] * 3,
-        contact_damping_ratio=wand.contact_damping_ratio), scene, stiffness, force.damping))
+    device.render_locally(_ContinuousWall(local_renderer(wand, limits, port_passivity(wand)),
+                                          scene, stiffness, force.damping))
     return max(-scene.query(device.read(t).position).distance
                for t in np.arange(0.0, duration, 1e-3))
 

@@ -21,6 +21,7 @@ sweep, the force it measured as the sweep began; its force error beside the hand
 patient's force about its mean over the same sweep, unheld).
 """
 import argparse
+import dataclasses
 import itertools
 import math
 import sys
@@ -32,16 +33,16 @@ import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD, LINK_TIMEOUT, MODEL_STEP_RATE, \
     SCAN_DURATION
+from haptic_contract.contact_model import ContactModel, Kind, Plane
+from haptic_contract.teleop import CommandLimits, HAND_SPEED
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
-from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
-from haptic_wand_driver.device import DeviceLimits
-from haptic_wand_driver.local_rendering import LocalRenderer
+from haptic_wand_driver.assembly import local_renderer, port_passivity, simulated_wand_config
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
 from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.scripts import WaypointScript
-from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from haptic_wand_driver.simulated import SimulatedWand
 from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.ft_sensor import ForceTorqueSensor
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
@@ -50,7 +51,6 @@ from remote_probe.link import EmulatedLink, LinkConfig, silence_timeout
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
-from remote_probe.teleop import CommandLimits, HAND_SPEED
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
 
 __all__ = ['as_series', 'hold_error', 'late_ticks', 'scan', 'SCHEMES']
@@ -70,18 +70,13 @@ ZERO = np.zeros(3)
 def _device(scheme: str, easing: float):
     """Build the driver's simulated wand and hand, rendering as the launcher sets ``scheme``."""
     wand = WandDriverParams()
-    limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
     hand = OperatorHand(WaypointScript.from_file(package_file(SCAN)),
                         stiffness=wand.hand_stiffness, damping=wand.hand_damping)
-    device = SimulatedWand(SimulatedWandConfig(
-        mass=[wand.device_mass] * 3, damping=[wand.device_damping] * 3,
-        step=1.0 / wand.servo_rate, limits=limits), operator=hand)
+    device = SimulatedWand(simulated_wand_config(wand), operator=hand)
     renderer = None
     if scheme == 'model':
-        renderer = LocalRenderer(
-            force_limit=limits.force_limit, torque_limit=limits.torque_limit,
-            passivity=PortPassivity(wand.passivity_max_damping), mass=[wand.device_mass] * 3,
-            contact_damping_ratio=wand.contact_damping_ratio, model_step_rate=easing)
+        renderer = local_renderer(dataclasses.replace(wand, model_step_rate=easing),
+                                  device.limits, port_passivity(wand))
         device.render_locally(renderer)
     return device, renderer
 

@@ -25,9 +25,8 @@ from typing import Callable
 import numpy as np
 from scipy.linalg import expm
 
-from force_renderer._checks import non_negative, positive, vector3
 from force_renderer.contact import Contact
-from force_renderer.errors import ForceRendererError
+from force_renderer.errors import ForceRendererError, non_negative, positive, vector3
 
 __all__ = ['Device', 'HalfSpace', 'OperatorHand', 'ServoTiming', 'WallRun', 'simulate']
 

@@ -75,8 +75,8 @@ printf '[setup] building haptic_msgs into the venv, beside the next steps ...\n'
 build_msgs &
 msgs=$!
 
-packages=(haptic_util collision_engine force_renderer haptic_wand_driver haptic_bringup
-  remote_probe ultrasound_sim site_gateway)
+packages=(haptic_util haptic_contract collision_engine force_renderer haptic_wand_driver
+  haptic_bringup remote_probe ultrasound_sim site_gateway)
 step "installing the toolkit's packages: ${packages[*]}"
 # compat mode puts src/<pkg> on sys.path, so a tests/<pkg>/ folder can never shadow it.
 editable=()
@@ -99,7 +99,7 @@ for scene in sorted(pathlib.Path('src/collision_engine/scenes').glob('*.yaml')):
 
 step "waiting for haptic_msgs"
 wait "$msgs" || { echo "[setup] building haptic_msgs failed"; exit 1; }
-"$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, collision_engine, force_renderer, \
-haptic_wand_driver, haptic_bringup, remote_probe, ultrasound_sim, site_gateway, zenoh" || { echo "[setup] import check failed"; exit 1; }
+"$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, haptic_contract, collision_engine, \
+force_renderer, haptic_wand_driver, haptic_bringup, remote_probe, ultrasound_sim, site_gateway, zenoh" || { echo "[setup] import check failed"; exit 1; }
 finish_step
 printf '[setup] done in %s s: %s\n' "$(since "$setup_started")" "$venv"

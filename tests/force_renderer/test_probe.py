@@ -193,8 +193,8 @@ def test_the_pipeline_scales_the_torque_with_the_saturated_force_and_zeroes_it_w
 
 
 def device_wrench(planes, tip, roll: float):
-    """The wand's own rendering of the model's planes (``haptic_wand_driver.contact_model``)."""
-    from haptic_wand_driver.contact_model import ContactModel, Kind, Plane
+    """The wand's own rendering of the model's planes (``haptic_contract.contact_model``)."""
+    from haptic_contract.contact_model import ContactModel, Kind, Plane
 
     model = ContactModel(0.0, Kind.PLANES, tuple(Plane(*plane) for plane in planes), 10.0, 1.0,
                          1.0, tuple(tip), (0.0,) * 6)

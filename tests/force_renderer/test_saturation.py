@@ -6,8 +6,7 @@ from hypothesis import strategies as st
 import numpy as np
 import pytest
 
-from force_renderer.errors import ForceRendererError
-from force_renderer.saturation import saturate
+from force_renderer.errors import ForceRendererError, saturate
 
 # Forces from a nanonewton to a meganewton: squares stay far from underflow and overflow.
 components = st.one_of(st.just(0.0), st.floats(1e-9, 1e6), st.floats(-1e6, -1e-9))

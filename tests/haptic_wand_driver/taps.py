@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 from haptic_bringup.contacts import contacts
-from haptic_wand_driver.contact_model import ContactModel
+from haptic_contract.contact_model import ContactModel
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.port_passivity import PortPassivity

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from taps import tap
 
-from haptic_wand_driver.contact_model import ContactModel, Kind
+from haptic_contract.contact_model import ContactModel, Kind
 from haptic_wand_driver.local_rendering import LocalRenderer, MAX_DAMPING_PER_MASS
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.port_passivity import PortPassivity

@@ -9,7 +9,7 @@ from contact_model_fields import fields, plane
 import numpy as np
 import pytest
 
-from haptic_wand_driver.contact_model import ContactModel
+from haptic_contract.contact_model import ContactModel
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.port_passivity import PortPassivity

@@ -8,7 +8,7 @@ from rclpy.clock import ROSClock
 from rclpy.context import Context
 from rclpy.time import Time
 
-from haptic_wand_driver.contact_model import Kind
+from haptic_contract.contact_model import Kind
 from haptic_wand_driver.local_rendering import DEADLINE
 from haptic_wand_driver.node import WandDriverNode
 

@@ -8,7 +8,7 @@ import pytest
 from wand_ground_truth import (
     matrix_from_quaternion, quaternion_from_matrix, rotation_x, rotation_y, rotation_z)
 
-from haptic_wand_driver.orientation import (
+from haptic_contract.wand import (
     PitchError, quaternion_from_roll_yaw, roll_yaw_from_quaternion, roll_yaw_jacobian)
 
 angles = st.floats(-3.0, 3.0)

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from wand_ground_truth import rotation_z
 
-from haptic_wand_driver.wrench_input import saturate, saturate_components, WrenchCommand
+from haptic_contract.plane_law import saturate, saturate_components
+from haptic_wand_driver.wrench_input import WrenchCommand
 
 components = st.floats(-50.0, 50.0)
 vectors = st.tuples(components, components, components).map(np.array)

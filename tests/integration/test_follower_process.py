@@ -18,9 +18,9 @@ from rclpy.node import Node
 
 from haptic_bringup.launcher import loop_environment
 from haptic_bringup.processes import start_child, stop_children
+from haptic_contract.teleop_fields import impedance_message
 from haptic_msgs.msg import RobotImpedance, TeleopCommand, TeleopFeedback
 from haptic_util.qos import HAPTIC_STREAM_QOS, LATCHED_QOS
-from remote_probe.link_messages import impedance_message
 
 PRESSED = 8.0  # [N] the sensor's good reading: the probe pressed on the patient
 CONNECT_TIMEOUT = 60.0  # [s] the node's imports and the phantom's mesh, on a busy machine

@@ -23,10 +23,10 @@ from rclpy.node import Node
 from test_teleop import DELAY, reports, streams
 
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
+from haptic_contract.teleop_fields import COMMAND
 from haptic_msgs.msg import TeleopCommand
 from haptic_util.cdr import MalformedMessage, MessageCodec
 from haptic_util.qos import HAPTIC_STREAM_QOS
-from remote_probe.link_messages import COMMAND
 
 MAX_PATIENT_FORCE = 20.0  # [N] the follower's and the robot's default
 POSE = MessageCodec(PoseStamped)

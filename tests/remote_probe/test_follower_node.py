@@ -3,9 +3,9 @@ import pytest
 import rclpy
 from rclpy.context import Context
 
+from haptic_contract.teleop_fields import impedance_message
 from haptic_util.diagnostics import ERROR, WARN
 from remote_probe.follower_node import FollowerNode
-from remote_probe.link_messages import impedance_message
 
 ROBOT = dict(max_speed=0.25, workspace_lower=(-0.4,) * 3, workspace_upper=(0.4,) * 3,
              max_patient_force=20.0)

@@ -2,12 +2,12 @@
 import numpy as np
 import pytest
 
+from haptic_contract.teleop import Command, CommandLimits, Feedback, RemotePlane
 from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
 from remote_probe.leader import Leader, LeaderConfig
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.safety import PatientSafety, SafetyConfig
-from remote_probe.teleop import Command, CommandLimits, Feedback, RemotePlane
 from remote_probe.tissue import HuntCrossley, PlaneSurface, Tissue
 from remote_probe.virtual_coupling import CouplingConfig
 from remote_probe.workspace_map import WorkspaceMap

@@ -1,38 +1,32 @@
-"""The one numba decorator every compiled kernel of the engine uses, and where its cache lives.
+"""Where the engine's compiled kernels are cached; they compile through the project's ``jit``.
 
-One place sets the compile options, so no kernel can drift: ``cache=True`` so that a second
-process loads machine code instead of compiling (seconds saved), and no ``fastmath``: it lets
-LLVM assume there are no infinities, and the searches here start from ``best = inf``.
-``error_model='numpy'`` makes a division by zero give inf/NaN (which the kernels test for)
-instead of raising from compiled code.
-
-The cache. numba keys a cached kernel on its own file, yet an entry point's machine code includes
-the kernels it calls from other modules: after an edit to ``gjk.py`` the cached ``_kernels`` code
-would silently be the old algorithm. And it caches beside the source, so every install (a
-``colcon build``, a venv) compiles again, and three nodes started together compiled three times
-over (about 60 s on two cores). So the kernels are cached under a fingerprint of every kernel
+The decorator and its options are ``haptic_util.jit``'s, the project's one. The cache: numba
+keys a cached kernel on its own file, yet an entry point's machine code includes the kernels it
+calls from other modules: after an edit to ``gjk.py`` the cached ``_kernels`` code would
+silently be the old algorithm. And it caches beside the source, so every install (a ``colcon
+build``, a venv) compiles again, and three nodes started together compiled three times over
+(about 60 s on two cores). So the kernels are cached under a fingerprint of every kernel
 module's content, in a per-user folder (``$NUMBA_CACHE_DIR`` or ``~/.cache``; the package's
-``__pycache__`` when that is not writable): a changed kernel
-module means another folder (nothing is deleted, so nothing races), and every install of the
-same code shares one cache. ``compiling`` lets one process compile while the others wait for
-its cache, and says so in one line.
+``__pycache__`` when that is not writable): a changed kernel module means another folder
+(nothing is deleted, so nothing races), and every install of the same code shares one cache.
+``compiling`` lets one process compile while the others wait for its cache, and says so in one
+line.
 
-Another package's kernels compiled through ``jit`` (the ultrasound image's) live in one module
-that calls only its own, so numba's stamp of that file is enough; they too are cached in the
-per-user folder, never beside the source, which a build must leave as it found it.
+Another package's kernels compiled through ``jit`` (the ultrasound image's, the driver's servo
+loop) live in one module that calls only its own, so numba's stamp of that file is enough
+(``haptic_util.jit``).
 """
 
 import contextlib
 import fcntl
 import functools
 import hashlib
-import os
 from pathlib import Path
-import tempfile
 from typing import Callable, Iterator
 
-from numba import njit
 from numba.core import caching
+
+from haptic_util.jit import jit, USER_CACHE, writable
 
 __all__ = ['jit', 'compiling', 'CACHE_DIR']
 
@@ -54,25 +48,12 @@ def _fingerprint() -> str:
     return digest.hexdigest()[:16]
 
 
-def _writable(folder: Path) -> bool:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        tempfile.TemporaryFile(dir=folder).close()
-        return True
-    except OSError:
-        return False
-
-
-_USER_CACHE = Path(os.environ.get('NUMBA_CACHE_DIR') or Path(
-    os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache')) / 'haptic_toolkit'
-
-
 def _cache_dir() -> Path:
     """Return the per-user cache of this fingerprint, or the package's own if not writable."""
     fingerprint = _fingerprint()
-    candidates = (_USER_CACHE / 'collision_engine' / fingerprint,
+    candidates = (USER_CACHE / 'collision_engine' / fingerprint,
                   _PACKAGE / '__pycache__' / fingerprint)
-    return next((folder for folder in candidates if _writable(folder)), candidates[0])
+    return next((folder for folder in candidates if writable(folder)), candidates[0])
 
 
 CACHE_DIR = _cache_dir()
@@ -98,43 +79,8 @@ class _FingerprintLocator(caching._SourceFileBackedLocatorMixin, caching._CacheL
         return super().from_function(py_func, py_file)
 
 
-if _FingerprintLocator not in caching.CacheImpl._locator_classes:
+if _FingerprintLocator not in caching.CacheImpl._locator_classes:  # before jit's own
     caching.CacheImpl._locator_classes.insert(0, _FingerprintLocator)
-
-
-class _UserCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
-    """numba's cache locator for another package's kernels compiled through ``jit``.
-
-    Under the per-user folder, by package; stamped with the source file, as numba's own.
-    """
-
-    def __init__(self, py_func, py_file) -> None:
-        self._py_file = py_file
-        self._lineno = py_func.__code__.co_firstlineno
-        self._folder = _USER_CACHE / Path(py_file).resolve().parent.name
-
-    def get_cache_path(self) -> str:
-        return str(self._folder)
-
-    @classmethod
-    def from_function(cls, py_func, py_file):
-        if Path(py_file).resolve() not in _OTHER_KERNEL_FILES:
-            return None
-        locator = cls(py_func, py_file)
-        return locator if _writable(locator._folder) else None
-
-
-_OTHER_KERNEL_FILES: set = set()  # other packages' modules with kernels compiled through jit
-if _UserCacheLocator not in caching.CacheImpl._locator_classes:
-    caching.CacheImpl._locator_classes.insert(1, _UserCacheLocator)
-
-
-def jit(function):
-    """Compile ``function`` with the engine's numba options (see the module docstring)."""
-    source = Path(function.__code__.co_filename).resolve()
-    if source.parent != _PACKAGE:
-        _OTHER_KERNEL_FILES.add(source)
-    return njit(cache=True, error_model='numpy', nogil=True)(function)
 
 
 @contextlib.contextmanager

@@ -6,17 +6,13 @@ tuples of leaf fields, in the order of each message's definition (``POSE.fields`
 """
 import math
 
-from geometry_msgs.msg import PoseStamped
-
-from haptic_msgs.msg import CollisionState
-from haptic_util.cdr import MessageCodec
+from haptic_contract.collision_state import STATE, STATUS_INVALID_INPUT
+from haptic_contract.streams import POSE
 
 __all__ = ['InvalidPose', 'POSE', 'STATE', 'invalid_state', 'state', 'tip_pose',
            'tool_state']
 
 UNIT_QUATERNION_TOLERANCE = 1e-3  # |q| may differ from 1 by this much (float32 round trips)
-POSE = MessageCodec(PoseStamped)
-STATE = MessageCodec(CollisionState)
 _NAN3 = (math.nan, math.nan, math.nan)
 _NO_CONTACTS = ((), (), ())  # the face's three sequences, empty without a tool
 
@@ -90,6 +86,6 @@ def tool_state(header: tuple, probe, tip: tuple, orientation: tuple, compute_tim
 
 def invalid_state(header: tuple, disagreements: int) -> tuple:
     """Return the leaf fields of a state marked invalid: the renderer then sends zero force."""
-    return (*header, '', CollisionState.STATUS_INVALID_INPUT, math.nan, False, *_NAN3, *_NAN3,
+    return (*header, '', STATUS_INVALID_INPUT, math.nan, False, *_NAN3, *_NAN3,
             *_NAN3, *_NAN3, 0, False, disagreements, 0.0, *_NAN3, math.nan,
             *_NAN3, *_NO_CONTACTS)

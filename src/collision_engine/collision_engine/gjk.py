@@ -41,14 +41,11 @@ import numpy as np
 from collision_engine._jit import jit
 from collision_engine.signed_volumes import nearest_on_simplex
 from collision_engine.support import POINT, support
+from haptic_contract.collision_state import (STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
+                                             STATUS_NOT_CONVERGED, STATUS_OK)
 
 __all__ = ['STATUS_OK', 'STATUS_NOT_CONVERGED', 'STATUS_NO_OBJECT', 'STATUS_INVALID_INPUT',
            'gjk', 'power_of_two_inverse', 'support_difference']
-
-STATUS_OK = 0
-STATUS_NOT_CONVERGED = 1
-STATUS_NO_OBJECT = 2
-STATUS_INVALID_INPUT = 3
 
 _EPS = float(np.finfo(np.float64).eps)
 _ROUNDING = 1024.0 * _EPS

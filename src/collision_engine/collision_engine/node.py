@@ -17,11 +17,14 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from collision_engine import load_scene, read_scene
-from collision_engine.conversions import (invalid_state, InvalidPose, POSE, STATE, state,
-                                          tip_pose, tool_state)
+from collision_engine.conversions import (invalid_state, InvalidPose, POSE, STATE, state, tip_pose,
+                                          tool_state)
 from collision_engine.markers import contact_markers, scene_markers
 from collision_engine.params import CollisionNodeParams
 from collision_engine.probe import query_probe
+from haptic_contract.graph import (COLLISION_MARKERS, COLLISION_NEARBY, COLLISION_STATE,
+                                   SCENE_DESCRIPTION, WAND_POSE)
+from haptic_contract.streams import header as stamped_header
 from haptic_msgs.msg import CollisionStateArray
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
@@ -52,22 +55,22 @@ class CollisionNode(Node):
         self._answered = 0
         self._refused = Tally()  # poses answered with an invalid state, by fault
         self._last_result = None
-        self._state_pub = stream_publisher(self, STATE, 'collision/state')
-        self._nearby_pub = (self.create_publisher(CollisionStateArray, 'collision/nearby',
+        self._state_pub = stream_publisher(self, STATE, COLLISION_STATE)
+        self._nearby_pub = (self.create_publisher(CollisionStateArray, COLLISION_NEARBY,
                                                   HAPTIC_STREAM_QOS)
                             if self.params.report_radius > 0 else None)
-        stream_subscription(self, POSE, 'wand/pose', self.on_pose, refused=self._refused)
+        stream_subscription(self, POSE, WAND_POSE, self.on_pose, refused=self._refused)
 
-        description = self.create_publisher(String, 'scene/description', LATCHED_QOS)
+        description = self.create_publisher(String, SCENE_DESCRIPTION, LATCHED_QOS)
         description.publish(String(data=scene_path.read_text()))
         self.diagnostics = Diagnostics(self, self.report, self.params.diagnostics_period)
         if self.params.marker_rate > 0:
-            self._marker_pub = self.create_publisher(MarkerArray, 'collision/markers', MARKER_QOS)
+            self._marker_pub = self.create_publisher(MarkerArray, COLLISION_MARKERS, MARKER_QOS)
             self._scene_markers = scene_markers(read_scene(scene_path))
             self.create_timer(1.0 / self.params.marker_rate, self.publish_markers)
 
     def on_pose(self, pose: Sequence) -> None:
-        header = (pose[0], pose[1], pose[2])
+        header = stamped_header(pose)
         disagreements = self.scene.cross_validation_disagreements
         try:
             tip, orientation = tip_pose(pose, self.scene.frame_id)

@@ -1,6 +1,7 @@
 """The collision node's ROS parameters, in one place (see config/collision_engine.yaml)."""
 from dataclasses import dataclass
 
+from haptic_contract.shared_defaults import DEFAULT_SCENE
 from haptic_util.parameters import parameter
 
 __all__ = ['CollisionNodeParams']
@@ -8,9 +9,7 @@ __all__ = ['CollisionNodeParams']
 
 @dataclass(frozen=True)
 class CollisionNodeParams:
-    scene_file: str = parameter(
-        'package://collision_engine/scenes/cuboid.yaml',
-        'scene YAML: a path or package://<pkg>/<path>')
+    scene_file: str = parameter(DEFAULT_SCENE, 'scene YAML: a path or package://<pkg>/<path>')
     report_radius: float = parameter(
         0.0, 'also publish every object within this signed distance on collision/nearby '
         '(0 = nearest object only)', unit='m', low=0.0)

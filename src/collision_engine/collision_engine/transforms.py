@@ -8,16 +8,11 @@ Rx(roll)``); quaternions are in ROS order (x, y, z, w).
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from haptic_contract.checks import finite_vector
+
 __all__ = ['Pose']
 
 _ORTHONORMAL_TOLERANCE = 1e-9
-
-
-def _finite_vector(value, length: int, name: str) -> np.ndarray:
-    array = np.asarray(value, dtype=np.float64)
-    if array.shape != (length,) or not np.all(np.isfinite(array)):
-        raise ValueError(f'{name} must be {length} finite numbers, got {value!r}')
-    return array
 
 
 class Pose:
@@ -41,7 +36,7 @@ class Pose:
                 or np.linalg.det(rotation) < 0.0):
             raise ValueError('rotation must be orthonormal with determinant +1')
         translation = np.zeros(3) if translation is None else translation
-        self.translation = _finite_vector(translation, 3, 'translation').copy()
+        self.translation = finite_vector(translation, 3, 'translation').copy()
         self.rotation = rotation
         self.rotation.setflags(write=False)
         self.translation.setflags(write=False)
@@ -49,14 +44,14 @@ class Pose:
     @classmethod
     def from_rpy(cls, position=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0)) -> 'Pose':
         """Pose from a position (3,) m and fixed-axis roll, pitch, yaw (3,) rad."""
-        angles = _finite_vector(rpy, 3, 'rpy')
+        angles = finite_vector(rpy, 3, 'rpy')
         return cls(Rotation.from_euler('xyz', angles).as_matrix(), position)
 
     @classmethod
     def from_quaternion(cls, position=(0.0, 0.0, 0.0),
                         quaternion=(0.0, 0.0, 0.0, 1.0)) -> 'Pose':
         """Pose from a position (3,) m and a quaternion (x, y, z, w), normalised here."""
-        q = _finite_vector(quaternion, 4, 'quaternion')
+        q = finite_vector(quaternion, 4, 'quaternion')
         if np.linalg.norm(q) < 1e-12:
             raise ValueError(f'quaternion must be non-zero, got {quaternion!r}')
         return cls(Rotation.from_quat(q).as_matrix(), position)

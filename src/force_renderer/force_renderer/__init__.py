@@ -6,11 +6,10 @@ controller and saturation, so the ROS node only converts messages.
 """
 
 from force_renderer.contact import Contact
-from force_renderer.errors import ForceRendererError
+from force_renderer.errors import ForceRendererError, saturate
 from force_renderer.passivity import passivity_bound, passivity_warning, PassivityController
 from force_renderer.pipeline import ForcePipeline, PipelineConfig
 from force_renderer.proxy import GodObjectProxy
-from force_renderer.saturation import saturate
 from force_renderer.spring_damper import CentroidSpringDamper, ForceLaw, SpringDamper
 from force_renderer.velocity import VelocityEstimator
 from force_renderer.watchdog import Reason, Watchdog

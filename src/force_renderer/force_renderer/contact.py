@@ -11,16 +11,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from force_renderer._checks import vector3
+from force_renderer.errors import vector3
+from haptic_contract.collision_state import STATUS_INVALID_INPUT, STATUS_NO_OBJECT, \
+    STATUS_NOT_CONVERGED, STATUS_OK
 
 __all__ = ['Contact', 'FaceContact', 'STATUS_OK', 'STATUS_NOT_CONVERGED', 'STATUS_NO_OBJECT',
            'STATUS_INVALID_INPUT']
-
-# The collision engine's status codes, as haptic_msgs/CollisionState defines them.
-STATUS_OK = 0
-STATUS_NOT_CONVERGED = 1  # the distance is an upper bound: the force from it is never stronger
-STATUS_NO_OBJECT = 2
-STATUS_INVALID_INPUT = 3
 
 
 @dataclass(frozen=True, eq=False)

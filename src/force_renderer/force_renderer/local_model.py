@@ -16,11 +16,11 @@ from dataclasses import dataclass
 
 from force_renderer.contact import Contact
 from force_renderer.spring_damper import ForceLaw
+from haptic_contract.contact_model import Kind, MAX_PLANES
 
 __all__ = ['FREE', 'PLANES', 'UNAVAILABLE', 'LocalModel', 'local_model']
 
-FREE, PLANES, UNAVAILABLE = 0, 1, 2  # as haptic_msgs/ContactModel.KIND_*
-MAX_PLANES = 3
+FREE, PLANES, UNAVAILABLE = Kind.FREE, Kind.PLANES, Kind.UNAVAILABLE
 
 
 @dataclass(frozen=True)

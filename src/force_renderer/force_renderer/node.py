@@ -12,42 +12,30 @@ leaf values within one process.
 """
 from typing import Sequence
 
-from geometry_msgs.msg import Point, TwistStamped, WrenchStamped
-import numpy as np
+from geometry_msgs.msg import Point
 from rclpy.node import Node
 from visualization_msgs.msg import Marker
 
-from force_renderer.contact import Contact, FaceContact
-from force_renderer.local_model import local_model, MAX_PLANES
-from force_renderer.materials import PerObjectLaw
+from force_renderer.assembly import force_law, force_pipeline, passivity_warnings, state_contact
+from force_renderer.local_model import local_model
 from force_renderer.params import ForceRendererParams
-from force_renderer.passivity import passivity_warning
-from force_renderer.pipeline import ForcePipeline, PipelineConfig
-from force_renderer.probe import ProbeSpringDamper
-from force_renderer.proxy import GodObjectProxy
-from force_renderer.spring_damper import CentroidSpringDamper, SpringDamper
 from force_renderer.watchdog import Reason
-from haptic_msgs.msg import CollisionState, ContactModel
-from haptic_util.cdr import MessageCodec
+from haptic_contract.collision_state import STATE, STATUS_NOT_CONVERGED
+from haptic_contract.contact_model import MODEL, model_fields
+from haptic_contract.graph import (COLLISION_STATE, WAND_CONTACT_MODEL, WAND_FORCE_MARKER,
+                                   WAND_TWIST, WAND_WRENCH)
+from haptic_contract.streams import stamp_ns, TWIST, TWIST_LINEAR, WRENCH
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.paths import resolve_path
 from haptic_util.qos import MARKER_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 
 __all__ = ['ForceNode', 'main']
 
-MODEL = MessageCodec(ContactModel)
-PLANE_FIELDS = 15  # leaves of a ContactPlane
-STATE = MessageCodec(CollisionState)
-TWIST = MessageCodec(TwistStamped)
-WRENCH = MessageCodec(WrenchStamped)
 _ZERO = (0.0, 0.0, 0.0)
-_ORIENTATION = STATE.fields.index('orientation.x')
-_FACE = STATE.fields.index('contact_distance')  # then the points and the normals
 
 ARROW_SCALE = 0.01  # [m/N] length of the RViz force arrow per newton
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -60,18 +48,12 @@ class ForceNode(Node):
         super().__init__('force_renderer', **kwargs)
         self.params = params = declare_parameters(self, ForceRendererParams)
         try:
-            law, gains = self._law(params)
+            law, gains = force_law(params, announce=self.get_logger().info)
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
-        self.pipeline = ForcePipeline(law, PipelineConfig(
-            force_limit=params.force_limit, passivity=params.passivity,
-            max_damping=params.max_damping, servo_period=params.servo_period,
-            timeout=params.watchdog_timeout))
-        for stiffness, damping in gains:
-            warning = passivity_warning(stiffness, params.device_damping, params.servo_period,
-                                        damping)
-            if warning:
-                self.get_logger().warn(warning)
+        self.pipeline = force_pipeline(params, law)
+        for warning in passivity_warnings(params, gains):
+            self.get_logger().warn(warning)
         self._contact = None
         self._header = None
         self._twist = None
@@ -80,76 +62,34 @@ class ForceNode(Node):
         self._refused = Tally()  # input that was no message of its type
         self._approximate = 0  # states whose distance is an upper bound (NOT_CONVERGED)
         self._force = self._torque = _ZERO
-        self._wrench_pub = stream_publisher(self, WRENCH, 'wand/wrench')
-        self._model_pub = stream_publisher(self, MODEL, 'wand/contact_model')
-        stream_subscription(self, STATE, 'collision/state', self.on_state,
+        self._wrench_pub = stream_publisher(self, WRENCH, WAND_WRENCH)
+        self._model_pub = stream_publisher(self, MODEL, WAND_CONTACT_MODEL)
+        stream_subscription(self, STATE, COLLISION_STATE, self.on_state,
                             refused=self._refused)
         uses_damping = any(max(damping) > 0.0 for _, damping in gains)
         if uses_damping and params.velocity_source == 'twist':
-            stream_subscription(self, TWIST, 'wand/twist', self.on_twist, refused=self._refused)
+            stream_subscription(self, TWIST, WAND_TWIST, self.on_twist, refused=self._refused)
         self.create_timer(params.watchdog_timeout / 2, self.check_stale)
         self.diagnostics = Diagnostics(self, self.report, DIAGNOSTICS_PERIOD)
         if params.marker_rate > 0:
-            self._marker_pub = self.create_publisher(Marker, 'wand/force_marker', MARKER_QOS)
+            self._marker_pub = self.create_publisher(Marker, WAND_FORCE_MARKER, MARKER_QOS)
             self.create_timer(1.0 / params.marker_rate, self.publish_marker)
         passivity = 'on' if params.passivity else 'off'
         self.get_logger().info(f'{params.law} law, passivity {passivity}, '
                                f'force limit {params.force_limit:g} N')
 
-    def _law(self, params: ForceRendererParams):
-        """Build the force law; return it and every (stiffness, damping) it renders with."""
-        default = (params.stiffness, params.damping)
-        if not params.scene_file:
-            if params.law != 'normal':
-                raise ValueError(f'law {params.law!r} needs parameter scene_file')
-            return SpringDamper(*default), [default]
-        scene_path = resolve_path(params.scene_file, what='parameter scene_file')
-        from collision_engine import read_scene
-        spec = read_scene(scene_path)
-        materials = {o.name: (tuple(o.material.stiffness), tuple(o.material.damping))
-                     for o in spec.objects if o.material is not None}
-        gains = [default, *materials.values()]
-        if spec.tool is not None:
-            if params.law != 'normal':
-                raise ValueError(f'law {params.law!r} renders a point tip, and the scene '
-                                 f'{scene_path} mounts a tool: use the normal law')
-            laws = {name: ProbeSpringDamper(*gain) for name, gain in materials.items()}
-            return PerObjectLaw(laws, ProbeSpringDamper(*default)), gains
-        if params.law == 'proxy':
-            from collision_engine import load_scene
-            scene = load_scene(scene_path, announce=self.get_logger().info)  # warmed up
-
-            def signed_distance(point):
-                result = scene.query(point)
-                return result.distance, result.normal
-            return GodObjectProxy(*default, signed_distance), [default]
-        if params.law == 'centroid':
-            from force_renderer.centroids import vertex_centroids
-            centroids = vertex_centroids(spec)
-            laws = {name: CentroidSpringDamper(*materials.get(name, default), centroid)
-                    for name, centroid in centroids.items()}
-            return PerObjectLaw(laws, SpringDamper(*default)), gains
-        laws = {name: SpringDamper(*gain) for name, gain in materials.items()}
-        return PerObjectLaw(laws, SpringDamper(*default)), gains
-
     def on_twist(self, fields: Sequence) -> None:
-        sec, nanosec, _, vx, vy, vz, _, _, _ = fields
-        self._twist = (sec * 1_000_000_000 + nanosec, (vx, vy, vz))
+        self._twist = (stamp_ns(fields), tuple(fields[TWIST_LINEAR]))
 
     def on_state(self, fields: Sequence) -> None:
-        (sec, nanosec, frame, name, status, distance, _, px, py, pz, nx, ny, nz, _, _, _,
-         tx, ty, tz) = fields[:19]
-        stamp_ns = sec * 1_000_000_000 + nanosec
-        self._approximate += status == CollisionState.STATUS_NOT_CONVERGED
-        self._contact = Contact.from_floats(distance, (px, py, pz), (nx, ny, nz), (tx, ty, tz),
-                                            name, stamp_ns * 1e-9, status, _face(fields))
-        self._header = (sec, nanosec, frame)
-        self.render(self._velocity(stamp_ns))
+        self._header, stamp, self._contact = state_contact(fields)
+        self._approximate += self._contact.status == STATUS_NOT_CONVERGED
+        self.render(self._velocity(stamp))
 
-    def _velocity(self, stamp_ns: int):
-        """Return the twist of the state's pose, or None (the pipeline then estimates it)."""
+    def _velocity(self, stamp: int):
+        """Return the twist of the pose stamped ``stamp`` (ns), or None (then it is estimated)."""
         twist = self._twist
-        if twist is None or abs(twist[0] - stamp_ns) > self.params.watchdog_timeout * 1e9:
+        if twist is None or abs(twist[0] - stamp) > self.params.watchdog_timeout * 1e9:
             return None
         return twist[1]
 
@@ -171,14 +111,10 @@ class ForceNode(Node):
 
     def _model_fields(self, model) -> tuple:
         """Return the leaf fields of the ContactModel of ``model`` and the current contact."""
-        planes = [value for plane in model.planes
-                  for value in (*plane[0], *plane[1], *plane[2], *plane[3],
-                                *(plane[4] if len(plane) > 4 else _ZERO))]
-        planes += [0.0] * (PLANE_FIELDS * MAX_PLANES - len(planes))
-        tip = self._contact.tip.tolist()
-        return (*self._header, self._contact.object, model.kind, len(model.planes), *planes,
-                self.params.force_limit, self.params.model_lifetime, model.valid_radius, *tip,
-                *self._force, *self._torque)
+        return model_fields(self._header, self._contact.object, model.kind, model.planes,
+                            self.params.force_limit, self.params.model_lifetime,
+                            model.valid_radius, self._contact.tip.tolist(),
+                            (*self._force, *self._torque))
 
     def check_stale(self) -> None:
         """Publish zero force while the collision state is stale (after the first one)."""
@@ -223,18 +159,6 @@ class ForceNode(Node):
         self.diagnostics.final()
         self.get_logger().info(f'published {self._published} wrenches')
         return super().destroy_node()
-
-
-def _face(fields: list) -> FaceContact | None:
-    """Return the tool's face from a CollisionState's leaves, or None when it has no tool."""
-    distance, points, normals = fields[_FACE:_FACE + 3]
-    if not distance:
-        return None
-    from collision_engine.probe import rotation_matrix
-
-    return FaceContact(np.array(distance), np.array(points).reshape(-1, 3),
-                       np.array(normals).reshape(-1, 3),
-                       rotation_matrix(fields[_ORIENTATION:_ORIENTATION + 4]))
 
 
 def main(args=None) -> int:

@@ -1,6 +1,8 @@
 """The force renderer's ROS parameters, in one place (see config/force_renderer.yaml)."""
 from dataclasses import dataclass
 
+from haptic_contract.shared_defaults import DEFAULT_SCENE, DEVICE_DAMPING, FORCE_LIMIT, \
+    LOOP_PERIOD
 from haptic_util.parameters import parameter
 
 __all__ = ['ForceRendererParams', 'LAWS']
@@ -13,19 +15,21 @@ class ForceRendererParams:
     law: str = parameter('normal', 'normal: spring-damper along the surface normal; proxy: '
                          'god-object proxy (no pop-through); centroid: the paper\'s law, for '
                          'comparison only', choices=LAWS)
-    scene_file: str = parameter('', 'scene YAML for per-object materials (and the proxy and '
-                                'centroid laws); empty: stiffness and damping below for all')
+    scene_file: str = parameter(DEFAULT_SCENE, 'scene YAML for per-object materials (and the '
+                                'proxy and centroid laws); empty: stiffness and damping below '
+                                'for all')
     stiffness: tuple[float, ...] = parameter((160.0, 160.0, 160.0), 'K per world axis, for '
                                              'objects without a material', unit='N/m', low=0.0,
                                              length=3)
     damping: tuple[float, ...] = parameter((0.8, 0.8, 0.8), 'C per world axis, in contact only, '
                                            'for objects without a material', unit='N*s/m',
                                            low=0.0, length=3)
-    force_limit: float = parameter(10.0, 'device force limit (saturation)', unit='N', low=0.0)
+    force_limit: float = parameter(FORCE_LIMIT, 'device force limit (saturation)', unit='N',
+                                   low=0.0)
     passivity: bool = parameter(True, 'time-domain passivity observer and controller')
-    device_damping: float = parameter(2.0, 'the device\'s physical damping b, for the '
+    device_damping: float = parameter(DEVICE_DAMPING, 'the device\'s physical damping b, for the '
                                       'passivity bound', unit='N*s/m', low=0.0)
-    servo_period: float = parameter(0.001, 'servo period T, for the passivity bound and '
+    servo_period: float = parameter(LOOP_PERIOD, 'servo period T, for the passivity bound and '
                                     'controller', unit='s', low=1e-5, high=0.1)
     max_damping: float = parameter(100.0, 'largest damping the passivity controller adds',
                                    unit='N*s/m', low=0.0)

@@ -38,7 +38,7 @@ wall (seen at the port when the deficit was kept for good).
 
 import math
 
-from force_renderer._checks import non_negative, per_axis, positive
+from force_renderer.errors import non_negative, per_axis, positive
 
 __all__ = ['BOOKS_CLOSE_AFTER', 'PassivityController', 'passivity_bound', 'passivity_warning']
 

@@ -9,13 +9,14 @@ import math
 
 import numpy as np
 
-from force_renderer._checks import floats3, non_negative, positive
 from force_renderer.contact import Contact, STATUS_INVALID_INPUT, STATUS_NO_OBJECT
+from force_renderer.errors import non_negative, positive
 from force_renderer.passivity import PassivityController
-from force_renderer.saturation import saturate_components
 from force_renderer.spring_damper import ForceLaw
 from force_renderer.velocity import VelocityEstimator
 from force_renderer.watchdog import Reason, Watchdog
+from haptic_contract.checks import floats3
+from haptic_contract.plane_law import saturate_components
 
 __all__ = ['ForcePipeline', 'PipelineConfig']
 
@@ -128,14 +129,14 @@ class ForcePipeline:
             if twist is None:
                 twist = self.velocity_estimator.velocity_components()
             raw = floats3(self.law.force(contact, twist))
-            force = saturate_components(*raw, limit)
+            force = saturate_components(raw, limit)
             axis = self.law.axis(contact)
             torque = self.law.torque(contact)
             if torque != _ZERO:
                 self.last_torque = _scaled(torque, force, raw)
         if self.passivity is not None:
             force = saturate_components(
-                *self.passivity.control(force, twist, position, now, axis), limit)
+                self.passivity.control(force, twist, position, now, axis), limit)
             self.passivity.record(force)
         return np.array(force)
 

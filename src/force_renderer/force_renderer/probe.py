@@ -15,7 +15,7 @@ the restoring torque −k cos θ sin θ ⟨y²⟩ (⟨y²⟩ the mean square of 
 tilted side: L²/12 (1 − 1/m²) for m cells along a side L; the continuous face's L²/12 as m grows).
 The damper here acts on the tip's linear velocity (the state carries no angular one); the
 device's own rendering of the model's planes damps each tool point's velocity, rotation included
-(``haptic_wand_driver.contact_model``).
+(``haptic_contract.contact_model``).
 
 Contact set: the points with d > 0. With none, the law pushes nothing; its local model then
 holds the whole face, for the contact the device may meet before the next state.
@@ -24,9 +24,10 @@ import math
 
 import numpy as np
 
-from force_renderer._checks import floats3
 from force_renderer.contact import Contact
-from force_renderer.spring_damper import SpringDamper, unilateral_spring_damper
+from force_renderer.spring_damper import SpringDamper
+from haptic_contract.checks import floats3
+from haptic_contract.plane_law import unilateral_spring_damper
 
 __all__ = ['ProbeSpringDamper', 'equivalent_points']
 

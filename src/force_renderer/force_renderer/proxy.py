@@ -17,14 +17,16 @@ from typing import Callable
 
 import numpy as np
 
-from force_renderer._checks import count, floats3, per_axis, positive, vector3
 from force_renderer.contact import Contact
-from force_renderer.spring_damper import nearest_plane, unilateral_spring_damper
+from force_renderer.errors import count, per_axis, positive, vector3
+from force_renderer.spring_damper import nearest_plane
+from haptic_contract.checks import floats3
+from haptic_contract.contact_model import MAX_PLANES
+from haptic_contract.plane_law import unilateral_spring_damper
 
 __all__ = ['GodObjectProxy']
 
 SignedDistance = Callable[[np.ndarray], tuple[float, np.ndarray]]
-_MAX_PLANES = 3
 # A move along a tangent plane must not count as heading into it because of rounding: only a
 # direction whose cosine with the outward normal is below this does.
 _INTO_SURFACE = -1e-6
@@ -137,7 +139,7 @@ class GodObjectProxy:
         for iteration in range(self.iterations):
             proxy, hit = self._advance(proxy, goal)
             if hit is not None:
-                planes = (planes + [hit])[-_MAX_PLANES:]
+                planes = (planes + [hit])[-MAX_PLANES:]
                 goal = _nearest_feasible(tip, planes, proxy, self.tolerance)
             elif goal is tip or iteration == self.iterations - 1:
                 break

@@ -11,12 +11,12 @@ from typing import Protocol
 
 import numpy as np
 
-from force_renderer._checks import floats3, per_axis, vector3
 from force_renderer.contact import Contact
-from force_renderer.errors import ForceRendererError
+from force_renderer.errors import ForceRendererError, per_axis, vector3
+from haptic_contract.checks import floats3
+from haptic_contract.plane_law import unilateral_spring_damper
 
-__all__ = ['CentroidSpringDamper', 'ForceLaw', 'SpringDamper', 'nearest_plane',
-           'unilateral_spring_damper']
+__all__ = ['CentroidSpringDamper', 'ForceLaw', 'SpringDamper', 'nearest_plane']
 
 Vector3 = tuple[float, float, float]
 _ZERO = (0.0, 0.0, 0.0)
@@ -50,35 +50,6 @@ class ForceLaw(Protocol):
         N·s/m), the point on the plane the tip's centre may not cross (``local_model``), and
         optionally the tool point it pushes (3,) m in the tip frame (omitted: the tip).
         """
-
-
-def unilateral_spring_damper(displacement: Vector3, normal: Vector3, velocity: Vector3,
-                             stiffness: Vector3, damping: Vector3) -> Vector3:
-    """K⊙x − C⊙v with its component along `normal` clipped at zero, as plain floats.
-
-    Why clip: on the way out of a surface the damper opposes the outward motion and can outweigh
-    the spring near the surface; the clip keeps it from pulling the tip back in (a sticky wall).
-
-    Parameters
-    ----------
-    displacement : (3,) float, m
-        Spring extension x, pointing out of the surface (towards where the tip should be).
-    normal : (3,) float
-        Unit outward normal that decides what "attractive" means.
-    velocity : (3,) float, m/s
-        Tip velocity.
-    stiffness, damping : (3,) float, N/m and N·s/m
-        Per-axis gains along the frame's axes.
-    """
-    fx = stiffness[0] * displacement[0] - damping[0] * velocity[0]
-    fy = stiffness[1] * displacement[1] - damping[1] * velocity[1]
-    fz = stiffness[2] * displacement[2] - damping[2] * velocity[2]
-    pushing = fx * normal[0] + fy * normal[1] + fz * normal[2]
-    if pushing < 0.0:
-        fx -= pushing * normal[0]
-        fy -= pushing * normal[1]
-        fz -= pushing * normal[2]
-    return fx, fy, fz
 
 
 def nearest_plane(contact: Contact) -> tuple[Vector3, Vector3]:

@@ -10,7 +10,8 @@ import math
 
 import numpy as np
 
-from force_renderer._checks import floats3, positive
+from force_renderer.errors import positive
+from haptic_contract.checks import floats3
 
 __all__ = ['VelocityEstimator']
 

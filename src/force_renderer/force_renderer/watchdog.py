@@ -8,7 +8,7 @@ as soon as fresh, valid, in-order input arrives.
 import enum
 import math
 
-from force_renderer._checks import positive
+from force_renderer.errors import positive
 
 __all__ = ['Reason', 'Watchdog']
 

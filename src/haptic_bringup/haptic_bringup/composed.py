@@ -18,8 +18,9 @@ import functools
 import importlib
 import sys
 
-from haptic_bringup.launcher import NO_INTRA_PROCESS, NODES, RECORDERS, TELEOP_NODES
+from haptic_bringup.launcher import NO_INTRA_PROCESS
 from haptic_bringup.process_recorder import ProcessRecorder
+from haptic_contract.graph import NODES, RECORDERS, TELEOP_NODES
 from haptic_util import intra_process
 from haptic_util.executor import run_nodes
 
@@ -38,8 +39,7 @@ def main(args=None) -> int:
         print(f'error: unknown node(s) {unknown}; choose from {[*known, *RECORDERS]}',
               file=sys.stderr)
         return 2
-    factories = [getattr(importlib.import_module(module), cls)
-                 for _, module, cls in (known[n] for n in names)]
+    factories = [getattr(importlib.import_module(known[n].module), known[n].cls) for n in names]
     factories += [functools.partial(ProcessRecorder, name) for name in RECORDERS
                   if name in given]
     if NO_INTRA_PROCESS not in given:

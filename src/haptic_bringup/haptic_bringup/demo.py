@@ -31,6 +31,8 @@ from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig, SCAN_DURA
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import (published_counts, PUBLISHERS, read_frames, read_session,
                                     read_vectors, reported, topic_counts)
+from haptic_contract.graph import absolute, REMOTE_PREFIX, ROBOT_FT_WRENCH, WAND_APPLIED_WRENCH
+from haptic_contract.teleop import Scheme
 
 __all__ = ['main', 'EXPERIMENTS', 'run_experiment']
 
@@ -47,7 +49,7 @@ EXPERIMENTS = {
 DURATION = 10.0  # [s] as the paper's experiments
 TELEOP = 'teleop'
 TELEOP_LINK = {'delay': 0.05, 'jitter': 0.005, 'loss': 0.01}  # [s, s, probability]
-TELEOP_SCHEME = 'model'
+TELEOP_SCHEME = Scheme.MODEL.value
 FORCE_SCALE = 0.3  # the leader's default
 
 
@@ -88,10 +90,11 @@ def run_teleop(out: pathlib.Path, *, domain_id: int = 42) -> pathlib.Path:
 def summarise_teleop(bag: pathlib.Path) -> str:
     """Summarise the scan: the patient's force and the hand's while pressing, the round trip."""
     typestore = typestore_with(custom_definitions())
-    series = read_vectors(bag, typestore, {'/wand/applied_wrench': 'wrench',
-                                           '/remote/robot/ft_sensor/wrench': 'wrench'})
-    patient = np.linalg.norm(series['/remote/robot/ft_sensor/wrench'][1], axis=1)
-    felt = np.linalg.norm(series['/wand/applied_wrench'][1], axis=1)
+    felt_topic = absolute(WAND_APPLIED_WRENCH)
+    patient_topic = REMOTE_PREFIX + absolute(ROBOT_FT_WRENCH)
+    series = read_vectors(bag, typestore, {felt_topic: 'wrench', patient_topic: 'wrench'})
+    patient = np.linalg.norm(series[patient_topic][1], axis=1)
+    felt = np.linalg.norm(series[felt_topic][1], axis=1)
     round_trip = reported(bag, typestore, 'round_trip_s').get('teleop_leader', ['nan'])[-1]
     frames = read_frames(bag, typestore)
     latency = frames.received - frames.stamp

@@ -39,51 +39,27 @@ from ament_index_python.packages import get_package_share_directory
 import yaml
 
 from haptic_bringup.discovery import GraphWatcher
-from haptic_bringup.processes import (clean_stale_shm, shm_segments, start_child,
-                                      stop_children, wait_any_exit)
+from haptic_bringup.processes import (clean_stale_shm, shm_segments, start_child, stop_children,
+                                      wait_any_exit)
+from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGER, LOOP_RECORDER,
+                                   NODES, OPERATOR_RECORDED, OPERATOR_RECORDER, OPERATOR_SITE,
+                                   PROBE_IMAGE, RECORDERS, REMOTE_PREFIX, REMOTE_RECORDED,
+                                   REMOTE_RECORDER, REMOTE_SITE, ROBOT_FT_WRENCH,
+                                   ROBOT_TARGET_POSE, ROBOT_TCP_POSE, TELEOP_COMMAND,
+                                   TELEOP_FEEDBACK, TELEOP_NODES, WAND_CONTACT_MODEL, WAND_POSE,
+                                   WAND_WRENCH)
+from haptic_contract.teleop import Scheme, SCHEMES
 from haptic_util.executor import end_process
 from remote_probe.link import silence_timeout
 
 __all__ = ['LoopConfig', 'Loop', 'main', 'loop_environment', 'NODES']
 
-# node name → (package, module with main(), Node class)
-NODES = {
-    'wand_driver': ('haptic_wand_driver', 'haptic_wand_driver.node', 'WandDriverNode'),
-    'collision_engine': ('collision_engine', 'collision_engine.node', 'CollisionNode'),
-    'force_renderer': ('force_renderer', 'force_renderer.node', 'ForceNode'),
-}
-TELEOP_NODES = {
-    'teleop_leader': ('remote_probe', 'remote_probe.leader_node', 'LeaderNode'),
-    'sim_robot': ('remote_probe', 'remote_probe.robot_node', 'SimulatedRobotNode'),
-    'teleop_follower': ('remote_probe', 'remote_probe.follower_node', 'FollowerNode'),
-    'probe_imager': ('ultrasound_sim', 'ultrasound_sim.node', 'ProbeImagerNode'),
-}
-OPERATOR_SITE = ('wand_driver', 'teleop_leader')
-REMOTE_SITE = ('sim_robot', 'teleop_follower')
-IMAGER = 'probe_imager'  # the remote site's ultrasound scanner, unless LoopConfig.imaging is off
-# The recorder in each kind of process (haptic_bringup.process_recorder), by its node name.
-RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
-    'recorder', 'operator_recorder', 'remote_recorder')
-REMOTE_PREFIX = '/remote'  # where the remote site's topics go in its bag
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 LATE_POSE_HOLD = 0.5  # [s] past the stalls seen with the machine fully loaded (up to 0.45 s)
 MODEL_STEP_RATE = 5.0  # [N/s] at the hand: 17 N/s at the patient, above the scan's 13 (p99)
 LINK_TIMEOUT = 0.1  # [s] both ends' watchdogs on a link without jitter (their defaults)
-TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
-IMAGE = '/probe/image'
-TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',
-               f'{IMAGE}:sensor_msgs/msg/Image')
-FRAMES = (IMAGE,)  # what crosses as frames: after the streams, dropped when congested
-# A session's bag holds what each site measured and what crossed the link, recorded where it
-# arrives (its sent copy is the same message, earlier). Left out, each one step from those and
-# read by no analysis: the wand's twist (the pose's rate), the leader's answer to its driver (the
-# feedback through the leader) and the robot's target (the command through the patient-safety
-# filter). Each 1 kHz stream recorded costs its writer and the recorder about 5 % of a core
-# (docs/cpu_budget.md), on two cores that hold both sites. The probe's image is recorded where
-# the operator sees it, once: its stamp is the pose's, so the bag gives pose to image there.
-OPERATOR_RECORDED = ('/wand/pose', '/wand/applied_wrench', '/teleop/feedback', '/diagnostics')
-REMOTE_RECORDED = ('/robot/tcp_pose', '/robot/ft_sensor/wrench', '/teleop/command', '/diagnostics')
+IMAGE = absolute(PROBE_IMAGE)
 COMPOSED_MODULE = 'haptic_bringup.composed'
 NO_INTRA_PROCESS = '--no-intra-process'  # the composed process's streams through DDS
 RECORDER_MODULE = 'haptic_bringup.recorder'
@@ -159,7 +135,7 @@ def loop_environment(domain_id: int, log_dir: pathlib.Path) -> dict:
 def node_parameters(config: LoopConfig) -> dict:
     """Every node's parameters: package defaults, then the user's file, then the options."""
     merged = {}
-    packages = {package for package, _, _ in (*NODES.values(), *TELEOP_NODES.values())}
+    packages = {entry.package for entry in (*NODES.values(), *TELEOP_NODES.values())}
     for package in sorted(packages):
         share = pathlib.Path(get_package_share_directory(package))
         merged.update(yaml.safe_load((share / 'config' / f'{package}.yaml').read_text()) or {})
@@ -208,8 +184,8 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
         package, relative = SCAN_SCRIPT
         driver['experiment'] = str(pathlib.Path(get_package_share_directory(package)) / relative)
         driver.setdefault('duration', SCAN_DURATION)
-    driver['rendering'] = 'local' if scheme == 'model' else 'remote'
-    driver['passivity'] = scheme != 'direct'
+    driver['rendering'] = 'local' if scheme == Scheme.MODEL else 'remote'
+    driver['passivity'] = scheme != Scheme.DIRECT
     driver['hold_while_late'] = LATE_POSE_HOLD
     driver['model_step_rate'] = MODEL_STEP_RATE
     timeout = silence_timeout(LINK_TIMEOUT, float(config.link.get('jitter', 0.0)))
@@ -242,17 +218,17 @@ def teleop_endpoints(config: LoopConfig) -> dict:
     """
     site = 0 if config.intra_process else 1  # a subscriber in the publisher's process
     recording = site if config.record else 0
-    reports = {'/diagnostics': (0, 1)} if config.record else {}
+    reports = {DIAGNOSTICS: (0, 1)} if config.record else {}
+    command, feedback = absolute(TELEOP_COMMAND), absolute(TELEOP_FEEDBACK)
     imaged = config.imaging
     return {
-        config.domain_id: {'/wand/pose': (1, site + recording), '/teleop/command': (1, 1),
-                           '/teleop/feedback': (1, 1 + recording), **reports,
+        config.domain_id: {absolute(WAND_POSE): (1, site + recording), command: (1, 1),
+                           feedback: (1, 1 + recording), **reports,
                            **({IMAGE: (1, int(bool(config.record)))} if imaged else {})},
-        config.remote_domain_id: {'/teleop/command': (1, 1 + recording),
-                                  '/teleop/feedback': (1, 1),
-                                  '/robot/target_pose': (1, site),
-                                  '/robot/tcp_pose': (1, site + recording + site * imaged),
-                                  '/robot/ft_sensor/wrench': (1, site + recording), **reports,
+        config.remote_domain_id: {command: (1, 1 + recording), feedback: (1, 1),
+                                  absolute(ROBOT_TARGET_POSE): (1, site),
+                                  absolute(ROBOT_TCP_POSE): (1, site + recording + site * imaged),
+                                  absolute(ROBOT_FT_WRENCH): (1, site + recording), **reports,
                                   **({IMAGE: (1, 1)} if imaged else {})},
     }
 
@@ -273,12 +249,13 @@ def expected_endpoints(config: LoopConfig) -> dict:
         return recording + over_dds * (node in running)
     endpoints = {}
     if 'wand_driver' in running:
-        endpoints['/wand/pose'] = (1, subscribers('collision_engine'))
+        endpoints[absolute(WAND_POSE)] = (1, subscribers('collision_engine'))
     if 'collision_engine' in running:
-        endpoints['/collision/state'] = (1, subscribers('force_renderer'))
-        endpoints.setdefault('/wand/pose', (0, 1))
+        endpoints[absolute(COLLISION_STATE)] = (1, subscribers('force_renderer'))
+        endpoints.setdefault(absolute(WAND_POSE), (0, 1))
     if 'force_renderer' in running:
-        endpoints['/wand/wrench'] = endpoints['/wand/contact_model'] = (1, recording)
+        endpoints[absolute(WAND_WRENCH)] = endpoints[absolute(WAND_CONTACT_MODEL)] = (
+            1, recording)
     return endpoints
 
 
@@ -328,7 +305,7 @@ class Loop:
         else:
             for name in config.nodes:
                 self.children.append(start_child(
-                    name, [config.python, '-m', NODES[name][1], *ros_args], env))
+                    name, [config.python, '-m', NODES[name].module, *ros_args], env))
         self._wait_for_discovery(config.domain_id)
         self.startup_time = time.monotonic() - started
 
@@ -454,7 +431,7 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='stop after this many seconds of closed loop (0: until Ctrl-C or '
                         'the end of the experiment)')
     parser.add_argument('--record', metavar='DIR', help='record a rosbag2 (mcap) to DIR')
-    parser.add_argument('--teleop', choices=('direct', 'tdpa', 'model'),
+    parser.add_argument('--teleop', choices=SCHEMES,
                         help='a telerobotic session over an emulated link with this bilateral '
                         'scheme (the experiment defaults to the scripted scan)')
     parser.add_argument('--delay', type=float, default=0.0, help='teleop: one-way link delay [s]')

@@ -17,8 +17,8 @@ The process builds this node last (``haptic_bringup.composed``), so it is destro
 every other node has said its last words. Each telerobotic site runs one and writes its own bag
 (``operator``, ``remote``: see ``haptic_bringup.session``).
 """
-from haptic_bringup.params import STREAMS, TOPIC_TYPES
 from haptic_bringup.recorder import message_class, Recorder
+from haptic_contract.graph import STREAMS, TOPIC_TYPES
 from haptic_util.cdr import MessageCodec
 from haptic_util.intra_process import stream_subscription
 

@@ -40,9 +40,9 @@ from rclpy.serialization import deserialize_message, serialize_message
 from std_msgs.msg import Bool
 
 from haptic_bringup.bag import typestore_with
-from haptic_bringup.params import (DIAGNOSTICS, FRAME_TOPICS, LATCHED_TOPICS, RecorderParams,
-                                   TOPIC_TYPES)
+from haptic_bringup.params import RecorderParams
 from haptic_bringup.queued_bag import QueuedBag
+from haptic_contract.graph import DIAGNOSTICS, FRAME_TOPICS, LATCHED_TOPICS, TOPIC_TYPES
 from haptic_util import diagnostics
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError

@@ -15,20 +15,16 @@ import numpy as np
 from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import killed_bags
+from haptic_contract.graph import (absolute, COLLISION_STATE, PUBLISHERS, SCENE_DESCRIPTION,
+                                   SITE_PUBLISHERS, WAND_APPLIED_WRENCH, WAND_WRENCH)
 from haptic_util.stamps import to_nanoseconds
 
 __all__ = ['Frames', 'Session', 'bags', 'read_frames', 'read_session', 'read_vectors',
            'reported', 'topic_counts', 'published_counts', 'applied_work', 'PUBLISHERS',
            'SITE_PUBLISHERS']
 
-# Which node publishes each stream, by its name in /diagnostics reports (a node publishes each
-# of its streams once per count): the loop's, and a telerobotic site's own measurements.
-PUBLISHERS = {'/wand/pose': 'wand_driver', '/wand/twist': 'wand_driver',
-              '/wand/applied_wrench': 'wand_driver', '/collision/state': 'collision_engine',
-              '/wand/wrench': 'force_renderer', '/wand/contact_model': 'force_renderer'}
-SITE_PUBLISHERS = {'/wand/pose': 'wand_driver', '/wand/applied_wrench': 'wand_driver',
-                   '/remote/robot/tcp_pose': 'sim_robot',
-                   '/remote/robot/ft_sensor/wrench': 'sim_robot'}
+_STATE, _WRENCH = absolute(COLLISION_STATE), absolute(WAND_WRENCH)
+_APPLIED, _SCENE = absolute(WAND_APPLIED_WRENCH), absolute(SCENE_DESCRIPTION)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -127,17 +123,17 @@ def read_session(path: pathlib.Path, typestore) -> Session:
     with AnyReader(bags(path), default_typestore=typestore) as reader:
         for connection, _, raw in reader.messages():
             msg = reader.deserialize(raw, connection.msgtype)
-            if connection.topic == '/collision/state':
+            if connection.topic == _STATE:
                 states[to_nanoseconds(msg.header.stamp)] = msg
-            elif connection.topic == '/wand/wrench':
+            elif connection.topic == _WRENCH:
                 wrenches[to_nanoseconds(msg.header.stamp)] = msg
-            elif connection.topic == '/wand/applied_wrench':
+            elif connection.topic == _APPLIED:
                 applied[to_nanoseconds(msg.header.stamp)] = msg
-            elif connection.topic == '/scene/description':
+            elif connection.topic == _SCENE:
                 scene = msg.data
     stamps = sorted(states)
     if not stamps:
-        raise ValueError(f'{path}: no /collision/state messages')
+        raise ValueError(f'{path}: no {_STATE} messages')
     rows = [states[s] for s in stamps]
     nan3 = (np.nan, np.nan, np.nan)
     forces = [_xyz(wrenches[s].wrench.force) if s in wrenches else nan3 for s in stamps]

@@ -32,10 +32,11 @@ from typing import Optional
 
 import yaml
 
-from haptic_bringup.launcher import (FRAMES, link_parameters, Loop, loop_environment,
-                                     LoopConfig, node_parameters, site_nodes, teleop_endpoints,
-                                     TO_OPERATOR, TO_REMOTE)
+from haptic_bringup.launcher import (link_parameters, Loop, loop_environment, LoopConfig,
+                                     node_parameters, site_nodes, teleop_endpoints)
 from haptic_bringup.processes import start_child
+from haptic_contract.graph import FRAME_TOPICS, TO_OPERATOR, TO_REMOTE
+from haptic_contract.teleop import Scheme, SCHEMES
 from site_gateway.certs import init_ca, issue
 
 __all__ = ['GATEWAY_MODULE', 'SiteConfig', 'Site', 'gateway_argv', 'gateway_parameters',
@@ -63,7 +64,7 @@ def gateway_parameters(role: str, *, listen=(), connect=(), certs: Optional[str]
     return {'role': role, 'listen': list(listen) or [''], 'connect': list(connect) or [''],
             'certs': str(pathlib.Path(certs).expanduser().resolve()) if certs else '',
             'insecure': insecure, 'to_remote': list(TO_REMOTE),
-            'to_operator': list(TO_OPERATOR), 'frames': list(FRAMES), **(link or {})}
+            'to_operator': list(TO_OPERATOR), 'frames': list(FRAME_TOPICS), **(link or {})}
 
 
 def site_parameters(site: SiteConfig) -> dict:
@@ -164,7 +165,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument('--certs', metavar='DIR', help="this site's files from haptic_certs")
     parser.add_argument('--insecure', action='store_true',
                         help='plaintext tcp/ endpoints, no certificates (warned at every start)')
-    parser.add_argument('--scheme', choices=('direct', 'tdpa', 'model'), default='model',
+    parser.add_argument('--scheme', choices=SCHEMES, default=Scheme.MODEL.value,
                         help='bilateral scheme, the same on both sites (default: model)')
     parser.add_argument('--experiment', help="operator: the operator's script (default: the "
                         'scripted scan)')

@@ -22,6 +22,7 @@ import yaml
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
 from haptic_bringup.launcher import LoopConfig, site_nodes
 from haptic_bringup.site import site_parameters, SiteConfig
+from haptic_contract.teleop import SCHEMES
 
 __all__ = ['site_launch_description']
 
@@ -61,7 +62,7 @@ def _site(role: str, context) -> SiteConfig:
 
 def _processes(context, role: str):
     site = _site(role, context)
-    if site.loop.teleop not in ('direct', 'tdpa', 'model'):
+    if site.loop.teleop not in SCHEMES:
         raise ValueError(f'scheme:={site.loop.teleop!r}: choose direct, tdpa or model')
     with tempfile.NamedTemporaryFile('w', prefix=f'{role}_site_', suffix='.yaml',
                                      delete=False) as out:

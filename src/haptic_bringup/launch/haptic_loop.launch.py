@@ -28,11 +28,9 @@ from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
-from haptic_bringup.launcher import LOOP_RECORDER
+from haptic_contract.graph import EXECUTABLES, LOOP_RECORDER, NODES as LOOP_NODES
 
-NODES = (('haptic_wand_driver', 'wand_driver', 'wand_driver'),
-         ('collision_engine', 'collision_node', 'collision_engine'),
-         ('force_renderer', 'force_node', 'force_renderer'))
+NODES = tuple((entry.package, EXECUTABLES[name], name) for name, entry in LOOP_NODES.items())
 
 
 def _config(package: str) -> str:

@@ -30,6 +30,7 @@ import yaml
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
 from haptic_bringup.launcher import LoopConfig, node_parameters, site_nodes
 from haptic_bringup.site import loopback_gateway_parameters
+from haptic_contract.teleop import SCHEMES
 
 ARGUMENTS = (  # name, default, description
     ('scheme', 'model', 'bilateral scheme: direct | tdpa | model'),
@@ -73,7 +74,7 @@ def _config(context) -> LoopConfig:
 
 def _processes(context):
     config = _config(context)
-    if config.teleop not in ('direct', 'tdpa', 'model'):
+    if config.teleop not in SCHEMES:
         raise ValueError(f"scheme:={config.teleop!r}: choose direct, tdpa or model")
     parameters = _written(node_parameters(config))
     session = AllOrNothing()

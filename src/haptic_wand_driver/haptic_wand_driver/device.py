@@ -45,9 +45,9 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from haptic_wand_driver._checks import (checked_number, finite_components, finite_vector,
-                                        read_only_vector)
-from haptic_wand_driver.orientation import quaternion_from_roll_yaw, roll_axis
+from haptic_contract.checks import (finite_components, finite_number, finite_vector,
+                                    read_only_vector)
+from haptic_contract.wand import quaternion_from_roll_yaw, roll_axis
 
 __all__ = [
     'DeviceClosedError',
@@ -104,7 +104,7 @@ class Workspace:
             raise ValueError(f'Workspace.lower {self.lower.tolist()} exceeds Workspace.upper '
                              f'{self.upper.tolist()}')
         for name in ('roll_limit', 'yaw_limit'):
-            limit = checked_number(getattr(self, name), f'Workspace.{name}', minimum=0.0)
+            limit = finite_number(getattr(self, name), f'Workspace.{name}', minimum=0.0)
             if limit > np.pi:
                 raise ValueError(f'Workspace.{name} must be at most pi rad, got {limit!r}')
             object.__setattr__(self, name, limit)
@@ -140,7 +140,7 @@ class DeviceLimits:
 
     def __post_init__(self):
         for name in ('force_limit', 'torque_limit'):
-            object.__setattr__(self, name, checked_number(
+            object.__setattr__(self, name, finite_number(
                 getattr(self, name), f'DeviceLimits.{name}', minimum=0.0))
 
 
@@ -173,7 +173,7 @@ class WandState:
     def __post_init__(self):
         for name in ('time', 'roll', 'yaw', 'roll_rate', 'yaw_rate'):
             object.__setattr__(self, name,
-                               checked_number(getattr(self, name), f'WandState.{name}'))
+                               finite_number(getattr(self, name), f'WandState.{name}'))
         for name in ('position', 'linear_velocity'):
             object.__setattr__(self, name,
                                finite_vector(getattr(self, name), 3, f'WandState.{name}'))
@@ -182,7 +182,7 @@ class WandState:
     def from_coordinates(cls, time: float, coordinates: np.ndarray,
                          rates: np.ndarray) -> 'WandState':
         """Build from joint coordinates and rates, both (5,): (x, y, z, roll, yaw) and d/dt."""
-        return cls._from_checked(checked_number(time, 'WandState.time'),
+        return cls._from_checked(finite_number(time, 'WandState.time'),
                                  finite_components(coordinates, 5, 'WandState coordinates'),
                                  finite_components(rates, 5, 'WandState rates'))
 

@@ -55,12 +55,12 @@ from typing import Sequence
 
 import numpy as np
 
-from haptic_wand_driver.contact_model import ContactModel, Kind, MAX_PLANES
+from haptic_contract.contact_model import ContactModel, Kind, MAX_PLANES
+from haptic_contract.plane_law import saturate_components
+from haptic_contract.wand import roll_axis
 from haptic_wand_driver.model_easing import eased_level, eased_scale, eased_shift, least_shift, \
     matched_shift, scaled_model, spring_push, stored_energy, total_damping, total_stiffness
-from haptic_wand_driver.orientation import roll_axis
 from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
-from haptic_wand_driver.wrench_input import saturate_components
 
 __all__ = ['DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE',
            'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE',

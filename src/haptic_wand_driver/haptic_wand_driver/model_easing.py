@@ -34,7 +34,7 @@ the same floats, compiled.
 """
 import dataclasses
 
-from haptic_wand_driver.contact_model import ContactModel
+from haptic_contract.contact_model import ContactModel
 from haptic_wand_driver.port_passivity import bounded_shift
 
 __all__ = ['eased_level', 'eased_scale', 'eased_shift', 'least_shift', 'matched_shift',

@@ -12,39 +12,31 @@ import pathlib
 import time
 from typing import Sequence
 
-from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
-from haptic_msgs.msg import ContactModel as ContactModelMessage
-from haptic_util.cdr import MessageCodec
+from haptic_contract.contact_model import ContactModel, Kind, MODEL, ModelRefused
+from haptic_contract.graph import (WAND_APPLIED_WRENCH, WAND_CONTACT_MODEL, WAND_POSE, WAND_TWIST,
+                                   WAND_WRENCH)
+from haptic_contract.streams import (frame, POSE, stamp_ns, TWIST, WRENCH, WRENCH_FORCE,
+                                     WRENCH_TORQUE)
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.paths import resolve_path
 from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.answer_deadline import AnswerDeadline
-from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
-from haptic_wand_driver.device import DeviceLimits, LocalRenderingUnsupported, make_device
-from haptic_wand_driver.experiments import make_script, needs_scene, surface_projection
+from haptic_wand_driver.assembly import local_renderer, make_wand, port_passivity
+from haptic_wand_driver.device import LocalRenderingUnsupported
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.loop_stats import LoopStats
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
-from haptic_wand_driver.port_passivity import PortPassivity
-from haptic_wand_driver.simulated import SimulatedWandConfig
 from haptic_wand_driver.wrench_input import Refusal, WrenchCommand
 
 __all__ = ['WandDriverNode', 'main']
-
-MODEL = MessageCodec(ContactModelMessage)
-POSE = MessageCodec(PoseStamped)
-TWIST = MessageCodec(TwistStamped)
-WRENCH = MessageCodec(WrenchStamped)
 
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 IN_FLIGHT_GRACE = 0.05  # [s] after the last pose, for its answer to arrive
@@ -68,7 +60,7 @@ class WandDriverNode(Node):
         super().__init__('wand_driver', **kwargs)
         self.params = params = declare_parameters(self, WandDriverParams)
         try:
-            self.device = self._make_device(params)
+            self.device = make_wand(params, announce=self.get_logger().info)
         except ValueError as error:  # includes DeviceUnavailableError and script/replay errors
             raise StartupError(f'{self.get_name()}: {error}') from None
         limits = self.device.limits
@@ -80,7 +72,7 @@ class WandDriverNode(Node):
         self.stats = LoopStats(record=self._record)
         # The observer always runs (its books are the port's energy figures); the controller acts
         # only when enabled.
-        self.passivity = PortPassivity(params.passivity_max_damping if params.passivity else 0.0)
+        self.passivity = port_passivity(params)
         self.renderer = self._local_renderer() if params.rendering == 'local' else None
         self.answers = AnswerDeadline(params.hold_while_late)
         self._applied = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))  # the wrench the device holds
@@ -95,15 +87,15 @@ class WandDriverNode(Node):
         self._refused = Tally()  # wrenches not taken, by fault
         self._reported = (time.monotonic(), 0, 0)  # when, poses and answers at the last report
         self._recorder_ready = False
-        self._pose_pub = stream_publisher(self, POSE, 'wand/pose')
-        self._twist_pub = stream_publisher(self, TWIST, 'wand/twist')
-        self._applied_pub = stream_publisher(self, WRENCH, 'wand/applied_wrench')
+        self._pose_pub = stream_publisher(self, POSE, WAND_POSE)
+        self._twist_pub = stream_publisher(self, TWIST, WAND_TWIST)
+        self._applied_pub = stream_publisher(self, WRENCH, WAND_APPLIED_WRENCH)
         # One answer per pose: the model when the device renders it (a model carries the wrench
         # of a law that has none), else the wrench. A stream it does not use costs a core's
         # percent or more at 1 kHz, for the publisher and for this node.
-        answers = ((MODEL, 'wand/contact_model', self.on_model)
+        answers = ((MODEL, WAND_CONTACT_MODEL, self.on_model)
                    if self.renderer is not None else
-                   (WRENCH, 'wand/wrench', self.on_wrench))
+                   (WRENCH, WAND_WRENCH, self.on_wrench))
         self._answer_sub = stream_subscription(self, *answers, refused=self._refused)
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
@@ -116,40 +108,13 @@ class WandDriverNode(Node):
 
     def _local_renderer(self) -> LocalRenderer | None:
         """Return the device's servo-rate law, or None (logged) if the device cannot run one."""
-        limits = self.device.limits
-        renderer = LocalRenderer(
-            force_limit=limits.force_limit, torque_limit=limits.torque_limit,
-            passivity=self.passivity, mass=[self.params.device_mass] * 3,
-            contact_damping_ratio=self.params.contact_damping_ratio,
-            model_step_rate=self.params.model_step_rate)
+        renderer = local_renderer(self.params, self.device.limits, self.passivity)
         try:
             self.device.render_locally(renderer)
         except LocalRenderingUnsupported as error:
             self.get_logger().warn(f'rendering local: {error}; it applies the wrench instead')
             return None
         return renderer
-
-    def _make_device(self, params: WandDriverParams):
-        if params.device == 'replay':
-            replay = resolve_path(params.replay_file, what='parameter replay_file')
-            return make_device('replay', path=replay, loop=params.replay_loop)
-        if params.device != 'simulated':
-            return make_device(params.device)
-        project = None
-        if needs_scene(params.experiment):
-            from collision_engine import load_scene  # only the scripted experiments need it
-
-            project = surface_projection(load_scene(
-                resolve_path(params.scene_file, what='parameter scene_file'),
-                announce=self.get_logger().info))
-        config = SimulatedWandConfig(
-            mass=[params.device_mass] * 3, damping=[params.device_damping] * 3,
-            step=1.0 / params.servo_rate,
-            limits=DeviceLimits(force_limit=params.force_limit,
-                                torque_limit=params.torque_limit))
-        hand = OperatorHand(make_script(params.experiment, project),
-                            stiffness=params.hand_stiffness, damping=params.hand_damping)
-        return make_device('simulated', config=config, operator=hand)
 
     def ready(self) -> bool:
         """Whether every consumer is connected, so no pose of the session is lost to discovery."""
@@ -247,23 +212,23 @@ class WandDriverNode(Node):
     def on_wrench(self, wrench: Sequence) -> None:
         """Apply a wrench (remote rendering): held, kept passive, until its deadline."""
         now_ns = clock_ns(self.get_clock())
-        stamp_ns = wrench[0] * 1_000_000_000 + wrench[1]
-        if not self._answered(stamp_ns, now_ns):
+        stamp = stamp_ns(wrench)
+        if not self._answered(stamp, now_ns):
             return
         now = now_ns * 1e-9
         state = self._state = self.device.read(self._device_time())  # acts from now on
-        refusal = self._take(wrench, stamp_ns * 1e-9, now)
+        refusal = self._take(wrench, stamp * 1e-9, now)
         if refusal is not None:
             self._refused.add(refusal.kind, refusal)  # logged at 1 Hz: cheap on this path
         else:
-            self.answers.taken(stamp_ns * 1e-9, self.params.wrench_timeout)
+            self.answers.taken(stamp * 1e-9, self.params.wrench_timeout)
         self._apply(now, state)
 
     def on_model(self, fields: Sequence) -> None:
         """Hand a contact model to the device's renderer; a bad one gives zero force."""
         now_ns = clock_ns(self.get_clock())
-        stamp_ns = fields[0] * 1_000_000_000 + fields[1]
-        if not self._answered(stamp_ns, now_ns):
+        stamp = stamp_ns(fields)
+        if not self._answered(stamp, now_ns):
             return
         try:
             model = ContactModel.from_fields(fields, self.params.frame_id)
@@ -277,7 +242,7 @@ class WandDriverNode(Node):
         self._model_stamp = model.stamp
         since = self._arrival()
         # From the nanoseconds, as the pose's was: seconds plus nanoseconds round otherwise.
-        self.answers.taken(stamp_ns * 1e-9, model.valid_for)
+        self.answers.taken(stamp * 1e-9, model.valid_for)
         deadline = self.answers.deadline - self._ros_minus_device()
         if model.kind == Kind.UNAVAILABLE:
             self.renderer.take_wrench(model.held_wrench[:3], model.held_wrench[3:], deadline,
@@ -332,12 +297,11 @@ class WandDriverNode(Node):
 
     def _take(self, wrench: list, stamp: float, now: float) -> Refusal | None:
         """Hand a received wrench (``WRENCH`` leaves) to the command; return why it was refused."""
-        frame = wrench[2]
-        if frame != self.params.frame_id:
+        if frame(wrench) != self.params.frame_id:
             self.wrench.clear()
             return Refusal('wrench in an unknown frame', f'wrench ignored and force zeroed: '
-                           f'frame_id {frame!r} is not {self.params.frame_id!r}')
-        return self.wrench.update(wrench[3:6], wrench[6:9], stamp, now)
+                           f'frame_id {frame(wrench)!r} is not {self.params.frame_id!r}')
+        return self.wrench.update(wrench[WRENCH_FORCE], wrench[WRENCH_TORQUE], stamp, now)
 
     def on_recorder_ready(self, msg: Bool) -> None:
         self._recorder_ready = msg.data

@@ -11,7 +11,7 @@ from typing import Callable
 
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number, finite_components, read_only_vector
+from haptic_contract.checks import finite_components, finite_number, read_only_vector
 from haptic_wand_driver.scripts import Script, TargetComponents
 
 __all__ = ['OperatorHand', 'impedance']
@@ -57,7 +57,7 @@ class OperatorHand:
     def __init__(self, script: Script, *, stiffness: float = 50.0, damping: float = 3.5,
                  rotational_stiffness: float = 0.3, rotational_damping: float = 0.017):
         stiffness, damping, rotational_stiffness, rotational_damping = (
-            checked_number(value, f'OperatorHand {name}', minimum=0.0)
+            finite_number(value, f'OperatorHand {name}', minimum=0.0)
             for name, value in (('stiffness', stiffness), ('damping', damping),
                                 ('rotational_stiffness', rotational_stiffness),
                                 ('rotational_damping', rotational_damping)))

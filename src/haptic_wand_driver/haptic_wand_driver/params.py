@@ -1,6 +1,8 @@
 """The wand driver's ROS parameters, in one place (see config/haptic_wand_driver.yaml)."""
 from dataclasses import dataclass
 
+from haptic_contract.shared_defaults import DEFAULT_SCENE, DEVICE_DAMPING, FORCE_LIMIT, \
+    LOOP_RATE
 from haptic_util.parameters import parameter
 
 __all__ = ['WandDriverParams']
@@ -10,12 +12,12 @@ __all__ = ['WandDriverParams']
 class WandDriverParams:
     device: str = parameter('simulated', 'device backend: simulated, replay, or one registered '
                             'with haptic_wand_driver.register_device')
-    rate: float = parameter(1000.0, 'pose publishing rate', unit='Hz', low=1.0, high=10000.0)
+    rate: float = parameter(LOOP_RATE, 'pose publishing rate', unit='Hz', low=1.0, high=10000.0)
     frame_id: str = parameter('world', 'frame of the published pose, twist and expected wrench')
     experiment: str = parameter('cuboid', 'simulated operator script: cuboid, cylinder, hand, '
                                 'hold, or a waypoint file (.yaml/.csv)')
-    scene_file: str = parameter('package://collision_engine/scenes/cuboid.yaml',
-                                'scene the scripted operator taps (simulated device only)')
+    scene_file: str = parameter(DEFAULT_SCENE, 'scene the scripted operator taps (simulated '
+                                'device only)')
     replay_file: str = parameter('', 'recording to replay (device: replay): a bag or a CSV')
     replay_loop: bool = parameter(False, 'start the replay over at its end')
     duration: float = parameter(0.0, 'run the experiment this long, then exit (0: forever)',
@@ -38,7 +40,8 @@ class WandDriverParams:
                                        low=0.0)
     servo_rate: float = parameter(4000.0, 'simulated device: its servo rate (the dynamics '
                                   'substep)', unit='Hz', low=100.0, high=100000.0)
-    force_limit: float = parameter(10.0, 'device force limit (saturation)', unit='N', low=0.0)
+    force_limit: float = parameter(FORCE_LIMIT, 'device force limit (saturation)', unit='N',
+                                   low=0.0)
     passivity: bool = parameter(True, 'passivity observer and controller at the device port: '
                                 'removes the energy the loop delay makes a stiff wall return')
     passivity_max_damping: float = parameter(50.0, 'largest damping it adds (keep below '
@@ -47,7 +50,7 @@ class WandDriverParams:
     torque_limit: float = parameter(0.5, 'device torque limit (saturation)', unit='N*m', low=0.0)
     device_mass: float = parameter(0.15, 'simulated apparent mass per axis', unit='kg',
                                    low=1e-4)
-    device_damping: float = parameter(2.0, 'simulated physical damping per axis',
+    device_damping: float = parameter(DEVICE_DAMPING, 'simulated physical damping per axis',
                                       unit='N*s/m', low=0.0)
     hand_stiffness: float = parameter(50.0, 'simulated operator hand stiffness', unit='N/m',
                                       low=0.0)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from haptic_wand_driver.orientation import roll_yaw_from_quaternion
+from haptic_contract.wand import roll_yaw_from_quaternion
 
 __all__ = ['PoseFileError', 'PoseTable', 'read_pose_csv', 'write_pose_csv']
 

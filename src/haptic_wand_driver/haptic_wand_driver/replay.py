@@ -14,14 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number
+from haptic_contract.checks import finite_number
+from haptic_contract.graph import absolute, WAND_POSE
+from haptic_contract.wand import PitchError, roll_yaw_from_quaternion
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState, Workspace
-from haptic_wand_driver.orientation import PitchError, roll_yaw_from_quaternion
 from haptic_wand_driver.pose_table import PoseFileError, PoseTable, read_pose_csv
 
 __all__ = ['DEFAULT_POSE_TOPIC', 'ReplayDevice', 'ReplayError', 'read_bag_poses']
 
-DEFAULT_POSE_TOPIC = '/wand/pose'
+DEFAULT_POSE_TOPIC = absolute(WAND_POSE)
 _POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
 _BAG_FILE_SUFFIXES = ('.mcap', '.db3')
 
@@ -138,8 +139,8 @@ class ReplayDevice(HapticDevice):
         if table.times.size < 2:
             raise ReplayError(f'{path}: a replay needs at least two poses, found one')
         duration = float(table.times[-1] - table.times[0])
-        time_scale = checked_number(time_scale, f'{path}: time_scale', minimum=0.0, strict=True,
-                                    error=ReplayError)
+        time_scale = finite_number(time_scale, f'{path}: time_scale', minimum=0.0, strict=True,
+                                   error=ReplayError)
         if not (np.isfinite(start_offset) and 0.0 <= start_offset < duration):
             raise ReplayError(f'{path}: start_offset must be in [0, {duration:.6g}) s, the '
                               f'recording length, got {start_offset!r}')
@@ -173,7 +174,7 @@ class ReplayDevice(HapticDevice):
     def read(self, now: float) -> WandState:
         """Return the recorded state at ``now`` (s); the first call starts playback."""
         self._raise_if_closed()
-        now = checked_number(now, 'ReplayDevice.read now')
+        now = finite_number(now, 'ReplayDevice.read now')
         if self._start is None:
             self._start = float(now)
         played = self._start_offset + (now - self._start) * self._time_scale

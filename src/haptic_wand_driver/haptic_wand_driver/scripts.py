@@ -20,7 +20,7 @@ from typing import Callable, NamedTuple, Protocol, Sequence
 
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector
 from haptic_wand_driver.device import Workspace
 from haptic_wand_driver.pose_table import PoseFileError, PoseTable, read_pose_csv
 
@@ -278,7 +278,7 @@ class TappingSite:
         if length < 1e-9:
             raise ScriptError(f'TappingSite.normal must not be zero, got {normal.tolist()}')
         for name in ('roll', 'yaw'):
-            checked_number(getattr(self, name), f'TappingSite.{name}', error=ScriptError)
+            finite_number(getattr(self, name), f'TappingSite.{name}', error=ScriptError)
         object.__setattr__(self, 'point', point)
         object.__setattr__(self, 'normal', normal / length)
 
@@ -348,8 +348,8 @@ class TappingScript:
         for name, value in (('duration', duration), ('clearance', clearance), ('depth', depth),
                             ('approach_speed', approach_speed), ('dwell', dwell),
                             ('move_speed', move_speed)):
-            checked_number(value, f'TappingScript {name}', minimum=0.0, strict=True,
-                           error=ScriptError)
+            finite_number(value, f'TappingScript {name}', minimum=0.0, strict=True,
+                          error=ScriptError)
         if not sites:
             raise ScriptError('TappingScript needs at least one site')
         start = np.concatenate([finite_vector(start, 3, 'TappingScript start',

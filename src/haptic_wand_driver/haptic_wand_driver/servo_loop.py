@@ -6,8 +6,11 @@ driver's tick. This is the same arithmetic in the same order, compiled: the Pyth
 (``SimulatedWand`` with any other law, which calls ``LocalRenderer.wrench``) is its reference,
 and the tests hold the two to the same trajectory, force and energy books.
 
-The module is self-contained (numba caches a kernel by its own file, so a kernel here must not
-call one elsewhere), and imported only by a wand given such a law, which calls ``compile_now``
+Its kernels go through the project's one numba decorator (``haptic_util.jit``). The
+module is self-contained (numba caches a kernel by its own file, so a kernel here must not call
+one elsewhere): ``_saturate`` and ``_plane_force`` repeat ``haptic_contract.plane_law``'s
+``saturate_components`` and ``unilateral_spring_damper``, the references their tests hold them
+to. It is imported only by a wand given such a law, which calls ``compile_now``
 before its loop starts. Its inputs, float64 arrays:
 
 * ``packed`` (2, n): the renderer's settings and what it holds, from a period on and before it
@@ -21,9 +24,9 @@ before its loop starts. Its inputs, float64 arrays:
 """
 import math
 
-from numba import njit
 import numpy as np
 
+from haptic_util.jit import jit
 from haptic_wand_driver.local_rendering import (DEADLINE, LAW_SIZE, MODE_PLANES, MODE_WRENCH,
                                                 PLANE_SIZE, PLANES_AT, SERIAL, SINCE, STEP_RATE)
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
@@ -31,21 +34,28 @@ from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
 __all__ = ['advance', 'compile_now']
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _saturate(x, y, z, limit):
+    """Return ``haptic_contract.plane_law.saturate_components`` of (x, y, z), compiled."""
     norm = math.sqrt(x * x + y * y + z * z)
+    if norm == math.inf or norm != norm:
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            return 0.0, 0.0, 0.0
+        largest = max(abs(x), abs(y), abs(z))
+        a, b, c = x / largest, y / largest, z / largest
+        norm = largest * math.sqrt(a * a + b * b + c * c)
     if norm <= limit:
         return x, y, z
     scale = limit / norm
     return x * scale, y * scale, z * scale
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _cross(ax, ay, az, bx, by, bz):
     return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _plane_force(law, at, depth, vx, vy, vz, limit, period):
     """One plane's force on its point (``ContactModel.wrench``), damped as the device damps."""
     nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
@@ -76,7 +86,7 @@ def _plane_force(law, at, depth, vx, vy, vz, limit, period):
     return fx + change * nx, fy + change * ny, fz + change * nz
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _arm(law, at, cr, sr, cy, sy):
     """Return the tool point of the plane at ``at``, turned by the wand's roll and yaw."""
     x, y, z = law[at + 12], law[at + 13], law[at + 14]
@@ -84,7 +94,7 @@ def _arm(law, at, cr, sr, cy, sy):
     return cy * x - sy * y, sy * x + cy * y, z
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _depth(law, at, coordinates, ax, ay, az):
     """How far the tool point at (ax, ay, az) from the tip lies behind the plane at ``at``."""
     return (law[at + 3] * (law[at] - (coordinates[0] + ax))
@@ -92,7 +102,7 @@ def _depth(law, at, coordinates, ax, ay, az):
             + law[at + 5] * (law[at + 2] - (coordinates[2] + az)))
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _springs(law, coordinates, depths, stiffnesses):
     """Fill each plane's depth and stiffness along its normal (``ContactModel.springs``)."""
     roll, yaw = coordinates[3], coordinates[4]
@@ -105,7 +115,7 @@ def _springs(law, coordinates, depths, stiffnesses):
         stiffnesses[k] = law[at + 6] * nx * nx + law[at + 7] * ny * ny + law[at + 8] * nz * nz
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _deepest_first(depths, stiffnesses, count, lowest, sorted_depths, sorted_stiffnesses,
                    behind_only):
     """Sort the springs as sorted(reverse=True) does, depths less ``lowest``; return how many.
@@ -129,7 +139,7 @@ def _deepest_first(depths, stiffnesses, count, lowest, sorted_depths, sorted_sti
     return kept
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _least_shift(depths, stiffnesses, count, energy, lowest):
     """Return the least shift from ``lowest`` storing at most ``energy`` (``least_shift``)."""
     d, k = np.empty(3), np.empty(3)
@@ -145,7 +155,7 @@ def _least_shift(depths, stiffnesses, count, energy, lowest):
     return 0.0 + lowest
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _matched_shift(depths, stiffnesses, count, push):
     """Return the shift at which the springs push ``push`` (``model_easing.matched_shift``)."""
     d, k = np.empty(3), np.empty(3)
@@ -162,7 +172,7 @@ def _matched_shift(depths, stiffnesses, count, push):
     return 0.0
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _total_stiffness(stiffnesses, count):
     total = 0.0
     for k in range(count):
@@ -171,7 +181,7 @@ def _total_stiffness(stiffnesses, count):
     return total
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _eased_scale(scale, step, push):
     """Return ``scale`` moved toward 1 (``model_easing.eased_scale``)."""
     if push <= 0.0:
@@ -180,7 +190,7 @@ def _eased_scale(scale, step, push):
     return min(scale + change, 1.0) if scale < 1.0 else max(scale - change, 1.0)
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _total_damping(law):
     total = 0.0
     for k in range(int(law[19])):
@@ -192,7 +202,7 @@ def _total_damping(law):
     return total
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _shift(law, coordinates, books, bound, period):
     """Set ``bound`` for this period of the planes held (``LocalRenderer._shift``)."""
     rate = law[STEP_RATE]
@@ -243,7 +253,7 @@ def _shift(law, coordinates, books, bound, period):
         damping_scale * damping)
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _scaled(law, scale, damping_scale):
     """Return ``law`` with its planes' stiffnesses and dampings scaled (``scaled_model``)."""
     if scale == 1.0 and damping_scale == 1.0:
@@ -257,7 +267,7 @@ def _scaled(law, scale, damping_scale):
     return scaled
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _planes(law, coordinates, rates, limit, period, shift):
     """Force and torque of the held planes moved out by ``shift`` (``ContactModel.wrench``)."""
     roll, yaw = coordinates[3], coordinates[4]
@@ -279,7 +289,7 @@ def _planes(law, coordinates, rates, limit, period, shift):
     return fx, fy, fz, tx, ty, tz
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _observe(books, coordinates):
     """Book the work the held force did since the last period (``PortPassivity.observe``)."""
     if books[8] != 0.0:
@@ -290,7 +300,7 @@ def _observe(books, coordinates):
     books[5], books[6], books[7], books[8] = coordinates[0], coordinates[1], coordinates[2], 1.0
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _passive(books, fx, fy, fz, coordinates, rates, period, lapsed):
     """Return the force the port's passivity controller lets through (``PortPassivity``)."""
     _observe(books, coordinates)
@@ -317,7 +327,7 @@ def _passive(books, fx, fy, fz, coordinates, rates, period, lapsed):
     return books[2], books[3], books[4]
 
 
-@njit(cache=True, nogil=True)
+@jit
 def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     """Return what ``LocalRenderer.wrench`` renders this period: force and torque, saturated."""
     law = packed[0] if time + period > packed[0, SINCE] else packed[1]
@@ -345,7 +355,7 @@ def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     return fx, fy, fz, tx, ty, tz
 
 
-@njit(cache=True, nogil=True)
+@jit
 def advance(coordinates, rates, joints, targets, packed, books, bound, force_limit, torque_limit,
             start, first, step, rendered, edges, pushing):
     """Run ``len(targets)`` servo periods from period ``first``, in place.

@@ -31,12 +31,12 @@ import math
 
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number, finite_components, finite_vector
+from haptic_contract.checks import finite_components, finite_number, finite_vector
+from haptic_contract.plane_law import saturate_components
+from haptic_contract.wand import roll_axis
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import impedance, OperatorHand
-from haptic_wand_driver.orientation import roll_axis
-from haptic_wand_driver.wrench_input import saturate_components
 
 __all__ = ['SimulatedWand', 'SimulatedWandConfig']
 
@@ -86,10 +86,10 @@ class SimulatedWandConfig:
                                                          f'SimulatedWandConfig.{name}'))
         for name, value in (('mass', self.mass.min()), ('roll_inertia', self.roll_inertia),
                             ('yaw_inertia', self.yaw_inertia), ('step', self.step)):
-            checked_number(value, f'SimulatedWandConfig.{name}', minimum=0.0, strict=True)
+            finite_number(value, f'SimulatedWandConfig.{name}', minimum=0.0, strict=True)
         for name, value in (('damping', self.damping.min()), ('roll_damping', self.roll_damping),
                             ('yaw_damping', self.yaw_damping)):
-            checked_number(value, f'SimulatedWandConfig.{name}', minimum=0.0)
+            finite_number(value, f'SimulatedWandConfig.{name}', minimum=0.0)
         if not self.limits.workspace.contains(self.initial_coordinates):
             raise ValueError(f'SimulatedWandConfig initial pose {self.initial_coordinates} lies '
                              f'outside the workspace {self.limits.workspace}')
@@ -168,7 +168,7 @@ class SimulatedWand(HapticDevice):
         The first call starts the clock (and the operator's script) at ``now``.
         """
         self._raise_if_closed()
-        now = checked_number(now, 'SimulatedWand.read now')
+        now = finite_number(now, 'SimulatedWand.read now')
         if self._start is None:
             self._start = now
         elif now < self._time():

@@ -10,42 +10,16 @@ It is pure: it reads no clock, ``now`` is passed in (seconds, the clock that sta
 """
 
 import math
-from typing import Sequence
 
 import numpy as np
 
-from haptic_wand_driver._checks import checked_number, finite_components
-from haptic_wand_driver.orientation import roll_axis
+from haptic_contract.checks import finite_components, finite_number
+from haptic_contract.plane_law import saturate_components
+from haptic_contract.wand import roll_axis
 
-__all__ = ['Refusal', 'WrenchCommand', 'saturate', 'saturate_components']
+__all__ = ['Refusal', 'WrenchCommand']
 
 _ZERO = (0.0, 0.0, 0.0)
-
-
-def saturate_components(vector: Sequence[float], limit: float) -> tuple[float, float, float]:
-    """Return :func:`saturate` of three floats as floats: numpy is slow on 3-vectors at 1 kHz."""
-    x, y, z = vector
-    norm = math.sqrt(x * x + y * y + z * z)  # as numpy's norm: a vector too small to square is 0
-    if norm <= limit:
-        return x, y, z
-    scale = limit / norm
-    return x * scale, y * scale, z * scale
-
-
-def saturate(vector: np.ndarray, limit: float) -> np.ndarray:
-    """Scale ``vector`` down to norm ``limit`` if it is longer, keeping its direction.
-
-    Parameters
-    ----------
-    vector : (3,) float
-    limit : float, same unit as vector, >= 0
-
-    Returns
-    -------
-    saturated : (3,) float
-        A new array.
-    """
-    return np.array(saturate_components(np.array(vector, dtype=np.float64).tolist(), limit))
 
 
 class Refusal(str):
@@ -71,10 +45,10 @@ class WrenchCommand:
     """
 
     def __init__(self, *, force_limit: float, torque_limit: float, timeout: float = 0.010):
-        self._force_limit = checked_number(force_limit, 'WrenchCommand force_limit', minimum=0.0)
-        self._torque_limit = checked_number(torque_limit, 'WrenchCommand torque_limit',
-                                            minimum=0.0)
-        self._timeout = checked_number(timeout, 'WrenchCommand timeout', minimum=0.0)
+        self._force_limit = finite_number(force_limit, 'WrenchCommand force_limit', minimum=0.0)
+        self._torque_limit = finite_number(torque_limit, 'WrenchCommand torque_limit',
+                                           minimum=0.0)
+        self._timeout = finite_number(timeout, 'WrenchCommand timeout', minimum=0.0)
         self._force = self._torque = _ZERO
         self._stamp: float | None = None
 

@@ -31,18 +31,11 @@ or rate out of the ordinary.
 import bisect
 from collections import deque
 from dataclasses import dataclass
-from typing import NamedTuple
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
+from haptic_contract.teleop import Refusal
 
 __all__ = ['Admission', 'AdmissionConfig', 'Refusal']
-
-
-class Refusal(NamedTuple):
-    """Why a message was not taken: ``kind`` a short fixed text (counted), ``detail`` its case."""
-
-    kind: str
-    detail: str = ''
 
 
 @dataclass(frozen=True)

@@ -41,14 +41,14 @@ from typing import Callable
 
 import numpy as np
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
+from haptic_contract.teleop import (Command, command_refusal, CommandLimits, Feedback, new_session,
+                                    RemotePlane, Scheme, SCHEMES)
 from remote_probe.admission import Admission, Refusal
 from remote_probe.force_hold import ForceHold, HoldConfig
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.safety import PatientSafety
 from remote_probe.tdpa import RobotPassivity
-from remote_probe.teleop import (Command, command_refusal, CommandLimits, Feedback, new_session,
-                                 RemotePlane, SCHEMES)
 
 __all__ = ['Follower', 'FollowerConfig']
 
@@ -67,7 +67,7 @@ class FollowerConfig:
         ``tdpa``: how fast the target drifts back toward the operator's position.
     """
 
-    scheme: str = 'model'
+    scheme: str = Scheme.MODEL.value
     robot_stiffness: float = 1500.0
     drift_rate: float = 2.0
 
@@ -102,7 +102,7 @@ class Follower:
                  estimator: ContactModelEstimator | None = None, *,
                  surface: Callable | None = None, admission: Admission | None = None,
                  session: int | None = None) -> None:
-        if config.scheme == 'model' and estimator is None:
+        if config.scheme == Scheme.MODEL and estimator is None:
             raise ValueError('the model scheme needs a contact estimator')
         self.config = config
         self.safety = safety
@@ -110,7 +110,7 @@ class Follower:
         self.admission = admission if admission is not None else Admission()
         self.session = new_session() if session is None else session
         self._sent = 0  # feedback so far
-        self.estimator = estimator if config.scheme == 'model' else None
+        self.estimator = estimator if config.scheme == Scheme.MODEL else None
         self.passivity = RobotPassivity(config.drift_rate)
         self._command: Command | None = None
         self._command_heard = -math.inf  # this site's clock when the newest command came
@@ -167,7 +167,7 @@ class Follower:
         command = self._command
         if command is None:
             return self._target
-        if self.config.scheme != 'tdpa':
+        if self.config.scheme != Scheme.TDPA:
             return command.position
         velocity = self.passivity.control(command.velocity, self._port_force(), dt,
                                           command.position - self._target)
@@ -201,7 +201,7 @@ class Follower:
         echo, hold, echoed = ((0.0, 0.0, 0) if command is None else
                               (command.stamp, now - self._command_heard, command.sequence))
         good = self._force_good
-        force = self._port_force() if self.config.scheme == 'tdpa' else self._force
+        force = self._port_force() if self.config.scheme == Scheme.TDPA else self._force
         self._sent += 1
         return Feedback(now, echo, hold, force if good else np.zeros(3), self._tcp,
                         self.passivity.books.energy_in, self._plane if good else None,

@@ -15,14 +15,18 @@ its workspace. Every refused command is counted and logged once a second with it
 import math
 from typing import Sequence
 
-from geometry_msgs.msg import PoseStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Empty, Float64
 
 from collision_engine import load_scene
+from haptic_contract.graph import (ROBOT_FT_WRENCH, ROBOT_IMPEDANCE, ROBOT_TARGET_POSE,
+                                   ROBOT_TCP_POSE, TELEOP_COMMAND, TELEOP_FEEDBACK)
+from haptic_contract.streams import POSE, POSE_POSITION, WRENCH, WRENCH_FORCE
+from haptic_contract.teleop import Scheme
+from haptic_contract.teleop_fields import (COMMAND, command_from_fields, command_session, FEEDBACK,
+                                           feedback_fields, impedance_report)
 from haptic_msgs.msg import RobotImpedance
-from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, ERROR, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
@@ -34,16 +38,12 @@ from haptic_util.tally import Tally
 from haptic_wand_driver.experiments import surface_projection
 from remote_probe.admission import Admission, AdmissionConfig, Refusal
 from remote_probe.follower import Follower, FollowerConfig
-from remote_probe.link_messages import (COMMAND, command_from_fields, command_session, FEEDBACK,
-                                        feedback_fields, impedance_report)
 from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import envelope, FollowerParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 
 __all__ = ['FollowerNode', 'main', 'take_command']
 
-POSE = MessageCodec(PoseStamped)
-WRENCH = MessageCodec(WrenchStamped)
 MODEL_FEEDBACK_RATE, FORCE_FEEDBACK_RATE = 100.0, 1000.0  # [Hz] what each scheme's content needs
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
 STIFFNESS_TOLERANCE = 0.01  # relative: the robot's reported stiffness against robot_stiffness
@@ -82,19 +82,19 @@ class FollowerNode(Node):
         self._force = np.zeros(3)
         self._refused = Tally()
         self._sent = 0
-        self._target_pub = stream_publisher(self, POSE, 'robot/target_pose')
-        self._feedback_pub = stream_publisher(self, FEEDBACK, 'teleop/feedback')
-        stream_subscription(self, COMMAND, 'teleop/command', self.on_command,
+        self._target_pub = stream_publisher(self, POSE, ROBOT_TARGET_POSE)
+        self._feedback_pub = stream_publisher(self, FEEDBACK, TELEOP_FEEDBACK)
+        stream_subscription(self, COMMAND, TELEOP_COMMAND, self.on_command,
                             refused=self._refused, qos=LINK_QOS)
-        for codec, topic, callback in ((POSE, 'robot/tcp_pose', self.on_tcp),
-                                       (WRENCH, 'robot/ft_sensor/wrench', self.on_wrench)):
+        for codec, topic, callback in ((POSE, ROBOT_TCP_POSE, self.on_tcp),
+                                       (WRENCH, ROBOT_FT_WRENCH, self.on_wrench)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
-        self.create_subscription(RobotImpedance, 'robot/impedance', self.on_impedance,
+        self.create_subscription(RobotImpedance, ROBOT_IMPEDANCE, self.on_impedance,
                                  LATCHED_QOS)
         self.create_subscription(Empty, 'teleop/re_engage', self.on_re_engage, 1)
         self.create_subscription(Float64, 'teleop/hold', self.on_hold, 1)
         self.create_timer(self._period, self.tick)
-        rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == 'model'
+        rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == Scheme.MODEL
                                         else FORCE_FEEDBACK_RATE)
         self.create_timer(1.0 / rate, self.send_feedback)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
@@ -156,13 +156,14 @@ class FollowerNode(Node):
 
     def on_tcp(self, fields: Sequence) -> None:
         now = self._now()
-        position = np.array(fields[3:6], dtype=np.float64)
+        position = np.array(fields[POSE_POSITION], dtype=np.float64)
         if self._tcp is not None and now > self._tcp_time:
             self._tcp_velocity = (position - self._tcp) / (now - self._tcp_time)
         self._tcp, self._tcp_time = position, now
 
     def on_wrench(self, fields: Sequence) -> None:
-        self._force, self._force_time = np.array(fields[3:6], dtype=np.float64), self._now()
+        self._force = np.array(fields[WRENCH_FORCE], dtype=np.float64)
+        self._force_time = self._now()
         if not np.all(np.isfinite(self._force)):
             self._refused.add('F/T wrench not finite')
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
 
 __all__ = ['ForceHold', 'HoldConfig']
 

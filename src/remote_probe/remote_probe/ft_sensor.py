@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector
 
 __all__ = ['FirstOrderLowPass', 'ForceTorqueSensor', 'ForceTorqueSensorConfig', 'Wrench']
 

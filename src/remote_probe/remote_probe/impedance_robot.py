@@ -25,8 +25,8 @@ from typing import Callable
 
 import numpy as np
 
-from remote_probe._checks import (finite_floats, finite_number, finite_vector, nonzero_floats,
-                                  unit_vector)
+from haptic_contract.checks import (finite_components, finite_number, finite_vector,
+                                    nonzero_components, unit_vector)
 
 __all__ = ['Environment', 'ImpedanceRobot', 'ImpedanceRobotConfig', 'RobotState']
 
@@ -168,8 +168,8 @@ class ImpedanceRobot:
         ``orientation`` (4,) x, y, z, w must be a non-zero quaternion; it is not tracked yet
         (the orientation stays at ``config.initial_orientation``).
         """
-        target = finite_floats(position, 3, 'ImpedanceRobot.command position')
-        nonzero_floats(orientation, 4, 'ImpedanceRobot.command orientation')
+        target = finite_components(position, 3, 'ImpedanceRobot.command position')
+        nonzero_components(orientation, 4, 'ImpedanceRobot.command orientation')
         self._target = target
 
     def read(self, now: float) -> RobotState:

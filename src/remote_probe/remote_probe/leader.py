@@ -45,12 +45,12 @@ import math
 
 import numpy as np
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
+from haptic_contract.teleop import (Command, Feedback, feedback_refusal, new_session, RemotePlane,
+                                    Scheme, SCHEMES)
 from remote_probe.admission import Admission, Refusal
 from remote_probe.link import RoundTripEstimator
 from remote_probe.tdpa import OperatorPassivity
-from remote_probe.teleop import Command, Feedback, feedback_refusal, new_session, RemotePlane, \
-    SCHEMES
 from remote_probe.virtual_coupling import CouplingConfig, VirtualCoupling
 from remote_probe.workspace_map import WorkspaceMap
 
@@ -81,7 +81,7 @@ class LeaderConfig:
         ``model``: how fast the shift a silence left is given back, at the robot.
     """
 
-    scheme: str = 'model'
+    scheme: str = Scheme.MODEL.value
     force_scale: float = 0.3
     position_scale: float = 1.0
     link_timeout: float = 0.1
@@ -188,7 +188,7 @@ class Leader:
             self._coupling = None
             return np.zeros(3)
         patient = self._feedback.force
-        if self.config.scheme != 'tdpa':
+        if self.config.scheme != Scheme.TDPA:
             return self.config.force_scale * patient
         if self.config.coupling is None:
             return self.config.force_scale * self.passivity.control(

@@ -11,13 +11,17 @@ the robot.
 import math
 from typing import Sequence
 
-from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Bool
 
-from haptic_msgs.msg import ContactModel
-from haptic_util.cdr import MessageCodec
+from haptic_contract.contact_model import Kind, MODEL, model_fields
+from haptic_contract.graph import (TELEOP_CLUTCH, TELEOP_COMMAND, TELEOP_FEEDBACK,
+                                   WAND_CONTACT_MODEL, WAND_POSE, WAND_TWIST, WAND_WRENCH)
+from haptic_contract.streams import (frame, POSE, POSE_POSITION, stamp_ns, TWIST, TWIST_LINEAR,
+                                     WRENCH)
+from haptic_contract.teleop import feedback_refusal, Scheme
+from haptic_contract.teleop_fields import COMMAND, command_fields, FEEDBACK, feedback_from_fields
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
@@ -27,19 +31,11 @@ from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from remote_probe.admission import Admission, AdmissionConfig, Refusal
 from remote_probe.leader import Leader, LeaderConfig
-from remote_probe.link_messages import (COMMAND, command_fields, FEEDBACK,
-                                        feedback_from_fields)
 from remote_probe.params import LeaderParams
-from remote_probe.teleop import feedback_refusal
 from remote_probe.virtual_coupling import CouplingConfig
 
 __all__ = ['LeaderNode', 'main']
 
-MODEL = MessageCodec(ContactModel)
-POSE = MessageCodec(PoseStamped)
-TWIST = MessageCodec(TwistStamped)
-WRENCH = MessageCodec(WrenchStamped)
-_UNUSED_PLANES = (0.0,) * 30  # two of ContactModel's three planes
 _ZERO_WRENCH = (0.0,) * 6
 
 
@@ -72,16 +68,16 @@ class LeaderNode(Node):
         self._answers = 0
         self._withheld = 0  # poses whose command was not sent: the feedback was silent
         self._unknown = 0  # poses given no model: the feedback was silent
-        self._command_pub = stream_publisher(self, COMMAND, 'teleop/command')
-        answer = ((MODEL, 'wand/contact_model') if params.scheme == 'model'
-                  else (WRENCH, 'wand/wrench'))
+        self._command_pub = stream_publisher(self, COMMAND, TELEOP_COMMAND)
+        answer = ((MODEL, WAND_CONTACT_MODEL) if params.scheme == Scheme.MODEL
+                  else (WRENCH, WAND_WRENCH))
         self._answer_pub = stream_publisher(self, *answer)
-        for codec, topic, callback in ((POSE, 'wand/pose', self.on_pose),
-                                       (TWIST, 'wand/twist', self.on_twist)):
+        for codec, topic, callback in ((POSE, WAND_POSE, self.on_pose),
+                                       (TWIST, WAND_TWIST, self.on_twist)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
-        stream_subscription(self, FEEDBACK, 'teleop/feedback', self.on_feedback,
+        stream_subscription(self, FEEDBACK, TELEOP_FEEDBACK, self.on_feedback,
                             refused=self._refused, qos=LINK_QOS)
-        self.create_subscription(Bool, 'teleop/clutch', self.on_clutch, LATCHED_QOS)
+        self.create_subscription(Bool, TELEOP_CLUTCH, self.on_clutch, LATCHED_QOS)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         self.get_logger().info(f'{params.scheme} scheme: force x{params.force_scale:g}, '
                                f'motion x{params.position_scale:g}; waiting for the robot')
@@ -111,15 +107,14 @@ class LeaderNode(Node):
             self._refused.add(f'feedback {refusal.kind}', refusal.detail)
 
     def on_pose(self, fields: Sequence) -> None:
-        if fields[2] != self.params.frame_id:
-            self._refused.add(f'pose in frame {fields[2]!r}')
+        if frame(fields) != self.params.frame_id:
+            self._refused.add(f'pose in frame {frame(fields)!r}')
             return
-        self._pending = (fields[0] * 1_000_000_000 + fields[1],
-                         np.array(fields[3:6], dtype=np.float64))
+        self._pending = (stamp_ns(fields), np.array(fields[POSE_POSITION], dtype=np.float64))
         self._answer_when_paired()
 
     def on_twist(self, fields: Sequence) -> None:
-        self._twist = (fields[0] * 1_000_000_000 + fields[1], fields[3:6])
+        self._twist = (stamp_ns(fields), fields[TWIST_LINEAR])
         self._answer_when_paired()
 
     def _answer_when_paired(self) -> None:
@@ -145,7 +140,7 @@ class LeaderNode(Node):
         else:
             self._command_pub.publish(command_fields(command, self.params.robot_frame))
         now = self._now()
-        if self.params.scheme == 'model':
+        if self.params.scheme == Scheme.MODEL:
             plane = self.leader.plane(now, position)
             if plane is None and not self.leader.live(now):
                 # Unknown, not free: the device zeroes the force when the last model lapses,
@@ -161,20 +156,18 @@ class LeaderNode(Node):
         """Publish the wrench or model for the pose ``stamp_ns``; None: zero force, no model."""
         header = (*divmod(stamp_ns, 1_000_000_000), self.params.frame_id)
         self._answers += 1
-        if self.params.scheme != 'model':
+        if self.params.scheme != Scheme.MODEL:
             force = (0.0, 0.0, 0.0) if answer is None else tuple(answer.tolist())
             self._answer_pub.publish((*header, *force, 0.0, 0.0, 0.0))
             return
         tip = (0.0, 0.0, 0.0) if position is None else tuple(position.tolist())
-        if answer is None:
-            kind, count, plane = ContactModel.KIND_FREE, 0, (0.0,) * 15
-        else:
-            kind, count = ContactModel.KIND_PLANES, 1
-            plane = (*answer.point.tolist(), *answer.normal.tolist(), *[answer.stiffness] * 3,
-                     *[answer.damping] * 3, 0.0, 0.0, 0.0)
-        self._answer_pub.publish((
-            *header, 'patient', kind, count, *plane, *_UNUSED_PLANES, self.params.force_limit,
-            self.params.model_lifetime, self.params.model_radius, *tip, *_ZERO_WRENCH))
+        planes = () if answer is None else ((
+            answer.point.tolist(), answer.normal.tolist(), (answer.stiffness,) * 3,
+            (answer.damping,) * 3),)
+        self._answer_pub.publish(model_fields(
+            header, 'patient', Kind.PLANES if planes else Kind.FREE, planes,
+            self.params.force_limit, self.params.model_lifetime, self.params.model_valid_radius,
+            tip, _ZERO_WRENCH))
 
     def on_clutch(self, msg: Bool) -> None:
         if self.leader is None or self._pending is None:

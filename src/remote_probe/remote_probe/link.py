@@ -27,7 +27,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
 
 __all__ = ['DelayTrace', 'Delivery', 'EchoSample', 'EmulatedLink', 'LinkConfig',
            'RoundTripEstimator', 'echo_sample', 'silence_timeout']

@@ -5,7 +5,6 @@ so the site gateway holds each message it sends for the emulated link (``remote_
 before handing it to Zenoh. The release timer (steady clock) is re-armed for the link's next
 arrival rather than polling at 1 kHz: a release is then late by the executor's wake-up alone.
 """
-from dataclasses import dataclass
 import math
 import time
 from typing import Callable
@@ -14,31 +13,13 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 
 from haptic_util.executor import StartupError
-from haptic_util.parameters import parameter
 from remote_probe.link import DelayTrace, EmulatedLink, LinkConfig
+from remote_probe.params import LinkStageParams
 from remote_probe.relay import Relay
 
-__all__ = ['LinkStageParams', 'ReleaseTimer', 'emulated_link']
+__all__ = ['ReleaseTimer', 'emulated_link']
 
 _STEADY = Clock(clock_type=ClockType.STEADY_TIME)  # the clock time.monotonic() reads
-
-
-@dataclass(frozen=True)
-class LinkStageParams:
-    """The emulated link's parameters (the site gateway's outgoing stage)."""
-
-    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
-                             high=10.0)
-    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
-                              "message's delay", unit='s', low=0.0, high=10.0)
-    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
-    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
-                              'holds back those behind it)')
-    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
-                          low=0)
-    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
-                                 'from each direction\'s first message, instead of delay; '
-                                 'empty: none')
 
 
 def emulated_link(params: LinkStageParams, direction: str, node_name: str) -> EmulatedLink:

@@ -36,7 +36,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector
 from remote_probe.ft_sensor import FirstOrderLowPass
 
 __all__ = ['ContactEstimate', 'ContactModelEstimator', 'EstimatorConfig']

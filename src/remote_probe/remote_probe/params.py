@@ -1,14 +1,15 @@
-"""The ROS parameters of the telerobotic nodes, in one place (see config/*.yaml)."""
+"""The ROS parameters of the telerobotic nodes and the gateway's link stage (config/*.yaml)."""
 from dataclasses import dataclass
 
+from haptic_contract.shared_defaults import FORCE_LIMIT
+from haptic_contract.teleop import HAND_SPEED, Scheme, SCHEMES
 from haptic_util.parameters import parameter
 from remote_probe.admission import AdmissionConfig
 from remote_probe.force_envelope import EnvelopeConfig
 from remote_probe.leader import LeaderConfig
 from remote_probe.safety import SafetyConfig
-from remote_probe.teleop import HAND_SPEED, SCHEMES
 
-__all__ = ['envelope', 'FollowerParams', 'LeaderParams', 'PatientBoundParams',
+__all__ = ['envelope', 'FollowerParams', 'LeaderParams', 'LinkStageParams', 'PatientBoundParams',
            'SimulatedRobotParams']
 
 
@@ -73,7 +74,7 @@ class SimulatedRobotParams(PatientBoundParams):
 
 @dataclass(frozen=True)
 class FollowerParams(PatientBoundParams):
-    scheme: str = parameter('model', 'bilateral scheme', choices=SCHEMES)
+    scheme: str = parameter(Scheme.MODEL.value, 'bilateral scheme', choices=SCHEMES)
     rate: float = parameter(1000.0, 'control rate: a target per tick', unit='Hz', low=1.0,
                             high=10000.0)
     feedback_rate: float = parameter(0.0, 'feedback over the link; 0: 1 kHz for direct and '
@@ -115,7 +116,7 @@ class FollowerParams(PatientBoundParams):
 
 @dataclass(frozen=True)
 class LeaderParams:
-    scheme: str = parameter('model', 'bilateral scheme', choices=SCHEMES)
+    scheme: str = parameter(Scheme.MODEL.value, 'bilateral scheme', choices=SCHEMES)
     force_scale: float = parameter(0.3, 'felt force per patient force', low=1e-3, high=10.0)
     position_scale: float = parameter(1.0, 'robot motion per wand motion', low=1e-3, high=10.0)
     link_timeout: float = parameter(0.1, 'no feedback for this long: zero force', unit='s',
@@ -130,12 +131,13 @@ class LeaderParams:
                                                unit='N*s/m', low=0.0, high=1e3)
     frame_id: str = parameter('world', 'the wand\'s frame')
     robot_frame: str = parameter('base_link', 'the robot\'s base frame, of the link\'s messages')
-    force_limit: float = parameter(10.0, 'force limit sent with the contact model', unit='N',
-                                   low=0.0)
+    force_limit: float = parameter(FORCE_LIMIT, 'force limit sent with the contact model',
+                                   unit='N', low=0.0)
     model_lifetime: float = parameter(0.010, 'a rendered model holds this long after its '
                                       'pose\'s stamp', unit='s', low=0.0005, high=1.0)
-    model_radius: float = parameter(0.01, 'a rendered model holds this far from the wand',
-                                    unit='m', low=1e-4, high=1.0)
+    model_valid_radius: float = parameter(0.01, 'a rendered model holds this far from the wand '
+                                          '(its valid_radius; the remote site decides where '
+                                          'there is a plane)', unit='m', low=1e-4, high=1.0)
     rejoin_speed: float = parameter(LeaderConfig.rejoin_speed, 'model: after a silence, the '
                                     'shift it left is given back this fast, at the robot',
                                     unit='m/s', low=1e-4)
@@ -148,3 +150,21 @@ class LeaderParams:
     session_timeout: float = parameter(AdmissionConfig.session_timeout, 'the remote site\'s '
                                        'silence after which another may take over', unit='s',
                                        low=0.01)
+
+
+@dataclass(frozen=True)
+class LinkStageParams:
+    """The emulated link's parameters (the site gateway's outgoing stage)."""
+
+    delay: float = parameter(0.0, 'one-way delay of the emulated link', unit='s', low=0.0,
+                             high=10.0)
+    jitter: float = parameter(0.0, 'standard deviation of the Gaussian jitter added to each '
+                              "message's delay", unit='s', low=0.0, high=10.0)
+    loss: float = parameter(0.0, 'probability that a message is lost', low=0.0, high=0.99)
+    reorder: bool = parameter(False, 'a message may overtake an earlier one (else a late one '
+                              'holds back those behind it)')
+    seed: int = parameter(0, 'seed of the draws: to_remote uses it, to_operator seed + 1',
+                          low=0)
+    delay_trace: str = parameter('', 'CSV of one-way delays (header time,delay, in s) replayed '
+                                 'from each direction\'s first message, instead of delay; '
+                                 'empty: none')

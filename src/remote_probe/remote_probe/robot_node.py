@@ -18,13 +18,16 @@ what it is on ``robot/impedance`` (latched), so the commanding node can check it
 import time
 from typing import Sequence
 
-from geometry_msgs.msg import PoseStamped, WrenchStamped
 import numpy as np
 from rclpy.node import Node
 
 from collision_engine import load_scene
+from haptic_contract.checks import finite_components, nonzero_components
+from haptic_contract.graph import (ROBOT_FT_WRENCH, ROBOT_IMPEDANCE, ROBOT_TARGET_POSE,
+                                   ROBOT_TCP_POSE)
+from haptic_contract.streams import frame, POSE, POSE_ORIENTATION, POSE_POSITION, WRENCH
+from haptic_contract.teleop_fields import impedance_message
 from haptic_msgs.msg import RobotImpedance
-from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_publisher, stream_subscription
@@ -33,18 +36,13 @@ from haptic_util.paths import resolve_path
 from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
-from remote_probe._checks import finite_floats, nonzero_floats
 from remote_probe.ft_sensor import ForceTorqueSensor, ForceTorqueSensorConfig
 from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
-from remote_probe.link_messages import impedance_message
 from remote_probe.params import envelope, SimulatedRobotParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.tissue import HuntCrossley, SceneSurface, Tissue
 
 __all__ = ['SimulatedRobotNode', 'main']
-
-POSE = MessageCodec(PoseStamped)
-WRENCH = MessageCodec(WrenchStamped)
 
 
 class SimulatedRobotNode(Node):
@@ -79,13 +77,13 @@ class SimulatedRobotNode(Node):
         self._measured = np.zeros(3)  # the sensor's latest force
         self._refused = Tally()
         self._published = 0
-        self._pose_pub = stream_publisher(self, POSE, 'robot/tcp_pose')
-        self._wrench_pub = stream_publisher(self, WRENCH, 'robot/ft_sensor/wrench')
-        stream_subscription(self, POSE, 'robot/target_pose', self.on_target,
+        self._pose_pub = stream_publisher(self, POSE, ROBOT_TCP_POSE)
+        self._wrench_pub = stream_publisher(self, WRENCH, ROBOT_FT_WRENCH)
+        stream_subscription(self, POSE, ROBOT_TARGET_POSE, self.on_target,
                             refused=self._refused)
         self.create_timer(1.0 / params.rate, self.tick)
         config = self.robot.config
-        self.create_publisher(RobotImpedance, 'robot/impedance', LATCHED_QOS).publish(
+        self.create_publisher(RobotImpedance, ROBOT_IMPEDANCE, LATCHED_QOS).publish(
             impedance_message(params.frame_id, stiffness=config.stiffness,
                               max_speed=config.max_speed,
                               workspace_lower=config.workspace_lower,
@@ -98,12 +96,12 @@ class SimulatedRobotNode(Node):
         return time.monotonic() - self._start
 
     def on_target(self, fields: Sequence) -> None:
-        if fields[2] != self.params.frame_id:
-            self._refused.add(f'target in frame {fields[2]!r}')
+        if frame(fields) != self.params.frame_id:
+            self._refused.add(f'target in frame {frame(fields)!r}')
             return
         try:
-            asked = finite_floats(fields[3:6], 3, 'target position')
-            nonzero_floats(fields[6:10], 4, 'target orientation')
+            asked = finite_components(fields[POSE_POSITION], 3, 'target position')
+            nonzero_components(fields[POSE_ORIENTATION], 4, 'target orientation')
         except ValueError as error:  # NaN, a zero quaternion
             self._refused.add('target not finite', str(error))
             return

@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector
 from remote_probe.force_envelope import EnvelopeConfig, ForceEnvelope, toward_within
 
 __all__ = ['LinkWatchdog', 'PatientSafety', 'SafetyConfig', 'within_force_bound']

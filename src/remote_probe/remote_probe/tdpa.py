@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector
 
 __all__ = ['EnergyBooks', 'OperatorPassivity', 'RobotPassivity']
 

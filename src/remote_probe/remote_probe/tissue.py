@@ -30,7 +30,7 @@ from typing import Protocol
 
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector, unit_vector
+from haptic_contract.checks import finite_number, finite_vector, unit_vector
 
 __all__ = ['ABDOMEN', 'HuntCrossley', 'PlaneSurface', 'SceneSurface', 'Surface', 'Tissue']
 

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from remote_probe._checks import finite_number
+from haptic_contract.checks import finite_number
 
 __all__ = ['CouplingConfig', 'VirtualCoupling']
 

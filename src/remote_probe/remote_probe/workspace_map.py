@@ -11,7 +11,7 @@ there, without a jump.
 """
 import numpy as np
 
-from remote_probe._checks import finite_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector
 
 __all__ = ['WorkspaceMap']
 

@@ -41,7 +41,8 @@ from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
 from haptic_util.qos import FRAME_QOS, HAPTIC_STREAM_QOS
 from haptic_util.transport import loopback_udp
-from remote_probe.link_stage import emulated_link, LinkStageParams, ReleaseTimer
+from remote_probe.link_stage import emulated_link, ReleaseTimer
+from remote_probe.params import LinkStageParams
 from remote_probe.relay import message_class, Relay
 from site_gateway.inbound import Inbound
 from site_gateway.routes import bye_key, FRAME, other_role, RELIABLE, ROLES, site_routes

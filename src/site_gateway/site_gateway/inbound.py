@@ -1,6 +1,6 @@
 """What comes from the other site, judged before it enters this site's DDS domain.
 
-Why here, before DDS: the nodes behind the gateway check every field (``remote_probe.teleop``),
+Why here, before DDS: the nodes behind the gateway check every field (``haptic_contract.teleop``),
 but each message the gateway lets through costs the site a DDS publication and its nodes a
 callback. So the gateway hands on a message only if:
 - it arrived under the key of the role that may publish it (the access control guarantees that

@@ -9,7 +9,7 @@ from contact_model_fields import fields, plane
 import numpy as np
 import pytest
 
-from haptic_wand_driver.contact_model import ContactModel, Kind, ModelRefused
+from haptic_contract.contact_model import ContactModel, Kind, ModelRefused
 
 
 @pytest.mark.parametrize('change, field', [

@@ -4,15 +4,16 @@ Why one module: what crosses between the two sites (``haptic_msgs/TeleopCommand`
 ``TeleopFeedback``) and what the robot says of itself (``RobotImpedance``) is read and written
 here only, with every field looked up by its name in the message definition, so that a field
 added to a message moves no literal index anywhere. The values are those of
-``remote_probe.teleop``; what they may hold is checked there.
+``haptic_contract.teleop``; what they may hold is checked there.
 """
 from typing import NamedTuple
 
 import numpy as np
 
+from haptic_contract.fields import span
+from haptic_contract.teleop import Command, CommandLimits, Feedback, RemotePlane
 from haptic_msgs.msg import RobotImpedance, TeleopCommand, TeleopFeedback
 from haptic_util.cdr import MessageCodec
-from remote_probe.teleop import Command, CommandLimits, Feedback, RemotePlane
 
 __all__ = ['COMMAND', 'FEEDBACK', 'RobotReport', 'command_fields', 'command_from_fields',
            'command_session',
@@ -21,20 +22,14 @@ __all__ = ['COMMAND', 'FEEDBACK', 'RobotReport', 'command_fields', 'command_from
 COMMAND = MessageCodec(TeleopCommand)
 FEEDBACK = MessageCodec(TeleopFeedback)
 _SECOND = 1_000_000_000
-
-
-def _span(codec: MessageCodec, first: str, last: str) -> slice:
-    return slice(codec.index(first), codec.index(last) + 1)
-
-
 _FRAME = COMMAND.index('header.frame_id')  # the same in every stamped message here
-_COMMAND_IDS = _span(COMMAND, 'session', 'sequence')
-_COMMAND_NUMBERS = _span(COMMAND, 'position.x', 'energy_in')
-_FEEDBACK_IDS = _span(FEEDBACK, 'session', 'sequence')
-_FEEDBACK_ECHO = _span(FEEDBACK, 'echo.sec', 'echo_sequence')
-_FEEDBACK_NUMBERS = _span(FEEDBACK, 'echo_hold', 'energy_in')
+_COMMAND_IDS = span(COMMAND, 'session', 'sequence')
+_COMMAND_NUMBERS = span(COMMAND, 'position.x', 'energy_in')
+_FEEDBACK_IDS = span(FEEDBACK, 'session', 'sequence')
+_FEEDBACK_ECHO = span(FEEDBACK, 'echo.sec', 'echo_sequence')
+_FEEDBACK_NUMBERS = span(FEEDBACK, 'echo_hold', 'energy_in')
 _FEEDBACK_KIND = FEEDBACK.index('kind')
-_FEEDBACK_PLANE = _span(FEEDBACK, 'plane.point.x', 'plane.tool_point.z')
+_FEEDBACK_PLANE = span(FEEDBACK, 'plane.point.x', 'plane.tool_point.z')
 _PLANE = {name: FEEDBACK.index(f'plane.{name}') - _FEEDBACK_PLANE.start
           for name in ('point.x', 'normal.x', 'stiffness.x', 'damping.x')}
 _NO_PLANE = (0.0,) * (_FEEDBACK_PLANE.stop - _FEEDBACK_PLANE.start)

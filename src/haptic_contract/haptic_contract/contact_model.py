@@ -1,4 +1,4 @@
-"""A local model of the contact (``haptic_msgs/ContactModel``), checked and rendered on the device.
+"""A local model of the contact (``haptic_msgs/ContactModel``): values, checks and fields.
 
 Why: a force computed from a pose one round trip old lags the motion, and a stiff wall then gives
 energy back (it rebounds). The force renderer sends, with every answer, the planes of the surface
@@ -6,38 +6,114 @@ near the tool and their material; the device renders them against its *current* 
 own servo rate, so the force lags by one servo period instead of a round trip.
 
 Each plane pushes one point of the tool (its ``tool_point``, in the tip frame: zero for the tip
-itself) with the force renderer's own law (``force_renderer.spring_damper``): a depth d behind the
-plane gives K ⊙ (d·n) − C ⊙ v, never pulling. A plane is exact only at its point: on a surface of
+itself) with the renderer's own law (``plane_law``): a depth d behind the plane gives
+K ⊙ (d·n) − C ⊙ v, never pulling. A plane is exact only at its point: on a surface of
 curvature radius R, a tip that slid a distance s along it sees the plane off by about s²/(2R),
 hence a force error of K·s²/(2R); ``valid_radius`` bounds s (``docs/local_rendering.md`` has the
 figures on the cylinder and the hand).
+
+Producers (the force renderer, the operator's leader) write a model with ``model_fields``, the
+device reads one with ``ContactModel.from_fields``: the message's layout is looked up here, by
+field name, and nowhere else.
 """
 from dataclasses import dataclass
 import enum
+import functools
 import math
+import re
 from typing import NamedTuple, Sequence
 
-from force_renderer.spring_damper import unilateral_spring_damper
-from haptic_wand_driver.orientation import rotate
-from haptic_wand_driver.wrench_input import saturate_components
+from haptic_contract.fields import span
+from haptic_contract.plane_law import damped_along, saturate_components, unilateral_spring_damper
+from haptic_contract.wand import rotate
+from haptic_msgs.msg import ContactModel as ContactModelMessage
 
-__all__ = ['Kind', 'ModelRefused', 'Plane', 'ContactModel', 'MAX_PLANES', 'UNIT_TOLERANCE']
+__all__ = ['Kind', 'MAX_PLANES', 'ModelRefused', 'Plane', 'ContactModel', 'UNIT_TOLERANCE',
+           'model_fields']  # and MODEL, the codec (``__getattr__``)
 
-MAX_PLANES = 3
+# ContactPlane[3]: read from the definition's types, which imports nothing more.
+MAX_PLANES = int(re.search(r'\[(\d+)\]', ContactModelMessage.get_fields_and_field_types()
+                           ['planes'])[1])
 UNIT_TOLERANCE = 1e-6  # |normal| may differ from 1 by this much
 Vector3 = tuple[float, float, float]
 _PLANE_VECTORS = ('point', 'normal', 'stiffness', 'damping', 'tool_point')
+_ZERO = (0.0, 0.0, 0.0)
+
+
+class _Layout(NamedTuple):
+    """Where a ContactModel's fields sit in the codec's tuple: slices, found by name."""
+
+    codec: object  # haptic_util.cdr.MessageCodec
+    header: slice  # stamp, frame, object, kind, plane count
+    planes: slice
+    plane_size: int
+    limits: slice  # force limit, valid for, valid radius
+    numbers: slice  # the limits, the tip and the wrench
+    tip: slice
+    wrench: slice
+    at: dict  # within one plane's leaves, where each vector starts
+
+    def plane(self, k: int) -> slice:
+        """Return the slice of plane ``k``'s leaves."""
+        start = self.planes.start + self.plane_size * k
+        return slice(start, start + self.plane_size)
+
+
+@functools.cache
+def _layout() -> _Layout:
+    """Build the codec and find the fields, once, on first use.
+
+    Not at import: the codec imports the message's nested types (geometry_msgs), which a
+    device's core that never reads a message must not load.
+    """
+    from haptic_util.cdr import MessageCodec
+
+    codec = MessageCodec(ContactModelMessage)
+    planes = span(codec, 'planes[0].point.x', f'planes[{MAX_PLANES - 1}].tool_point.z')
+    return _Layout(
+        codec, span(codec, 'header.stamp.sec', 'plane_count'), planes,
+        (planes.stop - planes.start) // MAX_PLANES, span(codec, 'force_limit', 'valid_radius'),
+        span(codec, 'force_limit', 'wrench.torque.z'), span(codec, 'tip.x', 'tip.z'),
+        span(codec, 'wrench.force.x', 'wrench.torque.z'),
+        {name: codec.index(f'planes[0].{name}.x') - planes.start for name in _PLANE_VECTORS})
+
+
+def __getattr__(name: str):
+    """``MODEL``, the ContactModel codec, is built on first use (see ``_layout``)."""
+    if name == 'MODEL':
+        return _layout().codec
+    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
 
 
 class Kind(enum.IntEnum):
     """What a model holds, as ``haptic_msgs/ContactModel.KIND_*``."""
 
-    FREE = 0
-    PLANES = 1
-    UNAVAILABLE = 2
+    FREE = ContactModelMessage.KIND_FREE
+    PLANES = ContactModelMessage.KIND_PLANES
+    UNAVAILABLE = ContactModelMessage.KIND_UNAVAILABLE
 
 
 _KINDS = {int(kind): kind for kind in Kind}  # a message's kind -> Kind, without Kind()'s cost
+
+
+def model_fields(header: tuple, name: str, kind: int, planes: Sequence, force_limit: float,
+                 valid_for: float, valid_radius: float, tip: Sequence[float],
+                 wrench: Sequence[float], plane_count: int | None = None) -> tuple:
+    """Return the leaf fields of a ContactModel message.
+
+    ``header`` is (sec, nanosec, frame_id), ``name`` the object's; each plane is (point,
+    normal, stiffness, damping[, tool_point]), (3,) each (no tool point: the tip itself);
+    ``wrench`` (6,) the law's force and torque. ``plane_count`` is ``len(planes)`` unless set
+    (a test's malformed model).
+    """
+    values = [value for plane in planes
+              for value in (*plane[0], *plane[1], *plane[2], *plane[3],
+                            *(plane[4] if len(plane) > 4 else _ZERO))]
+    slots = _layout().planes
+    values += [0.0] * (slots.stop - slots.start - len(values))
+    count = len(planes) if plane_count is None else plane_count
+    return (*header, name, int(kind), count, *values, force_limit, valid_for, valid_radius, *tip,
+            *wrench)
 
 
 class ModelRefused(ValueError):
@@ -99,25 +175,26 @@ class ContactModel:
         every answer, so a model whose numbers are all finite and whose limits are not
         negative skips the field-by-field checks that find the culprit.
         """
-        sec, nanosec, frame, _, kind, count = fields[:6]
+        at = _layout()
+        sec, nanosec, frame, _, kind, count = fields[at.header]
         if frame != frame_id:
             raise ModelRefused('header.frame_id', f'is {frame!r}, not {frame_id!r}')
         if kind not in _KINDS:
             raise ModelRefused('kind', f'is {kind}, not one of {[k.value for k in Kind]}')
         if count > MAX_PLANES:
             raise ModelRefused('plane_count', f'is {count}, more than {MAX_PLANES}')
-        force_limit, valid_for, valid_radius = fields[51:54]
-        if not (all(map(math.isfinite, fields[51:63]))
-                and all(map(math.isfinite, fields[6:6 + 15 * count]))
+        force_limit, valid_for, valid_radius = fields[at.limits]
+        if not (all(map(math.isfinite, fields[at.numbers]))
+                and all(map(math.isfinite, fields[at.planes.start:at.plane(count).start]))
                 and min(force_limit, valid_for, valid_radius) >= 0.0):
             _refuse(fields, count)
-        planes = tuple(_plane(k, fields[6 + 15 * k:21 + 15 * k]) for k in range(count))
+        planes = tuple(_plane(k, fields[at.plane(k)]) for k in range(count))
         model = object.__new__(cls)  # checked above: the dataclass's frozen __init__ costs more
         model.__dict__.update(
             stamp=sec + nanosec * 1e-9, kind=_KINDS[kind],
             planes=planes if kind == Kind.PLANES else (), force_limit=force_limit,
-            valid_for=valid_for, valid_radius=valid_radius, tip=tuple(fields[54:57]),
-            held_wrench=tuple(fields[57:63]))
+            valid_for=valid_for, valid_radius=valid_radius, tip=tuple(fields[at.tip]),
+            held_wrench=tuple(fields[at.wrench]))
         return model
 
     def valid(self, position: Sequence[float]) -> bool:
@@ -164,8 +241,8 @@ class ContactModel:
             f = unilateral_spring_damper((depth * n[0], depth * n[1], depth * n[2]), n, speed,
                                          plane.stiffness, plane.damping)
             if contact_damping is not None:
-                f = _damped_along(saturate_components(f, limit), n, speed,
-                                  contact_damping(plane))
+                f = damped_along(saturate_components(f, limit), n, speed,
+                                 contact_damping(plane))
             t = _cross(arm, f)
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
@@ -179,42 +256,34 @@ def _depth(plane: Plane, position: Sequence[float], arm: Vector3) -> float:
             + n[2] * (p[2] - (position[2] + arm[2])))
 
 
-def _damped_along(force: Vector3, normal: Vector3, velocity: Sequence[float],
-                  damping: float) -> Vector3:
-    """``force`` minus ``damping`` times the normal speed, along the normal, never pulling."""
-    push = force[0] * normal[0] + force[1] * normal[1] + force[2] * normal[2]
-    speed = velocity[0] * normal[0] + velocity[1] * normal[1] + velocity[2] * normal[2]
-    change = max(-push, -damping * speed)
-    return (force[0] + change * normal[0], force[1] + change * normal[1],
-            force[2] + change * normal[2])
-
-
 def _refuse(fields: Sequence, count: int) -> None:
     """Raise ModelRefused naming the first bad number, in the order the fields are read."""
-    for name, value in zip(('force_limit', 'valid_for', 'valid_radius'), fields[51:54]):
+    at = _layout()
+    for name, value in zip(('force_limit', 'valid_for', 'valid_radius'), fields[at.limits]):
         _non_negative(name, value)
-    _finite('tip', fields[54:57])
-    _finite('wrench', fields[57:63])
+    _finite('tip', fields[at.tip])
+    _finite('wrench', fields[at.wrench])
     for k in range(count):
-        values = fields[6 + 15 * k:21 + 15 * k]
-        for label, at in zip(_PLANE_VECTORS, range(0, 15, 3)):
-            _finite(f'planes[{k}].{label}', values[at:at + 3])
+        values = fields[at.plane(k)]
+        for label in _PLANE_VECTORS:
+            _finite(f'planes[{k}].{label}', values[at.at[label]:at.at[label] + 3])
         _plane(k, values)
 
 
 def _plane(k: int, values: Sequence[float]) -> Plane:
     """Return plane k of a model whose numbers are finite, its gains and normal checked."""
-    if min(values[6:12]) < 0.0:
-        for label, at in (('stiffness', 6), ('damping', 9)):
-            if min(values[at:at + 3]) < 0.0:
-                raise ModelRefused(f'planes[{k}].{label}',
-                                   f'is negative: {list(values[at:at + 3])}')
-    nx, ny, nz = values[3:6]
+    at = _layout().at
+    point, normal, stiffness, damping, tool_point = (
+        tuple(values[at[name]:at[name] + 3]) for name in _PLANE_VECTORS)
+    if min(stiffness + damping) < 0.0:
+        for label, gains in (('stiffness', stiffness), ('damping', damping)):
+            if min(gains) < 0.0:
+                raise ModelRefused(f'planes[{k}].{label}', f'is negative: {list(gains)}')
+    nx, ny, nz = normal
     norm = math.sqrt(0.0 + nx * nx + ny * ny + nz * nz)  # the order sum() adds them in
     if abs(norm - 1.0) > UNIT_TOLERANCE:
         raise ModelRefused(f'planes[{k}].normal', f'is not unit (|n| = {norm:.9g})')
-    return Plane(tuple(values[0:3]), (nx, ny, nz), tuple(values[6:9]), tuple(values[9:12]),
-                 tuple(values[12:15]))
+    return Plane(point, (nx, ny, nz), stiffness, damping, tool_point)
 
 
 def _finite(name: str, vector: Sequence[float]) -> None:

@@ -2,11 +2,11 @@
 import numpy as np
 from rclpy.serialization import deserialize_message
 
+from haptic_contract.teleop import Command, Feedback, RemotePlane
+from haptic_contract.teleop_fields import (COMMAND, command_fields, command_from_fields, FEEDBACK,
+                                           feedback_fields, feedback_from_fields,
+                                           impedance_message, impedance_report)
 from haptic_msgs.msg import TeleopCommand, TeleopFeedback
-from remote_probe.link_messages import (COMMAND, command_fields, command_from_fields, FEEDBACK,
-                                        feedback_fields, feedback_from_fields,
-                                        impedance_message, impedance_report)
-from remote_probe.teleop import Command, Feedback, RemotePlane
 
 
 def test_a_command_crosses_whole_and_rclpy_reads_each_field_by_its_name():

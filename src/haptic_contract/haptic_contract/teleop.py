@@ -2,28 +2,38 @@
 
 ``Command`` goes from the operator to the robot with every wand pose; ``Feedback`` comes back.
 Both are in the robot's base frame and SI units; the ROS nodes read them from and write them to
-``haptic_msgs/TeleopCommand`` and ``TeleopFeedback`` (``remote_probe.link_messages``).
+``haptic_msgs/TeleopCommand`` and ``TeleopFeedback`` (``teleop_fields``).
 
 What arrives is checked at the door (``command_refusal``, ``feedback_refusal``) before anything
 uses it: finite, and within what the physics allows. A number far outside that is not a fast
 operator or a hard press but a broken or hostile peer, and one absurd value (a speed of 1e308
 m/s) used once poisons every energy book after it.
 """
+import enum
 import math
 import secrets
 from typing import NamedTuple
 
 import numpy as np
 
-from remote_probe.admission import Refusal
+__all__ = ['Command', 'CommandLimits', 'Feedback', 'HAND_SPEED', 'Refusal', 'RemotePlane',
+           'SCHEMES', 'Scheme', 'command_refusal', 'feedback_refusal', 'new_session']
 
-__all__ = ['Command', 'CommandLimits', 'Feedback', 'HAND_SPEED', 'RemotePlane', 'SCHEMES',
-           'command_refusal', 'feedback_refusal', 'new_session']
 
-SCHEMES = ('direct', 'tdpa', 'model')
-"""The bilateral schemes: direct force reflection (the baseline), time-domain passivity on both
-ports (Artigas et al. 2011), and model-mediated teleoperation (the device renders the remote
-site's estimate of the contact)."""
+class Scheme(enum.StrEnum):
+    """The bilateral schemes, by the names a parameter and the command line give them.
+
+    Direct force reflection (the baseline), time-domain passivity on both ports (Artigas et al.
+    2011), and model-mediated teleoperation (the device renders the remote site's estimate of
+    the contact).
+    """
+
+    DIRECT = 'direct'
+    TDPA = 'tdpa'
+    MODEL = 'model'
+
+
+SCHEMES = tuple(scheme.value for scheme in Scheme)  # the names, as plain strings
 
 HAND_SPEED = 5.0  # [m/s] no hand moves a wand faster (fast jabs reach 1-2 m/s)
 MAX_FEEDBACK_FORCE = 500.0  # [N] beyond the range of any F/T sensor that holds a probe
@@ -32,6 +42,13 @@ MAX_PLANE_STIFFNESS = 1e6  # [N/m] stiffer than bone under a probe
 MAX_PLANE_DAMPING = 1e4  # [N·s/m]
 MAX_ECHO_HOLD = 60.0  # [s] a command held longer than this at the robot is no echo
 UNIT_TOLERANCE = 1e-6  # how far from unit length a normal may be
+
+
+class Refusal(NamedTuple):
+    """Why a message was not taken: ``kind`` a short fixed text (counted), ``detail`` its case."""
+
+    kind: str
+    detail: str = ''
 
 
 def new_session() -> int:

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from haptic_wand_driver._checks import (checked_number, finite_components, finite_vector,
-                                        read_only_vector)
+from haptic_contract.checks import (finite_components, finite_number, finite_vector,
+                                    read_only_vector)
 
 
 @pytest.mark.parametrize('value', [np.array([1.0, -2.0, 3.5]), (1.0, -2.0, 3.5), [1, -2, 3.5],
@@ -46,9 +46,9 @@ def test_read_only_vector_holds_the_floats_and_refuses_writes():
                                             (0.0, dict(minimum=0.0, strict=True))])
 def test_checked_number_refuses_naming_the_field(value, options):
     with pytest.raises(ValueError, match='rate must be finite'):
-        checked_number(value, 'rate', **options)
+        finite_number(value, 'rate', **options)
 
 
 def test_checked_number_returns_a_float():
-    assert checked_number(np.float32(0.5), 'rate', minimum=0.0) == 0.5
-    assert type(checked_number(3, 'rate')) is float
+    assert finite_number(np.float32(0.5), 'rate', minimum=0.0) == 0.5
+    assert type(finite_number(3, 'rate')) is float
