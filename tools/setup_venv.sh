@@ -89,6 +89,11 @@ for pkg in "${packages[@]}"; do
   (cd "src/$pkg" && "$venv/bin/python" -W ignore setup.py -q install_data -d "$venv" >/dev/null)
 done
 
+# The engine's status codes are CollisionState's own constants (haptic_contract), so its
+# kernels compile once the messages are built.
+step "waiting for haptic_msgs"
+wait "$msgs" || { echo "[setup] building haptic_msgs failed"; exit 1; }
+
 step "compiling the collision kernels (numba caches them per user for every later start)"
 "$venv/bin/python" -c "
 import pathlib
@@ -96,9 +101,6 @@ from collision_engine import load_scene
 for scene in sorted(pathlib.Path('src/collision_engine/scenes').glob('*.yaml')):
     load_scene(scene)
 "
-
-step "waiting for haptic_msgs"
-wait "$msgs" || { echo "[setup] building haptic_msgs failed"; exit 1; }
 "$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, haptic_contract, collision_engine, \
 force_renderer, haptic_wand_driver, haptic_bringup, remote_probe, ultrasound_sim, site_gateway, zenoh" || { echo "[setup] import check failed"; exit 1; }
 finish_step
