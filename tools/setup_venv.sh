@@ -58,7 +58,7 @@ step "pointing the wheels' CMake exports at this interpreter"
 finish_step
 
 # haptic_msgs builds (C and CMake, most of it waiting on the compiler) while the Python packages
-# install and the kernels compile: nothing of those needs it before the import check.
+# install: installing them needs no message.
 build_msgs() {
   local started
   started=$(now)
