@@ -20,7 +20,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from test_teleop import DELAY, reports, streams
+from test_teleop import DELAY, reports, streams, wait_for_the_first_pose
 
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_msgs.msg import TeleopCommand
@@ -132,9 +132,10 @@ def attacked(tmp_path_factory):
                         intra_process=False, link={'delay': DELAY, 'jitter': 0.1 * DELAY})
     windows = {}
     with Loop(config) as loop:
+        # From the wand's first pose: a fresh clone's first session compiles its kernels first.
+        deadline = wait_for_the_first_pose(config.domain_id, 180.0) + 30.0
         stranger = Stranger(config.remote_domain_id)
         try:
-            deadline = time.monotonic() + 30.0
             while stranger.pressed < PRESSING and time.monotonic() < deadline:
                 time.sleep(0.05)
             assert stranger.heard is not None, 'the operator\'s commands were never heard'
