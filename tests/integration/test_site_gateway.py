@@ -158,6 +158,10 @@ def test_poses_cross_both_ways_in_order_over_mutual_tls(site):
     sites.run([(publish_out, 1), (publish_back, 10)], count, 1e-3)  # 1 kHz out, 100 Hz back
     sites.spin(0.3)
     remote = sites.next_report()  # after the run: both gateways' counts are final
+    deadline = time.monotonic() + PEER_WAIT  # the operator's report comes on its own 1 Hz tick
+    while (sites.operator_report.get(f'in {TO_OPERATOR} received') != remote['out relayed']
+           and time.monotonic() < deadline):
+        sites.spin(0.05)
     xs, delays = np.array(out).T
     back_xs = np.array(back)[:, 0]
     p50, p99 = np.percentile(delays, [50, 99])
