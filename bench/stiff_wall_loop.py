@@ -16,6 +16,7 @@ taps, the same device law given the exact plane at the tip at 50 kHz, no loop), 
 applied force. Both passivity controllers are on in both.
 """
 import argparse
+from dataclasses import replace
 import math
 import os
 import pathlib
@@ -35,13 +36,12 @@ from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import applied_work, read_session
 from haptic_contract.contact_model import ContactModel, Kind, Plane
 from haptic_util.paths import package_file
-from haptic_wand_driver.assembly import local_renderer, port_passivity
-from haptic_wand_driver.device import DeviceLimits
+from haptic_wand_driver.assembly import local_renderer, port_passivity, simulated_wand_config
 from haptic_wand_driver.experiments import make_script, surface_projection
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
-from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from haptic_wand_driver.simulated import SimulatedWand
 
 __all__ = ['compare', 'ideal_depth', 'run', 'main']
 
@@ -111,11 +111,10 @@ def ideal_depth(stiffness: float, *, duration: float = 6.0, rate: float = IDEAL_
     scene = load_scene(package_file(SCENE))
     hand = OperatorHand(make_script('cuboid', surface_projection(scene)),
                         stiffness=wand.hand_stiffness, damping=wand.hand_damping)
-    limits = DeviceLimits(force_limit=wand.force_limit, torque_limit=wand.torque_limit)
-    device = SimulatedWand(SimulatedWandConfig(
-        mass=[wand.device_mass] * 3, damping=[wand.device_damping] * 3, step=1.0 / rate,
-        limits=limits), operator=hand)
-    device.render_locally(_ContinuousWall(local_renderer(wand, limits, port_passivity(wand)),
+    config = replace(simulated_wand_config(wand), step=1.0 / rate)
+    device = SimulatedWand(config, operator=hand)
+    device.render_locally(_ContinuousWall(local_renderer(wand, config.limits,
+                                                         port_passivity(wand)),
                                           scene, stiffness, force.damping))
     return max(-scene.query(device.read(t).position).distance
                for t in np.arange(0.0, duration, 1e-3))

@@ -4,6 +4,7 @@ from dataclasses import dataclass
 from haptic_contract.shared_defaults import DEFAULT_SCENE, DEVICE_DAMPING, FORCE_LIMIT, \
     LOOP_RATE
 from haptic_util.parameters import parameter
+from haptic_wand_driver.simulated import DEVICE_MASS, SERVO_RATE, TORQUE_LIMIT
 
 __all__ = ['WandDriverParams']
 
@@ -38,7 +39,7 @@ class WandDriverParams:
     model_step_rate: float = parameter(0.0, 'local rendering: a new contact model eases in at '
                                        'most this fast (spring push; 0: at once)', unit='N/s',
                                        low=0.0)
-    servo_rate: float = parameter(4000.0, 'simulated device: its servo rate (the dynamics '
+    servo_rate: float = parameter(SERVO_RATE, 'simulated device: its servo rate (the dynamics '
                                   'substep)', unit='Hz', low=100.0, high=100000.0)
     force_limit: float = parameter(FORCE_LIMIT, 'device force limit (saturation)', unit='N',
                                    low=0.0)
@@ -47,8 +48,9 @@ class WandDriverParams:
     passivity_max_damping: float = parameter(50.0, 'largest damping it adds (keep below '
                                              'device mass / servo period)', unit='N*s/m',
                                              low=0.0)
-    torque_limit: float = parameter(0.5, 'device torque limit (saturation)', unit='N*m', low=0.0)
-    device_mass: float = parameter(0.15, 'simulated apparent mass per axis', unit='kg',
+    torque_limit: float = parameter(TORQUE_LIMIT, 'device torque limit (saturation)', unit='N*m',
+                                    low=0.0)
+    device_mass: float = parameter(DEVICE_MASS, 'simulated apparent mass per axis', unit='kg',
                                    low=1e-4)
     device_damping: float = parameter(DEVICE_DAMPING, 'simulated physical damping per axis',
                                       unit='N*s/m', low=0.0)

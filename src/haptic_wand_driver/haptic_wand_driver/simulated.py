@@ -33,12 +33,17 @@ import numpy as np
 
 from haptic_contract.checks import finite_components, finite_number, finite_vector
 from haptic_contract.plane_law import saturate_components
+from haptic_contract.shared_defaults import DEVICE_DAMPING, FORCE_LIMIT
 from haptic_contract.wand import roll_axis
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.operator import impedance, OperatorHand
 
-__all__ = ['SimulatedWand', 'SimulatedWandConfig']
+__all__ = ['DEVICE_MASS', 'SERVO_RATE', 'SimulatedWand', 'SimulatedWandConfig', 'TORQUE_LIMIT']
+
+DEVICE_MASS = 0.15  # [kg] apparent mass per axis
+TORQUE_LIMIT = 0.5  # [N*m]
+SERVO_RATE = 4000.0  # [Hz] the substep's rate
 
 _STABLE_STEP = 0.2
 """Largest step · sqrt(k / m) and step · c / m accepted for the hand's explicit spring-damper."""
@@ -67,15 +72,15 @@ class SimulatedWandConfig:
     initial_roll, initial_yaw : float, rad
     """
 
-    mass: np.ndarray = field(default_factory=lambda: np.full(3, 0.15))
-    damping: np.ndarray = field(default_factory=lambda: np.full(3, 0.3))
+    mass: np.ndarray = field(default_factory=lambda: np.full(3, DEVICE_MASS))
+    damping: np.ndarray = field(default_factory=lambda: np.full(3, DEVICE_DAMPING))
     roll_inertia: float = 5e-4
     yaw_inertia: float = 5e-4
     roll_damping: float = 2e-3
     yaw_damping: float = 2e-3
     limits: DeviceLimits = field(
-        default_factory=lambda: DeviceLimits(force_limit=10.0, torque_limit=0.5))
-    step: float = 2.5e-4
+        default_factory=lambda: DeviceLimits(force_limit=FORCE_LIMIT, torque_limit=TORQUE_LIMIT))
+    step: float = 1.0 / SERVO_RATE
     initial_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
     initial_roll: float = 0.0
     initial_yaw: float = 0.0
