@@ -159,8 +159,8 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
         for delivery in to_operator.deliver(now):
             leader.receive(now, delivery.payload)
         if renderer is not None:
-            plane = leader.plane(now, state.position)
-            if plane is not None or leader.live(now):  # silent: no answer, as the leader node
+            known, plane = leader.model(now, state.position)
+            if known:
                 answers.taken(now, MODEL_LIFETIME)  # answered as it went out, as in the site
                 renderer.take(_model(now, plane, state.position), answers.deadline)
         else:

@@ -231,6 +231,16 @@ class Leader:
         self._shown_at = now
         return self._shown
 
+    def model(self, now: float, wand) -> tuple[bool, RemotePlane | None]:
+        """Return whether the leader knows what the wand touches, and the plane to show it.
+
+        Unknown while the feedback is silent: then no model goes out, so the device's last one
+        lapses to zero force and its port keeps the books of the contact the silence
+        interrupted, which a free model would close.
+        """
+        plane = self.plane(now, wand)
+        return plane is not None or self.live(now), plane
+
     def _given_back(self, passive: float, shown: float, now: float) -> float:
         """Return the shift (m) after giving back what a silence added, at ``rejoin_speed``.
 

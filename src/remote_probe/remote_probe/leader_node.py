@@ -141,10 +141,8 @@ class LeaderNode(Node):
             self._command_pub.publish(command_fields(command, self.params.robot_frame))
         now = self._now()
         if self.params.scheme == Scheme.MODEL:
-            plane = self.leader.plane(now, position)
-            if plane is None and not self.leader.live(now):
-                # Unknown, not free: the device zeroes the force when the last model lapses,
-                # and its port keeps the books of the contact the silence interrupted.
+            known, plane = self.leader.model(now, position)
+            if not known:
                 self._unknown += 1
                 return
             self._answer(stamp_ns, plane, position)
