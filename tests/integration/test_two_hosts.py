@@ -74,8 +74,9 @@ import json, time, rclpy
 from rclpy.node import Node
 rclpy.init()
 node = Node('graph_probe', start_parameter_services=False, enable_rosout=False)
-deadline = time.monotonic() + 8.0
-while time.monotonic() < deadline and len(node.get_topic_names_and_types()) < 5:
+own = {'/wand/pose', '/teleop/command'}  # this site's: discovery has reached them
+deadline = time.monotonic() + 30.0
+while time.monotonic() < deadline and not own <= {n for n, _ in node.get_topic_names_and_types()}:
     time.sleep(0.1)
 time.sleep(2.0)  # whatever else there is to discover
 print(json.dumps(sorted(name for name, _ in node.get_topic_names_and_types())))
@@ -164,9 +165,9 @@ def session(tmp_path_factory):
                                        '--duration', str(SCAN_DURATION))
         started = wait_for_text(folder / 'operator.log', 'loop closed: experiment started',
                                 sites['operator'], START_LIMIT)
-        graph = subprocess.run(hosts.command('operator', sys.executable, '-c', GRAPH),
-                               env=loop_environment(domain, folder / 'log'),
-                               capture_output=True, text=True, timeout=60)
+        graph = subprocess.Popen(hosts.command('operator', sys.executable, '-c', GRAPH),
+                                 env=loop_environment(domain, folder / 'log'),
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         time.sleep(max(0.0, started + CUT_AFTER - time.time()))
         cut = time.time()
         hosts.link(up=False)
@@ -178,6 +179,7 @@ def session(tmp_path_factory):
                                              f'tls/{REMOTE_ADDRESS}:{PORT}'),
                                capture_output=True, text=True, timeout=60)
         codes = {role: process.wait(START_LIMIT) for role, process in sites.items()}
+        graph = subprocess.CompletedProcess(graph.args, graph.wait(60), *graph.communicate())
     finally:
         for process in sites.values():
             if process.poll() is None:
