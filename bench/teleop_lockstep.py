@@ -92,7 +92,7 @@ def _model(time: float, plane, tip) -> ContactModel:
 def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
          duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0,
          easing: float = MODEL_STEP_RATE, link_timeout: float | None = None,
-         force_hold: tuple | None = None) -> dict:
+         force_hold: tuple | None = None, outage: tuple | None = None) -> dict:
     """Run the scan; return the operator's and the remote site's per-tick arrays.
 
     ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``. ``ticks``: the tick
@@ -103,7 +103,8 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     ``easing``: the driver's ``model_step_rate`` (N/s; 0: each model at once, the baseline).
     ``link_timeout``: both ends' watchdogs (s); None waits out the jitter, as the launcher sets.
     ``force_hold``: (start, end) s, the remote site holding the force it measured at the start
-    (``Follower.hold_force``) until the end; the run then has ``held`` (N).
+    (``Follower.hold_force``) until the end; the run then has ``held`` (N). ``outage``: (start,
+    end) s, the link carries nothing either way.
     Returns ``time``, ``wand``, ``felt`` (applied since the tick before) at the operator's
     ticks, and ``remote_time``, ``patient``, ``tcp``.
     """
@@ -130,6 +131,9 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     to_robot, to_operator = EmulatedLink(link), EmulatedLink(LinkConfig(
         delay, jitter, loss, seed=seed + 1))
     count = round(duration / TICK)
+    cut = np.zeros(count + 1, dtype=bool)
+    if outage is not None:
+        cut[round(outage[0] / TICK):round(outage[1] / TICK)] = True
     operating = np.ones(count + 1, dtype=bool) if ticks is None else np.isin(
         np.arange(count + 1), ticks)
     operator_rows, remote_rows, held = [], [], np.nan
@@ -140,7 +144,7 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
             state = device.read(now)
             operator_rows.append((now, *state.position, *device.applied()[0]))
             command = leader.command(now, state.position, state.linear_velocity)
-            if command is not None:  # none until the feedback is heard
+            if command is not None and not cut[k]:  # none until the feedback is heard
                 to_robot.send(now, command)
         for delivery in to_robot.deliver(now):
             follower.receive(now, delivery.payload)
@@ -151,7 +155,8 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
             follower.hold_force(0.0)
         reading = sensor.measure(now, remote.external_force).force
         robot.command(follower.target(now, remote.position, remote.velocity, reading, TICK))
-        to_operator.send(now, follower.feedback(now))
+        if not cut[k]:
+            to_operator.send(now, follower.feedback(now))
         remote = robot.read(now + TICK)
         remote_rows.append((now + TICK, *remote.external_force, *remote.position))
         if not operating[k]:

@@ -3,11 +3,13 @@
 The figures are ``teleop_scan.figures`` of the force the simulated device applied to the hand and
 the force the patient's tissue put on the probe; the schemes' own books are not read.
 """
+import numpy as np
 import pytest
 import teleop_lockstep
 import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD
+from remote_probe.leader import LeaderConfig
 
 MAX_PATIENT_FORCE = 20.0  # [N] the safety's default
 
@@ -120,3 +122,23 @@ def test_a_force_held_through_the_sweep_stays_within_half_a_newton_of_the_set_on
     assert 5.0 < error['held_n'] < 20.0
     assert error['hold_error_max_n'] <= 0.5, error
     assert own['hold_error_max_n'] > 10 * error['hold_error_max_n'], own
+
+
+def test_after_a_link_outage_mid_press_the_hand_feels_what_the_patient_gets():
+    """The link carries nothing for 1 s as the sweep begins, and the hand sinks meanwhile.
+
+    From 2 s after it is back to the end of the sweep the hand feels, scaled, what the patient
+    gets. Giving the shift back beyond the energy the spring held (the baseline) moved the robot
+    in while the device's port held the hand's force: 4.4 N felt, scaled, against 17 N at the
+    patient, to the end of the sweep.
+    """
+    outage = (teleop_lockstep.SWEEP[0], teleop_lockstep.SWEEP[0] + 1.0)
+    run = teleop_lockstep.scan('model', 0.1, jitter=0.01, loss=0.01, outage=outage)
+    scale = LeaderConfig().force_scale
+
+    def median(times, values, start, end):
+        return np.median(values[(times >= start) & (times < end)])
+    for start in np.arange(outage[1] + 2.0, teleop_lockstep.SWEEP[1], 0.5):
+        felt = median(run['time'], run['felt'][:, 2], start, start + 0.5) / scale
+        patient = median(run['remote_time'], run['patient'][:, 2], start, start + 0.5)
+        assert patient > 1.0 and felt == pytest.approx(patient, rel=0.1), start

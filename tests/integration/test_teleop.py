@@ -161,7 +161,7 @@ def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_
     target, which lay further in) and retracts: the patient's force never rises during the
     stall; what the gateway held is older than the link allows and never executed; and when the
     link is back the robot and the operator's model meet again: the patient is pressed and the
-    hand feels it, as before the stall."""
+    hand feels, scaled, the force the patient gets."""
     with teleop(tmp_path, duration=SCAN_DURATION) as loop:
         start = wait_for_the_first_pose(session_domain_id(), SCAN_DURATION)
         time.sleep(max(0.0, start + PRESSING[0] + 0.5 - time.monotonic()))
@@ -194,11 +194,11 @@ def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_
     assert stale and int(stale[-1]) > 0
     felt_times, felt = series['/wand/applied_wrench']
     felt_before = np.median(felt[window(felt_times, dropped - 0.5, dropped), 2])
-    again = dropped + 3.0  # the shift the stall left, given back at the rejoin speed
+    again = dropped + 3.0  # the robot rejoined, the hand pressing on the force it left
     felt_after = np.median(felt[window(felt_times, again, again + 0.5), 2])
     pressed_after = np.median(pressing[window(patient_times, again, again + 0.5)])
-    assert felt_after > 0.5 * felt_before > 0.0  # the hand presses on something again
-    assert pressed_after > 3.0
+    assert felt_before > 0.0 and pressed_after > 1.0  # the hand presses on something again
+    assert felt_after / FORCE_SCALE == pytest.approx(pressed_after, rel=0.2)  # as the patient
     assert np.max(pressing) <= MAX_PATIENT_FORCE
 
 

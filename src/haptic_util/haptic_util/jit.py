@@ -8,7 +8,7 @@ instead of raising from compiled code.
 
 numba caches beside the source, so every install (a ``colcon build``, a venv) would compile
 again, and a build must leave the sources as it found it. So a kernel compiled through ``jit``
-is cached in a per-user folder (``$NUMBA_CACHE_DIR`` or ``~/.cache``, by package), stamped with
+is cached in a per-user folder (``$NUMBA_CACHE_DIR`` or ``~/.cache``, by install), stamped with
 its source file as numba's own cache is: a module of kernels that call only their own needs no
 more (``collision_engine._jit`` adds a fingerprint of all its modules for the engine's, which
 call one another). Only numba is imported here, so a package's core can compile a kernel
@@ -41,13 +41,15 @@ def writable(folder: Path) -> bool:
 class _UserCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
     """numba's cache locator for the kernels compiled through ``jit``.
 
-    Under the per-user folder, by package; stamped with the source file, as numba's own.
+    Under the per-user folder, by package and where it is installed (numba's own subpath: the
+    folder's name and a hash of its path), so that two checkouts of different code never
+    overwrite each other's kernels; stamped with the source file, as numba's own.
     """
 
     def __init__(self, py_func, py_file) -> None:
         self._py_file = py_file
         self._lineno = py_func.__code__.co_firstlineno
-        self._folder = USER_CACHE / Path(py_file).resolve().parent.name
+        self._folder = USER_CACHE / self.get_suitable_cache_subpath(py_file)
 
     def get_cache_path(self) -> str:
         return str(self._folder)

@@ -23,14 +23,13 @@ every wand pose at once from the newest feedback it holds, never waiting on the 
   allows. A reserve rather than a ratchet: refusing every rise while keeping every fall, the
   estimate's noise alone drove the shift out to tens of millimetres.
 
-After a silence the model would come back with the wand deep (nothing resisted the hand), and
-that first update is shown moved out as any other: no jolt, but the operator would go on
-pressing into nothing, the robot held at the skin by the same shift. So what the silence added
-to the shift is given back at ``rejoin_speed`` (m/s at the robot), down to the shift before it:
-the plane comes back to where it was shown, and the robot's target with it, as a ramp of force
-on both sides. That energy, at most half the felt stiffness times the added shift squared, is
-not booked: it is the one place the model's updates are not passive, and only after a
-silence.
+A silence (or the clutch) keeps the books: what the shown spring held when it began stays in
+the reserve, so the first model after it comes back storing no more than that, wherever the
+hand sank meanwhile: the hand feels the force it left, and the robot's target, moved out by the
+same shift, presses the patient as much. The device's port keeps the same books through the
+lapse (``port_passivity``), so the two agree; a give-back of the shift beyond that energy would
+move the robot in while the port held the hand's force where it was (in lockstep, a 1 s outage
+mid-press then left 4.4 N felt, scaled, against 17 N at the patient).
 
 Feedback older than ``link_timeout`` (on this site's clock: the sites share none) gives zero
 force and no model, and no command is sent while it lasts: the robot then holds, as it does when
@@ -56,7 +55,6 @@ from remote_probe.workspace_map import WorkspaceMap
 
 __all__ = ['Leader', 'LeaderConfig']
 
-_ROUNDING = 1e-9  # [m] how far a shift computed back from its own energy may come out off
 _STAMP_ROUNDING = 1e-6  # [s] a stamp through the message's integer seconds and nanoseconds
 
 
@@ -77,8 +75,6 @@ class LeaderConfig:
     coupling : CouplingConfig or None
         ``tdpa``: between the link's port and the wand. None: the controller acts on the wand
         itself, as plain TDPA does (the baseline the coupling improves on: it chatters).
-    rejoin_speed : float, m/s
-        ``model``: how fast the shift a silence left is given back, at the robot.
     """
 
     scheme: str = Scheme.MODEL.value
@@ -86,13 +82,11 @@ class LeaderConfig:
     position_scale: float = 1.0
     link_timeout: float = 0.1
     coupling: CouplingConfig | None = CouplingConfig()
-    rejoin_speed: float = 0.03
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:
             raise ValueError(f'scheme {self.scheme!r} is not one of {list(SCHEMES)}')
         finite_number(self.link_timeout, 'link_timeout', minimum=0.0, strict=True)
-        finite_number(self.rejoin_speed, 'rejoin_speed', minimum=0.0, strict=True)
 
 
 class Leader:
@@ -126,9 +120,6 @@ class Leader:
         self._shown: RemotePlane | None = None  # the plane last shown, shift included
         self._shift = np.zeros(3)  # [m] wand frame: how far it is shown out from the estimate
         self._reserve = 0.0  # [J] energy model updates took out of the wand's spring, net
-        self._rejoining = False  # giving back the shift a silence added
-        self._kept = 0.0  # [m] the shift before that silence, which stays
-        self._shown_at = 0.0  # [s] when the plane was last shown
         self._coupling: VirtualCoupling | None = None  # tdpa, while the link is live
 
     def receive(self, now: float, feedback: Feedback) -> Refusal | None:
@@ -209,9 +200,9 @@ class Leader:
         None too while the link is silent or the clutch is engaged.
         """
         if not self.live(now) or self.map.clutched or self._feedback.plane is None:
-            if not self.live(now) and not self._rejoining:  # a silence begins
-                self._rejoining, self._kept = True, float(np.linalg.norm(self._shift))
-            self._shown, self._shift, self._reserve = None, np.zeros(3), 0.0
+            if self._shown is not None:  # the spring lapses: its energy stays booked
+                self._reserve += _stored(self._shown, wand)
+            self._shown, self._shift = None, np.zeros(3)
             return None
         remote = self._feedback.plane
         stiffness = self.map.felt_gain(remote.stiffness)
@@ -222,13 +213,10 @@ class Leader:
         allowed = (math.sqrt(2.0 * max(affordable, 0.0) / stiffness) if stiffness > 0.0
                    else math.inf)
         shift = max(depth - allowed, 0.0)  # [m] the least a passive update is shown moved out
-        if self._rejoining and self._shown is not None:
-            shift = self._given_back(shift, float(self._shift @ remote.normal), now)
         self._shift = shift * remote.normal
         self._shown = RemotePlane(point - self._shift, remote.normal, stiffness,
                                   self.map.felt_gain(remote.damping))
         self._reserve = max(affordable - _stored(self._shown, wand), 0.0)
-        self._shown_at = now
         return self._shown
 
     def model(self, now: float, wand) -> tuple[bool, RemotePlane | None]:
@@ -240,20 +228,6 @@ class Leader:
         """
         plane = self.plane(now, wand)
         return plane is not None or self.live(now), plane
-
-    def _given_back(self, passive: float, shown: float, now: float) -> float:
-        """Return the shift (m) after giving back what a silence added, at ``rejoin_speed``.
-
-        An update that needs more than is shown is shown as passivity asks; else the shift
-        shrinks at the rejoin speed, or to what passivity allows if that is less, down to what
-        it was before the silence. Once that is given back, updates are passive again.
-        """
-        if passive > shown + _ROUNDING:
-            return passive
-        step = self.config.rejoin_speed / self.map.position_scale * (now - self._shown_at)
-        shift = min(passive, max(shown - step, self._kept))
-        self._rejoining = shift > self._kept + _ROUNDING
-        return shift
 
 
 def _stored(plane: RemotePlane, wand) -> float:

@@ -51,8 +51,7 @@ class LeaderNode(Node):
                                        CouplingConfig(params.coupling_mass,
                                                       params.coupling_stiffness,
                                                       params.coupling_damping,
-                                                      params.coupling_ground_damping),
-                                       params.rejoin_speed)
+                                                      params.coupling_ground_damping))
             self._admission = AdmissionConfig(
                 max_age=params.max_feedback_age, max_lead=params.max_stamp_lead,
                 session_timeout=params.session_timeout)

@@ -6,7 +6,6 @@ from haptic_contract.teleop import HAND_SPEED, Scheme, SCHEMES
 from haptic_util.parameters import parameter
 from remote_probe.admission import AdmissionConfig
 from remote_probe.force_envelope import EnvelopeConfig
-from remote_probe.leader import LeaderConfig
 from remote_probe.safety import SafetyConfig
 
 __all__ = ['envelope', 'FollowerParams', 'LeaderParams', 'LinkStageParams', 'PatientBoundParams',
@@ -138,9 +137,6 @@ class LeaderParams:
     model_valid_radius: float = parameter(0.01, 'a rendered model holds this far from the wand '
                                           '(its valid_radius; the remote site decides where '
                                           'there is a plane)', unit='m', low=1e-4, high=1.0)
-    rejoin_speed: float = parameter(LeaderConfig.rejoin_speed, 'model: after a silence, the '
-                                    'shift it left is given back this fast, at the robot',
-                                    unit='m/s', low=1e-4)
     max_feedback_age: float = parameter(AdmissionConfig.max_age, 'after a silence this long, '
                                         'feedback later than the link\'s best by more than '
                                         'this is dropped', unit='s', low=0.001)
