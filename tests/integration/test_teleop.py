@@ -263,7 +263,9 @@ def test_tdpa_over_the_link_gives_the_hand_no_energy_and_keeps_the_patient_safe(
     following = np.flatnonzero(np.diff(at_pose) == 1)  # consecutive ticks, both recorded
     steps = wand[at_pose[following + 1]] - wand[at_pose[following]]
     work = float(np.einsum('ij,ij->', felt[at_felt[following + 1]], steps))
-    assert len(following) > 10_000
+    # The whole scan, every tick (a count would be this machine's speed: 7387 at load 15).
+    assert pose_times[-1] - pose_times[0] > SCAN_DURATION - 1.0
+    assert len(following) >= 0.99 * (len(pose_times) - 1)
     assert work <= 0.0, f'the hand was given {work:.4f} J'
     patient = series['/remote/robot/ft_sensor/wrench'][1]
     assert np.max(np.linalg.norm(patient, axis=1)) <= MAX_PATIENT_FORCE
