@@ -4,8 +4,9 @@
 the terminal; users press Ctrl-C twice. Each trial starts the three nodes in one process group,
 waits until the loop runs, signals the group twice 2 ms apart, at a different moment of the
 running loop, and requires every node to exit 0 with nothing on its error stream but its own log
-lines. (A SIGINT during a node's first imports, before any of its code runs, ends it as any Python
-program: ``KeyboardInterrupt``. The start-up after that is covered in ``test_executor.py``.)
+lines. The launcher starts a node holding its stop signals, so a SIGINT while it still imports
+stops it the same way, even when the shell that started the session ignored SIGINT (the start-up
+after its imports is covered in ``test_executor.py``).
 
 And fast: with one core kept busy by another process, every process of a session (the loop, a
 telerobotic session, each with its recorder) is gone within 2 s of a Ctrl-C, seen from outside:
@@ -24,6 +25,7 @@ import pytest
 import yaml
 
 from haptic_bringup.launcher import Loop, loop_environment, LoopConfig, node_parameters, NODES
+from haptic_bringup.processes import start_child
 
 TRIALS = 20
 GAP = 0.002  # [s] between the two SIGINTs
@@ -73,6 +75,33 @@ def test_two_sigints_to_the_group_stop_every_node_cleanly(tmp_path, trial):
         for process in processes:
             process.kill()
             process.wait()
+
+
+@pytest.mark.parametrize('inherited', [signal.SIG_DFL, signal.SIG_IGN],
+                         ids=['default', 'ignored'])
+def test_a_sigint_while_a_node_still_imports_stops_it_cleanly(tmp_path, inherited):
+    """The slowest node to import, signalled at once; ``ignored``: started as ``cmd &`` starts it.
+
+    Before the launcher held the signal: a ``KeyboardInterrupt`` traceback from inside some
+    import (``default``), or a lost SIGINT and a node that spun on (``ignored``).
+    """
+    config = LoopConfig(domain_id=session_domain_id())
+    params = tmp_path / 'params.yaml'
+    params.write_text(yaml.safe_dump(node_parameters(config)))
+    env = loop_environment(config.domain_id, tmp_path / 'log')
+    argv = [config.python, '-m', NODES['collision_engine'].module, '--ros-args', '--params-file',
+            str(params)]
+    before = signal.signal(signal.SIGINT, inherited)
+    try:
+        child = start_child('collision_engine', argv, env)
+    finally:
+        signal.signal(signal.SIGINT, before)
+    child.signal(signal.SIGINT)  # it has only just started Python: its imports take seconds
+    try:
+        code = child.process.wait(timeout=120)  # a spinning node never ends: fails here
+    finally:
+        child.process.kill()
+    assert code == 0, f'exit {code} (-2: KeyboardInterrupt in an import)'
 
 
 def _stat(pid: int) -> list:

@@ -15,6 +15,8 @@ import subprocess
 import time
 from typing import Iterable, Optional
 
+from haptic_util.executor import hold_stop_signals
+
 __all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'shm_segments',
            'wait_any_exit']
 
@@ -48,15 +50,20 @@ class Child:
             pass
 
 
-def _die_with_parent() -> None:
+def _as_child() -> None:
+    """In the child before it runs Python: die with the launcher, hold stop signals until taken."""
     libc = ctypes.CDLL('libc.so.6', use_errno=True)
     libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+    hold_stop_signals()
 
 
 def start_child(name: str, argv: list, env: dict) -> Child:
-    """Start ``argv`` as a new session whose processes die with the launcher."""
-    process = subprocess.Popen(argv, env=env, start_new_session=True,
-                               preexec_fn=_die_with_parent)
+    """Start ``argv`` as a new session whose processes die with the launcher.
+
+    A stop signal that comes while the child still imports waits until its node can take it
+    (``haptic_util.executor``): it then exits 0, as a started node does.
+    """
+    process = subprocess.Popen(argv, env=env, start_new_session=True, preexec_fn=_as_child)
     return Child(name, process, argv, env)
 
 

@@ -9,13 +9,21 @@ and those that become ready meanwhile: under a flood (a peer publishing the loop
 as it can) it never ended, and the node never saw its SIGINT. So a stop request also completes
 the slice's future, which ends it after the callback in progress.
 
-Stopping. SIGINT and SIGTERM only ever *request* a stop; the handler never raises inside an rclpy
-callback or ``destroy_node`` (a ``KeyboardInterrupt`` there aborted nodes). ``ros2 launch`` sends
-SIGINT to every node on top of the one its process group already got, so repeats are the same
-request. The spin then ends while the context is still valid, nodes are destroyed in order and
-say their last words (final counts, a zero wrench), and the process exits 0. Start-up is the
-exception: a node may spend seconds compiling its kernels before it spins, so a stop requested
-then interrupts the start at once (no rclpy callback runs yet), and the process still exits 0.
+Stopping. SIGINT and SIGTERM only ever *request* a stop. ``ros2 launch`` sends SIGINT to every
+node on top of the one its process group already got, so repeats are the same request. The spin
+then ends while the context is still valid, nodes are destroyed in order and say their last words
+(final counts, a zero wrench), and the process exits 0. Start-up is the exception: a node may
+spend seconds compiling its kernels before it spins, so a stop requested then interrupts the
+start at once (no rclpy callback runs yet), and the process still exits 0.
+
+The signals are held (blocked) and taken by a thread of their own (``sigwait``), not by a Python
+handler: such a handler runs only when the main thread next runs Python, inside whatever that
+thread is doing (an rclpy callback, a ``Future``'s lock), and in about one stop in a hundred it
+never ran at all: the node spun on, its SIGINTs consumed, nothing pending (py-spy, /proc). A
+child of the launcher holds them from its very first instruction (``hold_stop_signals``, in the
+child before it runs Python), so one that comes while it still imports waits for this thread:
+before, it raised ``KeyboardInterrupt`` inside some import (a traceback), or, inherited as ignored
+from a shell without job control, was lost, and the node then spun forever.
 
 Once its nodes are destroyed (which deletes their DDS participants) and ROS is shut down (which
 flushes the logs), the process ends at once (``os._exit``). The interpreter's own teardown
@@ -27,11 +35,13 @@ A callback that raises does not end its node: the spin logs the exception once, 
 traceback, counts it, and goes on. Each node decides what a failed callback means for its output
 (an invalid state, zero force); the count is in ``callback_errors()`` for its diagnostics.
 """
+import _thread
 import faulthandler
 import gc
 import os
 import signal
 import sys
+import threading
 from typing import Callable, Iterable, NoReturn, Optional
 
 import rclpy
@@ -47,11 +57,12 @@ from haptic_util import intra_process
 from haptic_util.callback_errors import callback_errors, log_callback_error
 
 __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'end_process',
-           'request_stop', 'callback_errors', 'StartupError']
+           'request_stop', 'hold_stop_signals', 'STOP_SIGNALS', 'callback_errors', 'StartupError']
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
 SHUTDOWN_TIMEOUT = 1.0  # [s] for the executor to finish a callback in progress
 TEARDOWN_LIMIT = 20.0  # [s] for nodes to say their last words and be destroyed
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 EXECUTORS = {'events': EventsExecutor, 'single_threaded': SingleThreadedExecutor}
 
@@ -63,10 +74,10 @@ class StartupError(RuntimeError):
 # What a wrong command line, parameter or parameter file raises while a node starts.
 _CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException, NameValidationException,
                          rclpy_implementation.RCLError)
-# Plain flags, not threading.Event: a signal handler that takes a lock deadlocks when a second
-# signal lands while the first handler holds it.
-# 'starting' is set while nodes are being built: a signal interrupts that.
-_flags = {'stop': False, 'starting': False}
+# Plain flags, not threading.Event: the fallback handler below must not take a lock.
+# 'starting' is set while nodes are being built: a signal interrupts that; 'interrupt' asks the
+# main thread's handler to.
+_flags = {'stop': False, 'starting': False, 'interrupt': False}
 _slice = [Future()]  # the spin slice in progress ends when this completes
 
 
@@ -81,12 +92,40 @@ def _end_slice() -> None:
         _slice[0].set_result(None)
 
 
+def hold_stop_signals() -> None:
+    """Hold SIGINT and SIGTERM pending in this thread and in every thread it later starts.
+
+    A launcher's ``preexec_fn``: its child then holds them from its first instruction, through
+    its imports, until its stop-signal thread takes them.
+    """
+    signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+
+
+def _stop_by_signal() -> bool:
+    """Request a stop; return whether it must interrupt the start in progress (once)."""
+    starting = _flags['starting']
+    _flags['starting'] = False
+    request_stop()
+    return starting
+
+
+def _take_stop_signals() -> None:
+    """Turn each held stop signal into a stop request, for as long as the process lives."""
+    while True:
+        signal.sigwait(STOP_SIGNALS)
+        if _stop_by_signal():
+            _flags['interrupt'] = True
+            _thread.interrupt_main()  # runs _on_signal in the main thread, which is building nodes
+
+
 def _on_signal(signum, frame) -> None:
-    first = not _flags['stop']
-    _flags['stop'] = True
-    _end_slice()
-    if first and _flags['starting']:
-        _flags['starting'] = False
+    """Interrupt the start on request, or take a stop signal that a thread not holding it got.
+
+    Threads a library started before this process's ``_run`` (numpy's) do not hold the signals
+    unless the launcher made the process hold them from its start.
+    """
+    if _stop_by_signal() or _flags['interrupt']:
+        _flags['interrupt'] = False
         raise KeyboardInterrupt  # nodes are still being built: no rclpy callback is running
 
 
@@ -143,11 +182,13 @@ def run_process(start: Callable[[list, list], None], *, executor: str = 'events'
 
 
 def _run(start: Callable[[list, list], None], executor: str) -> int:
-    for signum in (signal.SIGINT, signal.SIGTERM):
+    for signum in STOP_SIGNALS:
         signal.signal(signum, _on_signal)
+    hold_stop_signals()
     _flags['starting'] = True
     nodes, contexts, spinner = [], [], None
     try:
+        threading.Thread(target=_take_stop_signals, name='stop-signals', daemon=True).start()
         start(nodes, contexts)
         _flags['starting'] = False
         _freeze_what_start_made()
@@ -178,7 +219,7 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
         # Should an error escape, Python's own exit follows, where it resets its handlers to the
         # default, and a late repeat would kill the process with SIGINT; an ignored signal it
         # leaves alone.
-        for signum in (signal.SIGINT, signal.SIGTERM):
+        for signum in STOP_SIGNALS:
             signal.signal(signum, signal.SIG_IGN)
     return 0
 
