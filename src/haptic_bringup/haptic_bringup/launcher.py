@@ -28,9 +28,9 @@ over loopback mutual TLS, each gateway delaying, jittering and dropping what it 
 import argparse
 import dataclasses
 import itertools
+import math
 import os
 import pathlib
-import signal
 import sys
 import time
 from typing import Optional
@@ -39,8 +39,8 @@ from ament_index_python.packages import get_package_share_directory
 import yaml
 
 from haptic_bringup.discovery import GraphWatcher
-from haptic_bringup.processes import (clean_stale_shm, shm_segments, start_child, stop_children,
-                                      wait_any_exit)
+from haptic_bringup.processes import (clean_stale_shm, run_until_stopped, shm_segments,
+                                      start_child, stop_children, wait_any_exit)
 from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGER, LOOP_RECORDER,
                                    NODES, OPERATOR_RECORDED, OPERATOR_RECORDER, OPERATOR_SITE,
                                    PROBE_IMAGE, RECORDERS, REMOTE_PREFIX, REMOTE_RECORDED,
@@ -475,29 +475,18 @@ def main(argv=None) -> int:
                         remote_domain=args.remote_domain_id, imaging=args.imaging)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     loop = Loop(config)
-    stop = []
-    signal.signal(signal.SIGINT, lambda *_: stop.append(True))
-    signal.signal(signal.SIGTERM, lambda *_: stop.append(True))
-    try:
-        loop.start()
-    except RuntimeError as error:
-        print(f'haptic_loop: {error}', file=sys.stderr)
-        return 1
-    layout = ('one process' if config.composed else f'{len(config.nodes)} processes')
-    if config.teleop:
-        layout = (f'{config.teleop} over a {1e3 * args.delay:g} ms link, operator in domain '
-                  f'{config.domain_id}, remote site in {config.remote_domain_id}')
-    print(f'haptic_loop: loop closed in {loop.startup_time:.2f} s ({layout}, '
-          f'domain {config.domain_id}); Ctrl-C stops', flush=True)
-    # The driver ends its experiment after ``duration`` and exits; this is only a backstop.
-    deadline = time.monotonic() + args.duration + DURATION_GRACE if args.duration \
-        else float('inf')
-    while not stop and time.monotonic() < deadline and loop.exited() is None:
-        time.sleep(0.05)
-    codes = loop.stop()
-    failed = {name: code for name, code in codes.items() if code not in (0, -signal.SIGINT)}
-    print(f'haptic_loop: stopped ({", ".join(f"{n}: {c}" for n, c in codes.items())})')
-    end_process(1 if failed else 0)
+
+    def ready() -> str:
+        layout = ('one process' if config.composed else f'{len(config.nodes)} processes')
+        if config.teleop:
+            layout = (f'{config.teleop} over a {1e3 * args.delay:g} ms link, operator in domain '
+                      f'{config.domain_id}, remote site in {config.remote_domain_id}')
+        return (f'loop closed in {loop.startup_time:.2f} s ({layout}, domain '
+                f'{config.domain_id}); Ctrl-C stops')
+
+    # The driver ends its experiment after ``duration`` and exits; the limit is only a backstop.
+    end_process(run_until_stopped(loop, 'haptic_loop', ready, limit=args.duration + DURATION_GRACE
+                                  if args.duration else math.inf))
 
 
 if __name__ == '__main__':

@@ -8,17 +8,19 @@ live process holds, among those the launcher's own processes made, are removed a
 """
 import ctypes
 import fcntl
+import math
 import os
 import pathlib
 import signal
 import subprocess
+import sys
 import time
-from typing import Iterable, Optional
+from typing import Callable, Iterable, Optional
 
 from haptic_util.executor import hold_stop_signals
 
-__all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'shm_segments',
-           'wait_any_exit']
+__all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'run_until_stopped',
+           'shm_segments', 'wait_any_exit']
 
 PR_SET_PDEATHSIG = 1
 SHM_DIR = pathlib.Path('/dev/shm')
@@ -51,17 +53,17 @@ class Child:
 
 
 def _as_child() -> None:
-    """In the child before it runs Python: die with the launcher, hold stop signals until taken."""
+    """In the child before it runs Python: die with the launcher, hold SIGINT until taken."""
     libc = ctypes.CDLL('libc.so.6', use_errno=True)
     libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
-    hold_stop_signals()
+    hold_stop_signals({signal.SIGINT})
 
 
 def start_child(name: str, argv: list, env: dict) -> Child:
     """Start ``argv`` as a new session whose processes die with the launcher.
 
-    A stop signal that comes while the child still imports waits until its node can take it
-    (``haptic_util.executor``): it then exits 0, as a started node does.
+    A SIGINT that comes while the child still imports waits until its node can take it
+    (``haptic_util.executor``): it then exits 0, as a started node does. SIGTERM ends it.
     """
     process = subprocess.Popen(argv, env=env, start_new_session=True, preexec_fn=_as_child)
     return Child(name, process, argv, env)
@@ -73,8 +75,8 @@ def stop_children(children: list, *, timeout: float = 5.0, gently: bool = True) 
     Each step waits up to ``timeout`` for all of them. Together, so that a session stops within
     the slowest child's time rather than the sum of all (issue 24: every process within 2 s of
     a Ctrl-C), as ``ros2 launch`` stops its processes. ``gently=False`` starts at SIGTERM: for
-    children that may still be importing, where a SIGINT prints a ``KeyboardInterrupt``
-    traceback and SIGTERM ends them quietly (a started node stops cleanly on either).
+    children that may still be importing and must end now rather than once started (a started
+    node stops cleanly on either).
 
     Returns each child's exit code (negative: the signal that ended it), in their order.
     """
@@ -152,3 +154,30 @@ def wait_any_exit(children: list, timeout: float, poll: float = 0.05) -> Optiona
                 return child
         time.sleep(poll)
     return None
+
+
+def run_until_stopped(session, program: str, ready: Callable[[], str], *,
+                      limit: float = math.inf,
+                      why: Callable[[Optional[Child]], str] = lambda ended: 'stopped') -> int:
+    """Start ``session``, run it until Ctrl-C, a child's exit or ``limit`` s, stop it; its code.
+
+    ``session`` starts, stops (returning each child's exit code) and says which child exited
+    first; ``ready()`` and ``why(that child)`` are the lines said once it is up and once it has
+    stopped. The code: 1 when it could not start or a child failed (a Ctrl-C is no failure).
+    """
+    stop = []
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stop.append(True))
+    try:
+        session.start()
+    except RuntimeError as error:
+        print(f'{program}: {error}', file=sys.stderr)
+        return 1
+    print(f'{program}: {ready()}', flush=True)
+    deadline = time.monotonic() + limit
+    while not stop and time.monotonic() < deadline and session.exited() is None:
+        time.sleep(0.05)
+    ended = session.exited()
+    codes = session.stop()
+    print(f'{program}: {why(ended)} ({", ".join(f"{n}: {c}" for n, c in codes.items())})')
+    return 1 if any(code not in (0, -signal.SIGINT) for code in codes.values()) else 0

@@ -24,9 +24,7 @@ import argparse
 import dataclasses
 import os
 import pathlib
-import signal
 import socket
-import sys
 import time
 from typing import Optional
 
@@ -34,7 +32,7 @@ import yaml
 
 from haptic_bringup.launcher import (link_parameters, Loop, loop_environment, LoopConfig,
                                      node_parameters, site_nodes, teleop_endpoints)
-from haptic_bringup.processes import start_child
+from haptic_bringup.processes import run_until_stopped, start_child
 from haptic_contract.graph import FRAME_TOPICS, TO_OPERATOR, TO_REMOTE
 from haptic_contract.teleop import Scheme, SCHEMES
 from site_gateway.certs import init_ca, issue
@@ -209,29 +207,19 @@ def main(argv=None) -> int:
     args = parse_args(argv)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     site = Site(site_config(args))
-    stop = []
-    signal.signal(signal.SIGINT, lambda *_: stop.append(True))
-    signal.signal(signal.SIGTERM, lambda *_: stop.append(True))
-    try:
-        site.start()
-    except RuntimeError as error:
-        print(f'haptic_site: {error}', file=sys.stderr)
-        return 1
     peer = 'listening on ' + ', '.join(args.listen) if args.listen else \
         'connecting to ' + ', '.join(args.connect)
-    print(f'haptic_site: {args.role} site up in {site.startup_time:.2f} s (domain '
-          f'{args.domain_id}, {args.scheme}; {peer}); Ctrl-C stops', flush=True)
-    while not stop and site.exited() is None:
-        time.sleep(0.05)
-    ended = site.exited()
-    codes = site.stop()
-    gone = ended is not None and ended.name == 'gateway' and ended.returncode == 0
-    done = ended is not None and ended.name == args.role and ended.returncode == 0
-    why = ('the other site stopped' if gone else 'the experiment ended' if done
-           else 'stopped' if ended is None else f'{ended.name} exited')
-    print(f'haptic_site: {why} ({", ".join(f"{n}: {c}" for n, c in codes.items())})')
-    failed = {name: code for name, code in codes.items() if code not in (0, -signal.SIGINT)}
-    return 1 if failed else 0
+
+    def why(ended) -> str:
+        if ended is None:
+            return 'stopped'
+        if ended.returncode == 0 and ended.name in ('gateway', args.role):
+            return 'the other site stopped' if ended.name == 'gateway' else 'the experiment ended'
+        return f'{ended.name} exited'
+
+    return run_until_stopped(
+        site, 'haptic_site', lambda: f'{args.role} site up in {site.startup_time:.2f} s (domain '
+        f'{args.domain_id}, {args.scheme}; {peer}); Ctrl-C stops', why=why)
 
 
 if __name__ == '__main__':

@@ -20,7 +20,7 @@ The signals are held (blocked) and taken by a thread of their own (``sigwait``),
 handler: such a handler runs only when the main thread next runs Python, inside whatever that
 thread is doing (an rclpy callback, a ``Future``'s lock), and in about one stop in a hundred it
 never ran at all: the node spun on, its SIGINTs consumed, nothing pending (py-spy, /proc). A
-child of the launcher holds them from its very first instruction (``hold_stop_signals``, in the
+child of the launcher holds SIGINT from its very first instruction (``hold_stop_signals``, in the
 child before it runs Python), so one that comes while it still imports waits for this thread:
 before, it raised ``KeyboardInterrupt`` inside some import (a traceback), or, inherited as ignored
 from a shell without job control, was lost, and the node then spun forever.
@@ -92,13 +92,14 @@ def _end_slice() -> None:
         _slice[0].set_result(None)
 
 
-def hold_stop_signals() -> None:
-    """Hold SIGINT and SIGTERM pending in this thread and in every thread it later starts.
+def hold_stop_signals(signals=STOP_SIGNALS) -> None:
+    """Hold ``signals`` pending in this thread and in every thread it later starts.
 
-    A launcher's ``preexec_fn``: its child then holds them from its first instruction, through
-    its imports, until its stop-signal thread takes them.
+    A launcher's ``preexec_fn`` holds SIGINT: its child then holds it from its first
+    instruction, through its imports, until its stop-signal thread takes it. SIGTERM stays the
+    launcher's escalation, which ends a child that has not yet got that far.
     """
-    signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+    signal.pthread_sigmask(signal.SIG_BLOCK, signals)
 
 
 def _stop_by_signal() -> bool:
