@@ -25,9 +25,9 @@ model's life. A model that comes after a late tick, the one before expired and t
 deeper, then gives back no more than the hand put in.
 
 Smooth at any update rate, with ``model_step_rate`` > 0 (``model_easing``): a new model's planes
-start as stiff as the last period's and where they push as much, and ease to the model at that
-many N/s of push, held every period to the port's bound. 0 switches at once, as above (the
-baseline).
+start as stiff and as damped as the last period's and where they push as much, and ease to the
+model at that many N/s of push, held every period to the port's bound. 0 switches at once, as above
+(the baseline).
 
 A model renders from the servo period that holds its ``since`` (the device's clock when it
 arrived), and what was held before renders the periods until then: so a device that runs its
@@ -47,8 +47,8 @@ count, the damping cap per mass and period (``MAX_DAMPING_PER_MASS``), ``since``
 number, the model step rate; from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point,
 normal, stiffness, damping, tool point). ``bound`` is the planes' shift (m), the number of the take
 it was set for, the spring push the planes rendered in the last period (N; 0 when none), the
-factor on their stiffnesses and the sum of those scaled (N/m; 0 when none), the factor on their
-dampings and the sum of those scaled (N·s/m; 0 when none).
+factor on their stiffnesses and the sum of those scaled (N/m; 0 when none), the damping added to
+each plane's (N·s/m) and the sum of their dampings with it (N·s/m; 0 when none).
 """
 import math
 from typing import Sequence
@@ -58,8 +58,9 @@ import numpy as np
 from haptic_contract.contact_model import ContactModel, Kind, MAX_PLANES
 from haptic_contract.plane_law import saturate_components
 from haptic_contract.wand import roll_axis
-from haptic_wand_driver.model_easing import eased_level, eased_scale, eased_shift, least_shift, \
-    matched_shift, scaled_model, spring_push, stored_energy, total_damping, total_stiffness
+from haptic_wand_driver.model_easing import eased_extra, eased_scale, eased_shift, least_shift, \
+    matched_extra, matched_shift, scaled_model, spring_push, stored_energy, total_damping, \
+    total_stiffness
 from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
 
 __all__ = ['DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE',
@@ -104,8 +105,8 @@ class LocalRenderer:
         self.contact_damping_ratio = contact_damping_ratio
         self.model_step_rate = float(model_step_rate)
         self.packed = np.zeros((2, LAW_SIZE))  # (servo_loop's layout)
-        # shift, take, push, stiffness factor and sum, damping factor and sum
-        self.bound = np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0])
+        # shift, take, push, stiffness factor and sum, damping added and sum
+        self.bound = np.array([0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0])
         self._held = ((*_NOTHING, 0),) * 2 + (-math.inf,)  # before since, from since, since
         self._takes = 0
         self.clear()
@@ -167,7 +168,7 @@ class LocalRenderer:
             x, y, z = roll_axis(coordinates[4])
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
             limit = min(self.force_limit, model.force_limit)
-            shift = self._shift(model, take, coordinates, period)
+            shift = self._shift(model, take, coordinates, velocity, period)
             force, torque = scaled_model(model, float(self.bound[3]), float(self.bound[5])).wrench(
                 position, velocity, coordinates[3], coordinates[4], spin,
                 self._contact_damping(period), limit, shift)
@@ -179,12 +180,13 @@ class LocalRenderer:
                 saturate_components(torque, self.torque_limit))
 
     def _shift(self, model: ContactModel, take: int, coordinates: Sequence[float],
-               period: float) -> float:
+               velocity: Sequence[float], period: float) -> float:
         """Return the shift of ``model``'s planes this period.
 
         Set by the port's bound at the model's first period and kept; or, easing, matched to the
-        last period's stiffness, damping and push at the first and eased from there (the factors
-        with it, in ``bound``), storing no more than the port absorbed or the planes held.
+        last period's stiffness, damping and push at the first and eased from there (the factor
+        and the added damping with it, in ``bound``), storing no more than the port absorbed or
+        the planes held.
         """
         first = take != self.bound[1]
         if not (first or self.model_step_rate > 0.0):
@@ -196,22 +198,22 @@ class LocalRenderer:
             self.bound[:2] = (bounded_shift(springs, energy), take)
             return float(self.bound[0])
         step = self.model_step_rate * period
-        shift, _, push, scale, stiff, damping_scale, damped = self.bound.tolist()
-        total, damping = total_stiffness(springs), total_damping(model)
+        shift, _, push, scale, stiff, extra, damped = self.bound.tolist()
+        total = total_stiffness(springs)
         if first:
             scale = stiff / total if stiff > 0.0 and total > 0.0 else 1.0
-            damping_scale = damped / damping if damping > 0.0 else 1.0
+            extra = matched_extra(model, damped)
             springs = [(d, scale * k) for d, k in springs]
             shift = matched_shift(springs, push)
         else:
             held = stored_energy([(d, scale * k) for d, k in springs], shift)
             scale = eased_scale(scale, step, push)
-            damping_scale = eased_level(damping_scale, step, push)
+            extra = eased_extra(extra, step, push, velocity, len(model.planes))
             springs = [(d, scale * k) for d, k in springs]
             eased = eased_shift(springs, shift, step)
             shift = max(eased, least_shift(springs, max(energy, held), min(eased, 0.0)))
-        self.bound[:] = (shift, take, spring_push(springs, shift), scale, scale * total,
-                         damping_scale, damping_scale * damping)
+        self.bound[:] = (shift, take, spring_push(springs, shift), scale, scale * total, extra,
+                         total_damping(model, extra))
         return shift
 
     def _contact_damping(self, period: float):

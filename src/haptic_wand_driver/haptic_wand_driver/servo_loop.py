@@ -191,19 +191,21 @@ def _eased_scale(scale, step, push):
 
 
 @jit
-def _total_damping(law):
+def _total_damping(law, extra):
+    """Return the planes' dampings along their normals, ``extra`` added (``total_damping``)."""
     total = 0.0
     for k in range(int(law[19])):
         at = PLANES_AT + PLANE_SIZE * k
         nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
-        along = law[at + 9] * nx * nx + law[at + 10] * ny * ny + law[at + 11] * nz * nz
+        along = (max(law[at + 9] + extra, 0.0) * nx * nx + max(law[at + 10] + extra, 0.0) * ny * ny
+                 + max(law[at + 11] + extra, 0.0) * nz * nz)
         if along > 0.0:
             total += along
     return total
 
 
 @jit
-def _shift(law, coordinates, books, bound, period):
+def _shift(law, coordinates, rates, books, bound, period):
     """Set ``bound`` for this period of the planes held (``LocalRenderer._shift``)."""
     rate = law[STEP_RATE]
     first = law[SERIAL] != bound[1]
@@ -216,11 +218,11 @@ def _shift(law, coordinates, books, bound, period):
     if rate == 0.0:
         bound[0], bound[1] = _least_shift(depths, stiffnesses, count, books[0], 0.0), law[SERIAL]
         return
-    step, shift, push, scale, damping_scale = rate * period, bound[0], bound[2], bound[3], bound[5]
-    total, damping = _total_stiffness(stiffnesses, count), _total_damping(law)
+    step, shift, push, scale, extra = rate * period, bound[0], bound[2], bound[3], bound[5]
+    total, damping = _total_stiffness(stiffnesses, count), _total_damping(law, 0.0)
     if first:
         scale = bound[4] / total if bound[4] > 0.0 and total > 0.0 else 1.0
-        damping_scale = bound[6] / damping if damping > 0.0 else 1.0
+        extra = (bound[6] - damping) / count if count > 0 else 0.0
         for k in range(count):
             stiffnesses[k] = scale * stiffnesses[k]
         shift = _matched_shift(depths, stiffnesses, count, push)
@@ -230,11 +232,11 @@ def _shift(law, coordinates, books, bound, period):
             if depths[k] - shift > 0.0:
                 held += 0.5 * (scale * stiffnesses[k]) * (depths[k] - shift) * (depths[k] - shift)
         scale = _eased_scale(scale, step, push)
-        damping_scale = 1.0
-        if push > 0.0:
-            change = step / push
-            damping_scale = (min(bound[5] + change, 1.0) if bound[5] < 1.0
-                             else max(bound[5] - change, 1.0))
+        extra, speed = 0.0, count * math.sqrt(rates[0] * rates[0] + rates[1] * rates[1]
+                                              + rates[2] * rates[2])
+        if push > 0.0 and speed != 0.0:
+            change = step / speed
+            extra = min(bound[5] + change, 0.0) if bound[5] < 0.0 else max(bound[5] - change, 0.0)
         for k in range(count):
             stiffnesses[k] = scale * stiffnesses[k]
         scaled = _total_stiffness(stiffnesses, count)
@@ -249,21 +251,21 @@ def _shift(law, coordinates, books, bound, period):
         if depths[k] - shift > 0.0:
             push += stiffnesses[k] * (depths[k] - shift)
     bound[0], bound[1], bound[2] = shift, law[SERIAL], push
-    bound[3], bound[4], bound[5], bound[6] = scale, scale * total, damping_scale, (
-        damping_scale * damping)
+    bound[3], bound[4], bound[5] = scale, scale * total, extra
+    bound[6] = _total_damping(law, extra)
 
 
 @jit
-def _scaled(law, scale, damping_scale):
-    """Return ``law`` with its planes' stiffnesses and dampings scaled (``scaled_model``)."""
-    if scale == 1.0 and damping_scale == 1.0:
+def _scaled(law, scale, extra):
+    """Return ``law``, its planes' stiffnesses scaled, ``extra`` on dampings (``scaled_model``)."""
+    if scale == 1.0 and extra == 0.0:
         return law
     scaled = law.copy()
     for k in range(int(law[19])):
         at = PLANES_AT + PLANE_SIZE * k
         for j in range(6, 9):
             scaled[at + j] = law[at + j] * scale
-            scaled[at + j + 3] = law[at + j + 3] * damping_scale
+            scaled[at + j + 3] = max(law[at + j + 3] + extra, 0.0)
     return scaled
 
 
@@ -342,7 +344,7 @@ def _law_wrench(packed, books, bound, time, coordinates, rates, period):
         if dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
             if law[8] < limit:
                 limit = law[8]
-            _shift(law, coordinates, books, bound, period)
+            _shift(law, coordinates, rates, books, bound, period)
             fx, fy, fz, tx, ty, tz = _planes(_scaled(law, bound[3], bound[5]), coordinates,
                                              rates, limit, period, bound[0])
         else:
@@ -408,6 +410,6 @@ def compile_now() -> None:
     """Compile ``advance`` for the types the wand passes (or load it from numba's cache)."""
     advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)),
             np.zeros((2, LAW_SIZE)),
-            np.zeros(11), np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0]), 1.0, 1.0, 0.0, 0, 1.0,
+            np.zeros(11), np.array([0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0]), 1.0, 1.0, 0.0, 0, 1.0,
             np.zeros(6),
             np.empty(0, dtype=np.int64), False)
