@@ -24,9 +24,17 @@ energy than the port absorbed, and the bound below would cut the force at once (
 250 ms, 0.5 N in a tick at the first contact). A model that comes after nothing was rendered (a
 first contact, a lapse) starts from zero push, a ramp.
 
+The planes' normals go on too: each is rendered as it was the period before and turns toward the
+model's by at most ``rate`` / push radians a period, so that the push turning moves sideways by
+at most ``rate`` N/s. The estimate's normal is the measured force's direction, low-passed; models
+that reach the hand tens of milliseconds apart (the link's jitter, its losses) turned it by half
+a degree, and a 7 N push (scaled) stepped sideways by 0.06 N, the largest steps at 250 and 500 ms
+once the damping was eased. A normal turned further than ``EASED_TURN`` is another face (a
+corner's planes come in any order) and is taken at once; the planes are matched by their order.
+
 Passive: the switch itself stores what the planes before stored (the same push on the same
-stiffness), a damping (never below zero) only takes energy out, and each period's easing may raise
-the stored energy only up to what the port has absorbed in this contact
+stiffness, the same normals), a damping (never below zero) only takes energy out, and each period's
+easing may raise the stored energy only up to what the port has absorbed in this contact
 (``port_passivity.bounded_shift``, here also inward of the model when the new estimate pushes less
 than the old one did), as passive set-position modulation does (Lee and Huang, IEEE T-RO 2010);
 beyond, the shift holds. The hand's own motion into the planes is not bounded again: that is the
@@ -42,9 +50,12 @@ import math
 from haptic_contract.contact_model import ContactModel
 from haptic_wand_driver.port_passivity import bounded_shift
 
-__all__ = ['eased_extra', 'eased_scale', 'eased_shift', 'least_shift', 'matched_extra',
-           'matched_shift', 'scaled_model', 'spring_push', 'stored_energy', 'total_damping',
-           'total_stiffness']
+__all__ = ['COS_EASED_TURN', 'EASED_TURN', 'eased_extra', 'eased_scale', 'eased_shift',
+           'held_normals', 'least_shift', 'matched_extra', 'matched_shift', 'scaled_model',
+           'spring_push', 'stored_energy', 'total_damping', 'total_stiffness', 'turned_normals']
+
+EASED_TURN = math.radians(10.0)  # [rad] a normal turned further is another face: at once
+COS_EASED_TURN = math.cos(EASED_TURN)
 
 
 def total_stiffness(springs) -> float:
@@ -150,6 +161,51 @@ def eased_extra(extra: float, push_step: float, push: float, velocity, count: in
         return 0.0
     step = push_step / speed
     return min(extra + step, 0.0) if extra < 0.0 else max(extra - step, 0.0)
+
+
+def held_normals(model: ContactModel, held) -> ContactModel:
+    """Return ``model`` with the normals ``held`` where each is within ``EASED_TURN`` of its own.
+
+    ``held``: the count of planes rendered the period before, then their normals, 3 floats each;
+    ``model`` as it is when they were not as many as its planes.
+    """
+    count = len(model.planes)
+    if held[0] != count or count == 0:
+        return model
+    planes = []
+    for k, plane in enumerate(model.planes):
+        h = (float(held[1 + 3 * k]), float(held[2 + 3 * k]), float(held[3 + 3 * k]))
+        n = plane.normal
+        along = h[0] * n[0] + h[1] * n[1] + h[2] * n[2]
+        planes.append(plane._replace(normal=h) if along >= COS_EASED_TURN else plane)
+    return dataclasses.replace(model, planes=tuple(planes))
+
+
+def turned_normals(model: ContactModel, toward: ContactModel, push_step: float,
+                   push: float) -> ContactModel:
+    """Return ``model``, each normal turned toward ``toward``'s by ``push_step`` / ``push`` rad.
+
+    At most: a push turning by that angle moves sideways by ``push_step``. At once when nothing
+    pushes, or by more than ``EASED_TURN``.
+    """
+    return dataclasses.replace(model, planes=tuple(
+        plane._replace(normal=_turned(plane.normal, goal.normal, push_step, push))
+        for plane, goal in zip(model.planes, toward.planes)))
+
+
+def _turned(normal, toward, push_step: float, push: float):
+    along = normal[0] * toward[0] + normal[1] * toward[1] + normal[2] * toward[2]
+    if push <= 0.0 or along < COS_EASED_TURN:
+        return toward
+    angle = push_step / push
+    if angle >= EASED_TURN or along >= math.cos(angle):
+        return toward
+    x, y, z = (toward[0] - along * normal[0], toward[1] - along * normal[1],
+               toward[2] - along * normal[2])
+    length = math.sqrt(x * x + y * y + z * z)
+    cos, sin = math.cos(angle), math.sin(angle)
+    return (normal[0] * cos + x / length * sin, normal[1] * cos + y / length * sin,
+            normal[2] * cos + z / length * sin)
 
 
 def scaled_model(model: ContactModel, scale: float, extra: float) -> ContactModel:
