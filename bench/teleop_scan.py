@@ -219,20 +219,22 @@ def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
                             intra_process=site_streams == 'in-process',
                             overrides={} if model_step_rate is None else
                             {'wand_driver': {'model_step_rate': model_step_rate}})
-        with Loop(config) as loop, concurrent.futures.ThreadPoolExecutor(1) as requests:
+        with concurrent.futures.ThreadPoolExecutor(1) as requests:
             asked = None if hold is None else requests.submit(hold_during, domain_id, hold,
-                                                              *SWEEP, 60.0)
-            cpu = process_cpu(loop)
-            if loop.wait(60.0) is None:
-                raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
-            if asked is not None and asked.result() is None:
+                                                              *SWEEP, 120.0)
+            with Loop(config) as loop:
+                cpu = process_cpu(loop)
+                if loop.wait(60.0) is None:
+                    raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
+            zero = None if asked is None else asked.result()
+            if asked is not None and zero is None:
                 raise RuntimeError(f'{scheme} at {delay} s: the hold was never asked')
         streams = ', '.join([site_streams] + ([] if model_step_rate is None else
                                               [f'ease {model_step_rate:g}'])
                             + ([] if delay_trace is None else [f'trace {delay_trace.name}'])
                             + ([] if hold is None else [f'force held {hold:g} N']))
         scan = read_scan(folder / 'bag')
-        start = scan['/wand/pose'][0][0]
+        start = scan['/wand/pose'][0][0] if zero is None else zero  # the hold's own zero
         return {'scheme': scheme, **figures(scan, delay), 'cpu': cpu, 'site_streams': streams,
                 **hold_error(*scan['/remote/robot/ft_sensor/wrench'],
                              np.nan if hold is None else hold, start + SWEEP[0],

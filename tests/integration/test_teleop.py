@@ -88,9 +88,10 @@ def window(times: np.ndarray, start: float, end: float) -> np.ndarray:
 def scan(tmp_path_factory):
     """The scan at 50 ms; once ``PRESSING`` is over the operator asks for a force-hold."""
     folder = tmp_path_factory.mktemp('teleop_scan')
-    with teleop(folder) as loop, concurrent.futures.ThreadPoolExecutor(1) as requests:
-        asked = requests.submit(hold_during, session_domain_id(), HELD, PRESSING[1], None, 60.0)
-        assert loop.wait(60.0) is not None, 'the scan did not end'
+    with concurrent.futures.ThreadPoolExecutor(1) as requests:
+        asked = requests.submit(hold_during, session_domain_id(), HELD, PRESSING[1], None, 120.0)
+        with teleop(folder) as loop:
+            assert loop.wait(60.0) is not None, 'the scan did not end'
         assert asked.result() is not None, 'the operator\'s gateway never took the hold'
     return folder, streams(folder)
 
