@@ -231,7 +231,10 @@ def _teleop_chapter(findings: Findings) -> list[str]:
         'driver easing each new model in at 5 N/s, *ease 0* each taken at once (the code '
         'before issue 28); *time to force* from the first contact to 90 % of the mean contact '
         'force, and the *peak rise* of the patient\'s force over 5 ms (the envelope bounds the '
-        'robot\'s spring to 40 N/s in contact).',
+        'robot\'s spring to 40 N/s in contact); the *sweep force error* the patient\'s force '
+        'through the sweep (from 0.5 s into it) against the one held, in the runs marked '
+        '*force held* (the remote site holding it, asked on `teleop/hold` across the '
+        'gateways over ROS 2), else against its own mean (what the operator\'s hand keeps).',
         '']
     parts += ['### In lockstep', '']
     parts += _stored(findings, 'teleop_lockstep', lambda rows: [

@@ -402,7 +402,8 @@ def teleop_section(rows: list) -> str:
         ['scheme', 'one-way delay (ms)', 'run', 'stable', 'net work on the hand (mJ)',
          'oscillation (%)', 'transparency error (N)', '(% of mean contact force)',
          'peak patient force (N)', 'tracking RMS (mm)', 'felt step ratio p99', '(max)',
-         'jumps > 1 N', 'time to force (s)', 'peak rise (N/s)'],
+         'jumps > 1 N', 'time to force (s)', 'peak rise (N/s)', 'sweep force error max (N)',
+         '(RMS)'],
         [[r['scheme'], f'{1e3 * r["delay"]:g}',
           ', '.join(filter(None, (r['source'], r.get('site_streams', '')))),
           'yes' if r['stable'] else '**no**',
@@ -412,7 +413,9 @@ def teleop_section(rows: list) -> str:
           number(r.get('step_ratio_p99', np.nan), '.1f'),
           number(r.get('step_ratio_max', np.nan), '.1f'), str(r.get('jumps', '–')),
           number(r.get('time_to_force_s', np.nan), '.2f'),
-          number(r.get('peak_rise_n_per_s', np.nan), '.0f')]
+          number(r.get('peak_rise_n_per_s', np.nan), '.0f'),
+          number(r.get('hold_error_max_n', np.nan), '.2f'),
+          number(r.get('hold_error_rms_n', np.nan), '.2f')]
          for r in rows])
 
 

@@ -63,7 +63,7 @@ SKIN = -0.025  # [m] the phantom's front, under the probe's start
 TICK = 1e-3  # [s]
 MODEL_LIFETIME = LeaderParams().model_lifetime  # [s]
 LATE_FRACTION, LATE_LONGEST = 0.02, 0.08  # of the ticks, late by up to [s]
-SWEEP = (5.0, 16.0)  # [s] the scan's sweep along the patient, pressed (scan.yaml)
+SWEEP = teleop_scan.SWEEP
 ZERO = np.zeros(3)
 
 
@@ -180,18 +180,13 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
             'tcp': remote_table[:, 4:7], 'held': held}
 
 
-def hold_error(run: dict, start: float, end: float, settle: float = 0.5) -> dict:
-    """Return the patient's force against the held one (N) from ``settle`` s after ``start``.
+def hold_error(run: dict, start: float, end: float) -> dict:
+    """Return the patient's force against the held one (``teleop_scan.hold_error``).
 
     Without a hold (``held`` NaN), against the force's own mean over the same window: what the
     operator's hand keeps by itself.
     """
-    window = (run['remote_time'] >= start + settle) & (run['remote_time'] < end)
-    force = np.linalg.norm(run['patient'][window], axis=1)
-    held = run['held'] if np.isfinite(run['held']) else float(np.mean(force))
-    error = force - held
-    return {'held_n': held, 'hold_error_max_n': float(np.max(np.abs(error))),
-            'hold_error_rms_n': float(np.sqrt(np.mean(error ** 2)))}
+    return teleop_scan.hold_error(run['remote_time'], run['patient'], run['held'], start, end)
 
 
 def late_ticks(duration: float, seed: int, *, late: float = LATE_FRACTION,

@@ -3,7 +3,7 @@
     .venv/bin/python bench/teleop_scan.py [--schemes direct tdpa model]
         [--delays 0 0.01 0.025 0.05 0.1 0.25 0.5] [--jitter 0.2] [--loss 0.05]
         [--site-streams in-process dds] [--model-step-rates 5 0] [--delay-trace CSV]
-        [--json PATH]
+        [--force-hold] [--json PATH]
 
 Both sites run as real processes in two DDS domains, joined by the two site gateways
 (``haptic_loop --teleop``): the scripted sonographer approaches the patient phantom, presses,
@@ -24,7 +24,10 @@ applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor
   over 1 N. Smooth: both ratios ≤ 3 and no jump. A sonographer reads the tissue by differences
   of a few tenths of a newton; a step the patient's force does not make is a jolt;
 - the patient's **force rise** (issue 28's envelope): the time from the first contact to 90 % of
-  the mean contact force, and the peak rate of rise of the patient's force over 5 ms.
+  the mean contact force, and the peak rate of rise of the patient's force over 5 ms;
+- the **force error** through the sweep (from 0.5 s after it begins, ``SWEEP`` from the wand's
+  first pose): the patient's force against the held one in a hold run, else against its own
+  mean (what the operator's hand keeps by itself).
 
 The jitter is given as a fraction of the delay (20 %, and 5 % loss: issue 28's harsher link, to
 500 ms one way). ``--delay-trace`` runs each scheme once more over a measured link: a CSV of
@@ -37,9 +40,12 @@ each case runs once per way, one after the other. With ``--json`` the figure of 
 the patient's force against time at 100 and 500 ms, a panel per scheme and delay, is drawn beside
 the file (.png).
 ``--model-step-rates`` runs ``model`` once per rate of the driver's easing of new models (N/s;
-0: each at once, the baseline), the rows marked ``ease N``.
+0: each at once, the baseline), the rows marked ``ease N``. ``--force-hold`` runs ``model`` once
+more per delay with the remote site holding ``HOLD_FORCE`` through the sweep: the operator's
+site asks on ``teleop/hold`` as the sweep begins and releases as it ends, across the gateways.
 """
 import argparse
+import concurrent.futures
 import itertools
 import os
 import pathlib
@@ -54,12 +60,13 @@ import psutil
 import result_files
 
 from haptic_bringup.bag import typestore_with
+from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_vectors
 from remote_probe.link import DelayTrace
 
-__all__ = ['figures', 'felt_steps', 'read_scan', 'run', 'main']
+__all__ = ['figures', 'felt_steps', 'hold_error', 'read_scan', 'run', 'main']
 
 FORCE_SCALE = 0.3  # the leader's default: felt = 0.3 x patient
 CONTACT = 1.0  # [N] patient force above which the probe is in contact
@@ -73,6 +80,9 @@ JUMP = 1.0  # [N] a change of the felt force (scaled) between ticks that counts 
 SMOOTH_RATIO = 3.0  # the felt force's steps at most this many times the patient's
 RISE_WINDOW = 5e-3  # [s] the patient's rate of rise, over the F/T sensor's noise
 CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the sweep
+SWEEP = (5.0, 16.0)  # [s] from the first pose: the scan's sweep along the patient (scan.yaml)
+HOLD_SETTLE = 0.5  # [s] after the sweep begins, before its force error counts
+HOLD_FORCE = 8.0  # [N] held in a hold run: the scan's own press
 SITE_STREAMS = ('in-process', 'dds')
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
           '/remote/robot/ft_sensor/wrench': 'wrench', '/remote/robot/tcp_pose': 'pose'}
@@ -139,6 +149,20 @@ def force_rise(patient: np.ndarray, mean_contact: float) -> dict:
             'peak_rise_n_per_s': rate}
 
 
+def hold_error(times: np.ndarray, patient: np.ndarray, held: float, start: float,
+               end: float) -> dict:
+    """Return the patient's force (N) against ``held`` from ``HOLD_SETTLE`` after ``start``.
+
+    ``held`` NaN: against the force's own mean over the same window.
+    """
+    window = (times >= start + HOLD_SETTLE) & (times < end)
+    force = np.linalg.norm(patient[window], axis=1)
+    held = held if np.isfinite(held) else float(np.mean(force))
+    error = force - held
+    return {'held_n': held, 'hold_error_max_n': float(np.max(np.abs(error))),
+            'hold_error_rms_n': float(np.sqrt(np.mean(error ** 2)))}
+
+
 def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
     """Compute what the module's docstring lists from the series ``read_scan`` returns."""
     pose_t, pose = scan['/wand/pose']
@@ -178,11 +202,12 @@ def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
 def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
         domain_id: int = 42, keep: pathlib.Path | None = None,
         site_streams: str = 'in-process', model_step_rate: float | None = None,
-        delay_trace: pathlib.Path | None = None) -> dict:
+        delay_trace: pathlib.Path | None = None, hold: float | None = None) -> dict:
     """One scan with ``scheme`` over a link of one-way ``delay`` s; its figures.
 
     ``model_step_rate``: the driver's (N/s), None for the launcher's. ``delay_trace``: a CSV of
-    one-way delays replayed instead of ``delay``, which is then the trace's longest.
+    one-way delays replayed instead of ``delay``, which is then the trace's longest. ``hold``:
+    the force (N) the remote site is asked to hold through the sweep.
     """
     with tempfile.TemporaryDirectory() as tmp:
         folder = keep or pathlib.Path(tmp)
@@ -194,15 +219,26 @@ def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
                             intra_process=site_streams == 'in-process',
                             overrides={} if model_step_rate is None else
                             {'wand_driver': {'model_step_rate': model_step_rate}})
-        with Loop(config) as loop:
-            cpu = process_cpu(loop)
-            if loop.wait(60.0) is None:
-                raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
+        with concurrent.futures.ThreadPoolExecutor(1) as requests:
+            asked = None if hold is None else requests.submit(hold_during, domain_id, hold,
+                                                              *SWEEP, 120.0)
+            with Loop(config) as loop:
+                cpu = process_cpu(loop)
+                if loop.wait(60.0) is None:
+                    raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
+            zero = None if asked is None else asked.result()
+            if asked is not None and zero is None:
+                raise RuntimeError(f'{scheme} at {delay} s: the hold was never asked')
         streams = ', '.join([site_streams] + ([] if model_step_rate is None else
                                               [f'ease {model_step_rate:g}'])
-                            + ([] if delay_trace is None else [f'trace {delay_trace.name}']))
-        return {'scheme': scheme, **figures(read_scan(folder / 'bag'), delay), 'cpu': cpu,
-                'site_streams': streams}
+                            + ([] if delay_trace is None else [f'trace {delay_trace.name}'])
+                            + ([] if hold is None else [f'force held {hold:g} N']))
+        scan = read_scan(folder / 'bag')
+        start = scan['/wand/pose'][0][0] if zero is None else zero  # the hold's own zero
+        return {'scheme': scheme, **figures(scan, delay), 'cpu': cpu, 'site_streams': streams,
+                **hold_error(*scan['/remote/robot/ft_sensor/wrench'],
+                             np.nan if hold is None else hold, start + SWEEP[0],
+                             start + SWEEP[1])}
 
 
 def process_cpu(loop: Loop) -> dict:
@@ -237,6 +273,15 @@ def print_row(r: dict) -> None:
           flush=True)
 
 
+def print_hold_errors(rows: list) -> None:
+    print("\nThe patient's force through the sweep against the held one (unheld: its mean):")
+    for r in rows:
+        if r['scheme'] == 'model':
+            print(f'{1e3 * r["delay"]:6.0f} ms {r["site_streams"]:>30} held {r["held_n"]:5.2f} N'
+                  f'  error max {r["hold_error_max_n"]:5.2f} N'
+                  f'  rms {r["hold_error_rms_n"]:5.2f} N')
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--schemes', nargs='+', default=['direct', 'tdpa', 'model'],
@@ -251,6 +296,8 @@ def main(argv=None) -> int:
                         choices=SITE_STREAMS, help="how each site's nodes pass their streams")
     parser.add_argument('--model-step-rates', nargs='+', type=float, default=[None],
                         help="model: the driver's easing of new models, N/s (0: at once)")
+    parser.add_argument('--force-hold', action='store_true',
+                        help=f'model once more per delay, {HOLD_FORCE:g} N held through the sweep')
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     result_files.add_option(parser)
     args = parser.parse_args(argv)
@@ -274,12 +321,17 @@ def main(argv=None) -> int:
                     if folder:
                         traces[f'{scheme}, {1e3 * delay:g} ms one way, over ROS 2'] = read_scan(
                             folder / 'bag')
+            if args.force_hold:
+                rows.append(run('model', delay, jitter=args.jitter, loss=args.loss,
+                                domain_id=args.domain_id, hold=HOLD_FORCE))
+                print_row(rows[-1])
     if args.delay_trace:
         longest = float(DelayTrace.from_csv(args.delay_trace).delays.max())
         for scheme in args.schemes:
             rows.append(run(scheme, longest, jitter=0.0, loss=args.loss,
                             domain_id=args.domain_id, delay_trace=args.delay_trace))
             print_row(rows[-1])
+    print_hold_errors(rows)
     print('\nCPU, % of one core, over the press and the sweep (the machine has '
           f'{psutil.cpu_count()} cores):')
     names = list(rows[0]['cpu'])

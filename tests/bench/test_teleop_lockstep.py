@@ -71,17 +71,17 @@ def test_model_updates_eased_in_reach_the_hand_without_a_jolt():
     """At 250 ms one way each estimate reached the hand as a step: 6 N (scaled) at contact.
 
     The smoothness measure (``teleop_scan.felt_steps``) must fail there on models switched at
-    once (the driver's ``model_step_rate`` 0), and the eased ones must take the jumps out,
-    passive. What remains at this delay (0.06 N, 3.6 times the patient's largest step) is the
-    first estimate's normal turning half a degree from the skin's, which easing does not smooth.
+    once (the driver's ``model_step_rate`` 0), and the eased ones must be smooth, passive: the
+    largest steps left here by an easing of push and stiffness alone (0.06 N, 3.6 to 4.4 times
+    the patient's largest step) were the estimate's damping falling to zero and its normal
+    turning half a degree between updates; both are eased now.
     """
     stepped = figures('model', 0.25, duration=6.0, easing=0.0)
     eased = figures('model', 0.25, duration=6.0)
     assert not stepped['smooth'] and stepped['jumps'] >= 1, stepped
     assert stepped['step_ratio_max'] > teleop_scan.SMOOTH_RATIO
-    assert eased['jumps'] == 0, eased
+    assert eased['smooth'], eased
     assert eased['felt_step_max_n'] < stepped['felt_step_max_n'] / 20.0
-    assert eased['step_ratio_p99'] <= teleop_scan.SMOOTH_RATIO
     assert eased['stable'] and eased['net_work_j'] <= 0.0
 
 

@@ -21,9 +21,9 @@ RATE = 5.0  # [N/s]
 MASS = 0.15  # [kg]
 
 
-def wall(stiffness: float, height: float = 0.0) -> ContactModel:
-    return ContactModel.from_fields(fields([plane(point=(0.0, 0.0, height),
-                                                  stiffness=stiffness)], radius=1.0), 'world')
+def wall(stiffness: float, height: float = 0.0, damping: float = 0.0) -> ContactModel:
+    return ContactModel.from_fields(fields([plane(point=(0.0, 0.0, height), stiffness=stiffness,
+                                                  damping=damping)], radius=1.0), 'world')
 
 
 def law(rate: float) -> LocalRenderer:
@@ -76,6 +76,32 @@ def test_a_model_met_after_nothing_was_felt_ramps_in_from_zero():
     assert forces[0] == 0.0
     assert np.diff(forces).max() <= RATE * PERIOD * (1.0 + 1e-9)
     assert forces[-1] == 0.0  # nothing was put in: nothing to push back with
+
+
+def test_a_model_without_damping_goes_on_from_the_damping_felt_and_eases_it_out():
+    """An estimate's damping clamped to zero, met by a hand pressing in at 1 cm/s.
+
+    The damping felt (5 N·s/m: 0.05 N) drops at once unless eased. Eased, the force holds in the
+    period of the switch (the planes matched to the push before), then each period's change is
+    the spring's own (k·v·T) within the rate, and the damping is gone once eased out.
+    """
+    speed, spring_step = -0.01, 1000.0 * 0.01 * PERIOD  # m/s; N a period
+
+    def pressing(rate: float) -> list:
+        renderer = law(rate)
+        renderer.take(wall(1000.0, damping=5.0), math.inf)
+        heights = iter(np.arange(0.0005, -0.008, speed * PERIOD))
+        forces = [renderer.wrench(0.0, [0.0, 0.0, next(heights), 0.0, 0.0],
+                                  [0.0, 0.0, speed, 0.0, 0.0], PERIOD)[0][2] for _ in range(800)]
+        renderer.take(wall(1000.0), math.inf)
+        return forces + [renderer.wrench(0.0, [0.0, 0.0, z, 0.0, 0.0], [0.0, 0.0, speed, 0.0, 0.0],
+                                         PERIOD)[0][2] for z in heights]
+
+    stepped, eased = np.diff(pressing(0.0)), np.diff(pressing(RATE))
+    assert stepped[799] - spring_step < -0.045  # the damping's 0.05 N, gone in one period
+    assert eased[799] == pytest.approx(0.0, abs=1e-12)
+    assert np.abs(eased[800:] - spring_step).max() <= RATE * PERIOD * (1.0 + 1e-9)
+    assert eased[-1] == pytest.approx(spring_step, rel=1e-9)  # the model's own spring alone
 
 
 class _Recording:

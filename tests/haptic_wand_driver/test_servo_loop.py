@@ -80,6 +80,16 @@ def _give(law: LocalRenderer, rng, tip, now: float, since: float = -math.inf) ->
         law.take(model, deadline, since)
 
 
+def _give_estimate(law: LocalRenderer, rng, tip, now: float, since: float = -math.inf) -> None:
+    """Hand the law a remote site's estimate: one plane, its normal within a degree of up."""
+    normal = rng.normal(size=3) * 0.01 + (0.0, 0.0, 1.0)
+    plane = (tuple(np.asarray(tip) + (0.0, 0.0, rng.uniform(-0.002, 0.004))),
+             tuple(normal / np.linalg.norm(normal)), (rng.uniform(100.0, 3000.0),) * 3,
+             (rng.uniform(0.0, 5.0),) * 3, (0.0, 0.0, 0.0))
+    law.take(ContactModel.from_fields(fields([plane], radius=0.05, tip=tuple(tip)), 'world'),
+             now + 0.003, since)
+
+
 def _wand(law, hand: bool = True) -> SimulatedWand:
     config = SimulatedWandConfig(initial_position=np.array([0.0, 0.0, 0.004]), initial_roll=0.1)
     wand = SimulatedWand(config, operator=OperatorHand(_Sweep()) if hand else None)
@@ -91,10 +101,10 @@ def _row(wand: SimulatedWand, state, law: LocalRenderer) -> tuple:
     force, torque = wand.applied()
     return (*state.position, state.roll, state.yaw, *state.linear_velocity, state.roll_rate,
             state.yaw_rate, *force, *torque, law.passivity.energy, law.passivity.net_work,
-            *law.bound[[0, 2, 3, 4, 5, 6]])
+            *law.bound[[0, 2, 3, 4, 5, 6]], *law.bound[7:])
 
 
-def _run(seed: int, ratio: float, hand: bool, rate: float = 0.0):
+def _run(seed: int, ratio: float, hand: bool, rate: float = 0.0, give=_give):
     laws = [_renderer(ratio, rate), _renderer(ratio, rate)]
     wands = [_wand(laws[0], hand), _wand(_Python(laws[1]), hand)]
     assert wands[0]._compiled is not None and wands[1]._compiled is None  # the two paths
@@ -109,7 +119,7 @@ def _run(seed: int, ratio: float, hand: bool, rate: float = 0.0):
         draw = rng.bit_generator.state
         for law, row, wand, state in zip(laws, rows, wands, states):
             rng.bit_generator.state = draw  # the same model for both
-            _give(law, rng, tip, now, since)
+            give(law, rng, tip, now, since)
             row.append(_row(wand, state, law))
     return np.array(rows), [wand.force_edges for wand in wands]
 
@@ -142,6 +152,17 @@ def test_the_eased_runs_compared_match_pushes_scale_stiffnesses_and_shift_both_w
     assert shift.min() < 0.0 < shift.max()
     assert push.max() > 0.0
     assert scale.min() < 1.0 < scale.max()
+
+
+@pytest.mark.parametrize('seed', range(2))
+def test_estimates_eased_in_turn_their_normals_in_both_loops_float_for_float(seed):
+    """A new estimate every tick, its normal a fraction of a degree from the last one's."""
+    (compiled, reference), _ = _run(seed, 1.0, hand=True, rate=5.0, give=_give_estimate)
+    assert np.array_equal(compiled, reference)
+    pressing = (compiled[:-1, 24] == 1.0) & (compiled[1:, 24] == 1.0) & (compiled[1:, 19] > 0.0)
+    turns = np.arccos(np.clip(np.einsum('ij,ij->i', compiled[:-1, 25:28], compiled[1:, 25:28]),
+                              -1.0, 1.0))[pressing]
+    assert np.count_nonzero((turns > 0.0) & (turns < 2e-3)) > 10, turns  # turned, not taken
 
 
 @pytest.mark.parametrize('seed', range(3))

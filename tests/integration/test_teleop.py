@@ -3,6 +3,7 @@
 Every figure comes from the bag (what the device applied to the hand, what the remote sensor
 read) or from the nodes' own reports, never from the schemes' internal books.
 """
+import concurrent.futures
 import os
 import pathlib
 import signal
@@ -19,6 +20,7 @@ from rclpy.node import Node
 from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import recover, typestore_with
+from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import (bags, published_counts, read_vectors, reported,
@@ -33,6 +35,7 @@ JITTER = 0.1 * DELAY  # [s]
 LINK_TIMEOUT = silence_timeout(0.1, JITTER)  # [s] both ends', as the launcher sets them
 MODEL_LIFETIME = 0.010  # [s] the leader's default
 PRESSING = (6.0, 8.0)  # [s] after the first pose: the scan holds its press, then sweeps
+HELD = 7.0  # [N] the force the operator asks the remote site to hold once PRESSING is over
 STREAMS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
            '/teleop/feedback': 'pose', '/remote/robot/ft_sensor/wrench': 'wrench',
            '/remote/robot/tcp_pose': 'pose'}
@@ -83,9 +86,13 @@ def window(times: np.ndarray, start: float, end: float) -> np.ndarray:
 
 @pytest.fixture(scope='module')
 def scan(tmp_path_factory):
+    """The scan at 50 ms; once ``PRESSING`` is over the operator asks for a force-hold."""
     folder = tmp_path_factory.mktemp('teleop_scan')
-    with teleop(folder) as loop:
-        assert loop.wait(60.0) is not None, 'the scan did not end'
+    with concurrent.futures.ThreadPoolExecutor(1) as requests:
+        asked = requests.submit(hold_during, session_domain_id(), HELD, PRESSING[1], None, 120.0)
+        with teleop(folder) as loop:
+            assert loop.wait(60.0) is not None, 'the scan did not end'
+        assert asked.result() is not None, 'the operator\'s gateway never took the hold'
     return folder, streams(folder)
 
 
@@ -125,6 +132,15 @@ def test_each_site_records_itself_into_the_session_and_loses_nothing(scan):
     assert {topic: recorded[topic] for topic in SITE_PUBLISHERS} == published
     for recorder in ('operator_recorder', 'remote_recorder'):
         assert reports(folder, recorder, 'dropped')[-1] == '0'
+
+
+def test_a_force_hold_asked_at_the_operator_s_site_crosses_and_the_remote_site_holds(scan):
+    """``teleop/hold`` crosses the gateways as a reliable message: the follower, at the remote
+    site, reports the force it holds."""
+    folder, _ = scan
+    held = reports(folder, 'teleop_follower', 'force_hold')
+    assert held and held[0] == 'None'  # not holding as the scan began
+    assert float(held[-1]) == HELD
 
 
 def wait_for_the_first_pose(domain_id: int, timeout: float) -> float:

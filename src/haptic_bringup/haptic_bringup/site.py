@@ -33,7 +33,7 @@ import yaml
 from haptic_bringup.launcher import (link_parameters, Loop, loop_environment, LoopConfig,
                                      node_parameters, site_nodes, teleop_endpoints)
 from haptic_bringup.processes import run_until_stopped, start_child
-from haptic_contract.graph import FRAME_TOPICS, TO_OPERATOR, TO_REMOTE
+from haptic_contract.graph import FRAME_TOPICS, RELIABLE_CROSSINGS, TO_OPERATOR, TO_REMOTE
 from haptic_contract.teleop import Scheme, SCHEMES
 from site_gateway.certs import init_ca, issue
 
@@ -62,7 +62,8 @@ def gateway_parameters(role: str, *, listen=(), connect=(), certs: Optional[str]
     return {'role': role, 'listen': list(listen) or [''], 'connect': list(connect) or [''],
             'certs': str(pathlib.Path(certs).expanduser().resolve()) if certs else '',
             'insecure': insecure, 'to_remote': list(TO_REMOTE),
-            'to_operator': list(TO_OPERATOR), 'frames': list(FRAME_TOPICS), **(link or {})}
+            'to_operator': list(TO_OPERATOR), 'reliable': list(RELIABLE_CROSSINGS),
+            'frames': list(FRAME_TOPICS), **(link or {})}
 
 
 def site_parameters(site: SiteConfig) -> dict:

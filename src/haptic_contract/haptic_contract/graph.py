@@ -9,14 +9,14 @@ from typing import NamedTuple
 
 __all__ = ['COLLISION_MARKERS', 'COLLISION_NEARBY', 'COLLISION_STATE', 'DIAGNOSTICS',
            'EXECUTABLES', 'FRAME_TOPICS', 'IMAGER', 'LATCHED_TOPICS', 'LOOP_RECORDER',
-           'LOOP_TOPICS', 'NODES', 'NodeEntry', 'OPERATOR_RECORDED', 'OPERATOR_RECORDER',
-           'OPERATOR_SITE', 'PROBE_IMAGE', 'PUBLISHERS', 'RECORDERS', 'RELIABLE_TOPICS',
-           'REMOTE_PREFIX', 'REMOTE_RECORDED', 'REMOTE_RECORDER', 'REMOTE_SITE', 'ROBOT_FT_WRENCH',
-           'ROBOT_IMPEDANCE', 'ROBOT_TARGET_POSE', 'ROBOT_TCP_POSE', 'SCENE_DESCRIPTION',
-           'SITE_PUBLISHERS', 'STREAMS', 'TELEOP_CLUTCH', 'TELEOP_COMMAND', 'TELEOP_FEEDBACK',
-           'TELEOP_NODES', 'TOPIC_TYPES', 'TO_OPERATOR', 'TO_REMOTE', 'WAND_APPLIED_WRENCH',
-           'WAND_CONTACT_MODEL', 'WAND_FORCE_MARKER', 'WAND_POSE', 'WAND_TWIST', 'WAND_WRENCH',
-           'absolute']
+           'LOOP_TOPICS', 'NodeEntry', 'NODES', 'OPERATOR_RECORDED', 'OPERATOR_RECORDER',
+           'OPERATOR_SITE', 'PROBE_IMAGE', 'PUBLISHERS', 'RECORDERS', 'RELIABLE_CROSSINGS',
+           'RELIABLE_TOPICS', 'REMOTE_PREFIX', 'REMOTE_RECORDED', 'REMOTE_RECORDER', 'REMOTE_SITE',
+           'ROBOT_FT_WRENCH', 'ROBOT_IMPEDANCE', 'ROBOT_TARGET_POSE', 'ROBOT_TCP_POSE',
+           'SCENE_DESCRIPTION', 'SITE_PUBLISHERS', 'STREAMS', 'TELEOP_CLUTCH', 'TELEOP_COMMAND',
+           'TELEOP_FEEDBACK', 'TELEOP_HOLD', 'TELEOP_NODES', 'TELEOP_RE_ENGAGE', 'TOPIC_TYPES',
+           'TO_OPERATOR', 'TO_REMOTE', 'WAND_APPLIED_WRENCH', 'WAND_CONTACT_MODEL',
+           'WAND_FORCE_MARKER', 'WAND_POSE', 'WAND_TWIST', 'WAND_WRENCH', 'absolute']
 
 # The loop: the wand's state out, the engine's answer, the renderer's wrench or model back.
 WAND_POSE = 'wand/pose'
@@ -33,6 +33,8 @@ SCENE_DESCRIPTION = 'scene/description'
 TELEOP_COMMAND = 'teleop/command'
 TELEOP_FEEDBACK = 'teleop/feedback'
 TELEOP_CLUTCH = 'teleop/clutch'
+TELEOP_HOLD = 'teleop/hold'  # the force the remote site is to hold (N; <= 0 releases)
+TELEOP_RE_ENGAGE = 'teleop/re_engage'  # the operator's deliberate re-engage after a hard stop
 ROBOT_TARGET_POSE = 'robot/target_pose'
 ROBOT_TCP_POSE = 'robot/tcp_pose'
 ROBOT_FT_WRENCH = 'robot/ft_sensor/wrench'
@@ -114,9 +116,13 @@ RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
     'recorder', 'operator_recorder', 'remote_recorder')
 REMOTE_PREFIX = '/remote'  # where the remote site's topics go in its bag
 # What crosses between the sites, each way ('topic:type').
-TO_REMOTE = (f'{absolute(TELEOP_COMMAND)}:haptic_msgs/msg/TeleopCommand',)
+TO_REMOTE = (f'{absolute(TELEOP_COMMAND)}:haptic_msgs/msg/TeleopCommand',
+             f'{absolute(TELEOP_HOLD)}:std_msgs/msg/Float64',
+             f'{absolute(TELEOP_RE_ENGAGE)}:std_msgs/msg/Empty')
 TO_OPERATOR = (f'{absolute(TELEOP_FEEDBACK)}:haptic_msgs/msg/TeleopFeedback',
                f'{absolute(PROBE_IMAGE)}:sensor_msgs/msg/Image')
+# The operator's requests, rare and each one meant: they must arrive (reliable, in order).
+RELIABLE_CROSSINGS = (absolute(TELEOP_HOLD), absolute(TELEOP_RE_ENGAGE))
 # A session's bag holds what each site measured and what crossed the link, recorded where it
 # arrives (its sent copy is the same message, earlier). Left out, each one step from those and
 # read by no analysis: the wand's twist (the pose's rate), the leader's answer to its driver (the

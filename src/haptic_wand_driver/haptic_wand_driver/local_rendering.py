@@ -25,9 +25,9 @@ model's life. A model that comes after a late tick, the one before expired and t
 deeper, then gives back no more than the hand put in.
 
 Smooth at any update rate, with ``model_step_rate`` > 0 (``model_easing``): a new model's planes
-start as stiff as the last period's and where they push as much, and ease to the model at that
-many N/s of push, held every period to the port's bound. 0 switches at once, as above (the
-baseline).
+start as stiff and as damped as the last period's and where they push as much, and ease to the
+model at that many N/s of push, held every period to the port's bound. 0 switches at once, as above
+(the baseline).
 
 A model renders from the servo period that holds its ``since`` (the device's clock when it
 arrived), and what was held before renders the periods until then: so a device that runs its
@@ -47,8 +47,9 @@ count, the damping cap per mass and period (``MAX_DAMPING_PER_MASS``), ``since``
 number, the model step rate; from ``PLANES_AT`` the planes, ``PLANE_SIZE`` floats each (point,
 normal, stiffness, damping, tool point). ``bound`` is the planes' shift (m), the number of the take
 it was set for, the spring push the planes rendered in the last period (N; 0 when none), the
-factor on their stiffnesses and the sum of those scaled (N/m; 0 when none), the factor on their
-dampings and the sum of those scaled (N·s/m; 0 when none).
+factor on their stiffnesses and the sum of those scaled (N/m; 0 when none), the damping added to
+each plane's (N·s/m) and the sum of their dampings with it (N·s/m; 0 when none), then the count
+of planes rendered (0 when none) and their normals, 3 floats each (``BOUND_SIZE`` in all).
 """
 import math
 from typing import Sequence
@@ -58,12 +59,13 @@ import numpy as np
 from haptic_contract.contact_model import ContactModel, Kind, MAX_PLANES
 from haptic_contract.plane_law import saturate_components
 from haptic_contract.wand import roll_axis
-from haptic_wand_driver.model_easing import eased_level, eased_scale, eased_shift, least_shift, \
-    matched_shift, scaled_model, spring_push, stored_energy, total_damping, total_stiffness
+from haptic_wand_driver.model_easing import eased_extra, eased_scale, eased_shift, held_normals, \
+    least_shift, matched_extra, matched_shift, scaled_model, spring_push, stored_energy, \
+    total_damping, total_stiffness, turned_normals
 from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
 
-__all__ = ['DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS', 'MODE_NONE',
-           'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE',
+__all__ = ['BOUND_SIZE', 'DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS',
+           'MODE_NONE', 'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE',
            'STEP_RATE']
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -71,6 +73,7 @@ MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
 MODE_NONE, MODE_WRENCH, MODE_PLANES = 0.0, 1.0, 2.0  # what ``packed`` holds
 DEADLINE, SINCE, SERIAL, STEP_RATE, PLANES_AT, PLANE_SIZE = 7, 21, 22, 23, 24, 15
 LAW_SIZE = PLANES_AT + MAX_PLANES * PLANE_SIZE
+BOUND_SIZE = 8 + 3 * MAX_PLANES
 _NOTHING = (None, None, -math.inf)  # (model, wrench, deadline) held
 
 
@@ -104,8 +107,9 @@ class LocalRenderer:
         self.contact_damping_ratio = contact_damping_ratio
         self.model_step_rate = float(model_step_rate)
         self.packed = np.zeros((2, LAW_SIZE))  # (servo_loop's layout)
-        # shift, take, push, stiffness factor and sum, damping factor and sum
-        self.bound = np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0])
+        # shift, take, push, stiffness factor and sum, damping added and sum, planes, normals
+        self.bound = np.zeros(BOUND_SIZE)
+        self.bound[1], self.bound[3] = -1.0, 1.0
         self._held = ((*_NOTHING, 0),) * 2 + (-math.inf,)  # before since, from since, since
         self._takes = 0
         self.clear()
@@ -161,58 +165,68 @@ class LocalRenderer:
         limit = self.force_limit
         if wrench is not None and time + period <= deadline:
             force, torque = wrench
-            self.bound[2] = self.bound[4] = self.bound[6] = 0.0
+            self.bound[2] = self.bound[4] = self.bound[6] = self.bound[7] = 0.0
         elif (model is not None and model.kind == Kind.PLANES and time + period <= deadline
                 and model.valid(position)):
             x, y, z = roll_axis(coordinates[4])
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
             limit = min(self.force_limit, model.force_limit)
-            shift = self._shift(model, take, coordinates, period)
-            force, torque = scaled_model(model, float(self.bound[3]), float(self.bound[5])).wrench(
+            shift, rendered = self._shift(model, take, coordinates, velocity, period)
+            force, torque = scaled_model(rendered, float(self.bound[3]),
+                                         float(self.bound[5])).wrench(
                 position, velocity, coordinates[3], coordinates[4], spin,
                 self._contact_damping(period), limit, shift)
         else:
-            self.bound[2] = self.bound[4] = self.bound[6] = 0.0
+            self.bound[2] = self.bound[4] = self.bound[6] = self.bound[7] = 0.0
         force = self.passivity.control(force, position, velocity, period,
                                        time + period > deadline)
         return (saturate_components(force, limit),
                 saturate_components(torque, self.torque_limit))
 
     def _shift(self, model: ContactModel, take: int, coordinates: Sequence[float],
-               period: float) -> float:
-        """Return the shift of ``model``'s planes this period.
+               velocity: Sequence[float], period: float) -> tuple[float, ContactModel]:
+        """Return the shift of ``model``'s planes this period, and the model to render.
 
         Set by the port's bound at the model's first period and kept; or, easing, matched to the
-        last period's stiffness, damping and push at the first and eased from there (the factors
-        with it, in ``bound``), storing no more than the port absorbed or the planes held.
+        last period's stiffness, damping, normals and push at the first and eased from there
+        (the factor, the added damping and the normals with it, in ``bound``), storing no more
+        than the port absorbed or the planes held.
         """
         first = take != self.bound[1]
         if not (first or self.model_step_rate > 0.0):
-            return float(self.bound[0])
+            return float(self.bound[0]), model
         self.passivity.observe(coordinates[:3])
-        springs = model.springs(coordinates, coordinates[3], coordinates[4])
+        roll, yaw = coordinates[3], coordinates[4]
         energy = self.passivity.energy
         if self.model_step_rate == 0.0:
-            self.bound[:2] = (bounded_shift(springs, energy), take)
-            return float(self.bound[0])
+            self.bound[:2] = (bounded_shift(model.springs(coordinates, roll, yaw), energy), take)
+            return float(self.bound[0]), model
         step = self.model_step_rate * period
-        shift, _, push, scale, stiff, damping_scale, damped = self.bound.tolist()
-        total, damping = total_stiffness(springs), total_damping(model)
+        shift, _, push, scale, stiff, extra, damped = self.bound[:7].tolist()
+        rendered = held_normals(model, self.bound[7:])
         if first:
+            springs = rendered.springs(coordinates, roll, yaw)
+            total = total_stiffness(springs)
             scale = stiff / total if stiff > 0.0 and total > 0.0 else 1.0
-            damping_scale = damped / damping if damping > 0.0 else 1.0
+            extra = matched_extra(rendered, damped)
             springs = [(d, scale * k) for d, k in springs]
             shift = matched_shift(springs, push)
         else:
-            held = stored_energy([(d, scale * k) for d, k in springs], shift)
+            held = stored_energy([(d, scale * k) for d, k in rendered.springs(
+                coordinates, roll, yaw)], shift)
+            rendered = turned_normals(rendered, model, step, push)
+            springs = rendered.springs(coordinates, roll, yaw)
+            total = total_stiffness(springs)
             scale = eased_scale(scale, step, push)
-            damping_scale = eased_level(damping_scale, step, push)
+            extra = eased_extra(extra, step, push, velocity, len(model.planes))
             springs = [(d, scale * k) for d, k in springs]
             eased = eased_shift(springs, shift, step)
             shift = max(eased, least_shift(springs, max(energy, held), min(eased, 0.0)))
-        self.bound[:] = (shift, take, spring_push(springs, shift), scale, scale * total,
-                         damping_scale, damping_scale * damping)
-        return shift
+        self.bound[:8] = (shift, take, spring_push(springs, shift), scale, scale * total, extra,
+                          total_damping(rendered, extra), len(rendered.planes))
+        for k, plane in enumerate(rendered.planes):
+            self.bound[8 + 3 * k:11 + 3 * k] = plane.normal
+        return shift, rendered
 
     def _contact_damping(self, period: float):
         """Return the per-plane damping for this servo period (None when the ratio is zero)."""

@@ -16,8 +16,9 @@ before its loop starts. Its inputs, float64 arrays:
 * ``packed`` (2, n): the renderer's settings and what it holds, from a period on and before it
   (``LocalRenderer.packed``, whose layout ``local_rendering`` defines);
 * ``books``: the port's passivity (``PortPassivity.books``);
-* ``bound``: the shift of the planes, the take it was set for and the last period's spring push
-  (``LocalRenderer.bound``; ``model_easing`` when the law eases its models in);
+* ``bound``: the shift of the planes, the take it was set for and the last period's spring push,
+  and what the easing carries on (``LocalRenderer.bound``; ``model_easing`` when the law eases
+  its models in);
 * ``joints`` (5, 6): per joint, the hand's stiffness and damping, the inverse inertia, the
   damping decay per period and the workspace stops (lower, upper);
 * ``targets`` (n, 2, 5): the hand's target and its rate at each period.
@@ -27,8 +28,10 @@ import math
 import numpy as np
 
 from haptic_util.jit import jit
-from haptic_wand_driver.local_rendering import (DEADLINE, LAW_SIZE, MODE_PLANES, MODE_WRENCH,
-                                                PLANE_SIZE, PLANES_AT, SERIAL, SINCE, STEP_RATE)
+from haptic_wand_driver.local_rendering import (BOUND_SIZE, DEADLINE, LAW_SIZE, MODE_PLANES,
+                                                MODE_WRENCH, PLANE_SIZE, PLANES_AT, SERIAL,
+                                                SINCE, STEP_RATE)
+from haptic_wand_driver.model_easing import COS_EASED_TURN, EASED_TURN
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
 
 __all__ = ['advance', 'compile_now']
@@ -191,19 +194,58 @@ def _eased_scale(scale, step, push):
 
 
 @jit
-def _total_damping(law):
+def _total_damping(law, extra):
+    """Return the planes' dampings along their normals, ``extra`` added (``total_damping``)."""
     total = 0.0
     for k in range(int(law[19])):
         at = PLANES_AT + PLANE_SIZE * k
         nx, ny, nz = law[at + 3], law[at + 4], law[at + 5]
-        along = law[at + 9] * nx * nx + law[at + 10] * ny * ny + law[at + 11] * nz * nz
+        along = (max(law[at + 9] + extra, 0.0) * nx * nx + max(law[at + 10] + extra, 0.0) * ny * ny
+                 + max(law[at + 11] + extra, 0.0) * nz * nz)
         if along > 0.0:
             total += along
     return total
 
 
 @jit
-def _shift(law, coordinates, books, bound, period):
+def _held_normals(law, bound):
+    """Return ``law`` with the normals rendered the period before (``held_normals``)."""
+    count = int(law[19])
+    if bound[7] != count or count == 0:
+        return law
+    rendered = law.copy()
+    for k in range(count):
+        at = PLANES_AT + PLANE_SIZE * k
+        hx, hy, hz = bound[8 + 3 * k], bound[9 + 3 * k], bound[10 + 3 * k]
+        if hx * law[at + 3] + hy * law[at + 4] + hz * law[at + 5] >= COS_EASED_TURN:
+            rendered[at + 3], rendered[at + 4], rendered[at + 5] = hx, hy, hz
+    return rendered
+
+
+@jit
+def _turn_normals(rendered, law, step, push):
+    """Turn ``rendered``'s normals toward ``law``'s, in place (``turned_normals``)."""
+    for k in range(int(law[19])):
+        at = PLANES_AT + PLANE_SIZE * k
+        nx, ny, nz = rendered[at + 3], rendered[at + 4], rendered[at + 5]
+        tx, ty, tz = law[at + 3], law[at + 4], law[at + 5]
+        along = nx * tx + ny * ty + nz * tz
+        rendered[at + 3], rendered[at + 4], rendered[at + 5] = tx, ty, tz
+        if push <= 0.0 or along < COS_EASED_TURN:
+            continue
+        angle = step / push
+        if angle >= EASED_TURN or along >= math.cos(angle):
+            continue
+        x, y, z = tx - along * nx, ty - along * ny, tz - along * nz
+        length = math.sqrt(x * x + y * y + z * z)
+        cos, sin = math.cos(angle), math.sin(angle)
+        rendered[at + 3] = nx * cos + x / length * sin
+        rendered[at + 4] = ny * cos + y / length * sin
+        rendered[at + 5] = nz * cos + z / length * sin
+
+
+@jit
+def _shift(law, coordinates, rates, books, bound, period):
     """Set ``bound`` for this period of the planes held (``LocalRenderer._shift``)."""
     rate = law[STEP_RATE]
     first = law[SERIAL] != bound[1]
@@ -212,15 +254,17 @@ def _shift(law, coordinates, books, bound, period):
     _observe(books, coordinates)
     depths, stiffnesses = np.empty(3), np.empty(3)
     count = int(law[19])
-    _springs(law, coordinates, depths, stiffnesses)
     if rate == 0.0:
+        _springs(law, coordinates, depths, stiffnesses)
         bound[0], bound[1] = _least_shift(depths, stiffnesses, count, books[0], 0.0), law[SERIAL]
         return
-    step, shift, push, scale, damping_scale = rate * period, bound[0], bound[2], bound[3], bound[5]
-    total, damping = _total_stiffness(stiffnesses, count), _total_damping(law)
+    step, shift, push, scale, extra = rate * period, bound[0], bound[2], bound[3], bound[5]
+    rendered = _held_normals(law, bound).copy()
+    _springs(rendered, coordinates, depths, stiffnesses)
     if first:
+        total, damping = _total_stiffness(stiffnesses, count), _total_damping(rendered, 0.0)
         scale = bound[4] / total if bound[4] > 0.0 and total > 0.0 else 1.0
-        damping_scale = bound[6] / damping if damping > 0.0 else 1.0
+        extra = (bound[6] - damping) / count if count > 0 else 0.0
         for k in range(count):
             stiffnesses[k] = scale * stiffnesses[k]
         shift = _matched_shift(depths, stiffnesses, count, push)
@@ -229,12 +273,15 @@ def _shift(law, coordinates, books, bound, period):
         for k in range(count):
             if depths[k] - shift > 0.0:
                 held += 0.5 * (scale * stiffnesses[k]) * (depths[k] - shift) * (depths[k] - shift)
+        _turn_normals(rendered, law, step, push)
+        _springs(rendered, coordinates, depths, stiffnesses)
+        total = _total_stiffness(stiffnesses, count)
         scale = _eased_scale(scale, step, push)
-        damping_scale = 1.0
-        if push > 0.0:
-            change = step / push
-            damping_scale = (min(bound[5] + change, 1.0) if bound[5] < 1.0
-                             else max(bound[5] - change, 1.0))
+        extra, speed = 0.0, count * math.sqrt(rates[0] * rates[0] + rates[1] * rates[1]
+                                              + rates[2] * rates[2])
+        if push > 0.0 and speed != 0.0:
+            change = step / speed
+            extra = min(bound[5] + change, 0.0) if bound[5] < 0.0 else max(bound[5] - change, 0.0)
         for k in range(count):
             stiffnesses[k] = scale * stiffnesses[k]
         scaled = _total_stiffness(stiffnesses, count)
@@ -249,21 +296,25 @@ def _shift(law, coordinates, books, bound, period):
         if depths[k] - shift > 0.0:
             push += stiffnesses[k] * (depths[k] - shift)
     bound[0], bound[1], bound[2] = shift, law[SERIAL], push
-    bound[3], bound[4], bound[5], bound[6] = scale, scale * total, damping_scale, (
-        damping_scale * damping)
+    bound[3], bound[4], bound[5] = scale, scale * total, extra
+    bound[6], bound[7] = _total_damping(rendered, extra), count
+    for k in range(count):
+        at = PLANES_AT + PLANE_SIZE * k
+        bound[8 + 3 * k], bound[9 + 3 * k], bound[10 + 3 * k] = (
+            rendered[at + 3], rendered[at + 4], rendered[at + 5])
 
 
 @jit
-def _scaled(law, scale, damping_scale):
-    """Return ``law`` with its planes' stiffnesses and dampings scaled (``scaled_model``)."""
-    if scale == 1.0 and damping_scale == 1.0:
+def _scaled(law, scale, extra):
+    """Return ``law``, its planes' stiffnesses scaled, ``extra`` on dampings (``scaled_model``)."""
+    if scale == 1.0 and extra == 0.0:
         return law
     scaled = law.copy()
     for k in range(int(law[19])):
         at = PLANES_AT + PLANE_SIZE * k
         for j in range(6, 9):
             scaled[at + j] = law[at + j] * scale
-            scaled[at + j + 3] = law[at + j + 3] * damping_scale
+            scaled[at + j + 3] = max(law[at + j + 3] + extra, 0.0)
     return scaled
 
 
@@ -336,19 +387,20 @@ def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     mode, live = law[6], time + period <= law[DEADLINE]
     if mode == MODE_WRENCH and live:
         fx, fy, fz, tx, ty, tz = law[13], law[14], law[15], law[16], law[17], law[18]
-        bound[2] = bound[4] = bound[6] = 0.0
+        bound[2] = bound[4] = bound[6] = bound[7] = 0.0
     elif mode == MODE_PLANES and live:
         dx, dy, dz = coordinates[0] - law[10], coordinates[1] - law[11], coordinates[2] - law[12]
         if dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
             if law[8] < limit:
                 limit = law[8]
-            _shift(law, coordinates, books, bound, period)
-            fx, fy, fz, tx, ty, tz = _planes(_scaled(law, bound[3], bound[5]), coordinates,
-                                             rates, limit, period, bound[0])
+            _shift(law, coordinates, rates, books, bound, period)
+            fx, fy, fz, tx, ty, tz = _planes(_scaled(_held_normals(law, bound), bound[3],
+                                                     bound[5]), coordinates, rates, limit,
+                                             period, bound[0])
         else:
-            bound[2] = bound[4] = bound[6] = 0.0
+            bound[2] = bound[4] = bound[6] = bound[7] = 0.0
     else:
-        bound[2] = bound[4] = bound[6] = 0.0
+        bound[2] = bound[4] = bound[6] = bound[7] = 0.0
     fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period, not live)
     fx, fy, fz = _saturate(fx, fy, fz, limit)
     tx, ty, tz = _saturate(tx, ty, tz, law[1])
@@ -408,6 +460,6 @@ def compile_now() -> None:
     """Compile ``advance`` for the types the wand passes (or load it from numba's cache)."""
     advance(np.zeros(5), np.zeros(5), np.zeros((5, 6)), np.zeros((0, 2, 5)),
             np.zeros((2, LAW_SIZE)),
-            np.zeros(11), np.array([0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 0.0]), 1.0, 1.0, 0.0, 0, 1.0,
+            np.zeros(11), np.zeros(BOUND_SIZE), 1.0, 1.0, 0.0, 0, 1.0,
             np.zeros(6),
             np.empty(0, dtype=np.int64), False)

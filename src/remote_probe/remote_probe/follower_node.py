@@ -21,7 +21,8 @@ from std_msgs.msg import Empty, Float64
 
 from collision_engine import load_scene
 from haptic_contract.graph import (ROBOT_FT_WRENCH, ROBOT_IMPEDANCE, ROBOT_TARGET_POSE,
-                                   ROBOT_TCP_POSE, TELEOP_COMMAND, TELEOP_FEEDBACK)
+                                   ROBOT_TCP_POSE, TELEOP_COMMAND, TELEOP_FEEDBACK, TELEOP_HOLD,
+                                   TELEOP_RE_ENGAGE)
 from haptic_contract.streams import POSE, POSE_POSITION, WRENCH, WRENCH_FORCE
 from haptic_contract.teleop import Scheme
 from haptic_contract.teleop_fields import (COMMAND, command_from_fields, command_session, FEEDBACK,
@@ -91,8 +92,8 @@ class FollowerNode(Node):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
         self.create_subscription(RobotImpedance, ROBOT_IMPEDANCE, self.on_impedance,
                                  LATCHED_QOS)
-        self.create_subscription(Empty, 'teleop/re_engage', self.on_re_engage, 1)
-        self.create_subscription(Float64, 'teleop/hold', self.on_hold, 1)
+        self.create_subscription(Empty, TELEOP_RE_ENGAGE, self.on_re_engage, 1)
+        self.create_subscription(Float64, TELEOP_HOLD, self.on_hold, 1)
         self.create_timer(self._period, self.tick)
         rate = params.feedback_rate or (MODEL_FEEDBACK_RATE if params.scheme == Scheme.MODEL
                                         else FORCE_FEEDBACK_RATE)
