@@ -19,9 +19,9 @@ its first pose):
   operator's bag, p50 and p99, the link's delay included (target: p99 <= 50 ms + the delay);
   and to its publication at the remote site, as the imager reports it.
 
-The imager makes its frames in a thread of its own, at a niceness 5 above the site's loop
-(``worker_niceness``): ``--niceness`` sets another, to weigh the image's lateness against the
-loop's. The load average is printed with each run: the machine is shared, and only the ratios
+The imager is a process of its own beside the remote site's, at a niceness 5 above the loops'
+(its ``niceness``): ``--niceness`` sets another, to weigh the image's lateness against the
+loops'. The load average is printed with each run: the machine is shared, and only the ratios
 of runs side by side are figures.
 """
 import argparse
@@ -72,7 +72,7 @@ def run(imaging: bool, domain_id: int, niceness: int | None = None) -> dict:
         stats = folder / 'loop_stats.npz'
         overrides = {'wand_driver': {'stats_file': str(stats)}}
         if niceness is not None:
-            overrides['probe_imager'] = {'worker_niceness': niceness}
+            overrides['probe_imager'] = {'niceness': niceness}
         config = LoopConfig(teleop='model', link=dict(LINK), record=str(folder / 'bag'),
                             domain_id=domain_id, run_dir=folder / 'launch', imaging=imaging,
                             overrides=overrides)
@@ -164,7 +164,7 @@ def _print_row(row: dict) -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--pairs', type=int, default=3, help='runs with imaging on and off')
-    parser.add_argument('--niceness', type=int, help="the imaging thread's, above the loop's "
+    parser.add_argument('--niceness', type=int, help="the imager process's, above the loops' "
                         '(default: the node\'s, 5)')
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     result_files.add_option(parser)

@@ -42,7 +42,7 @@ def test_a_job_that_raises_is_reported_and_the_next_item_is_made():
         errors.append(error)
         failed.set()
 
-    worker = LatestWorker(job, on_error=on_error, niceness=5)
+    worker = LatestWorker(job, on_error=on_error)
     worker.offer('bad')
     assert failed.wait(WAIT)  # taken before the good one could replace it
     worker.offer('good')
