@@ -2,16 +2,16 @@
 
 Takes ``robot/tcp_pose`` (PoseStamped, the robot's 1 kHz stream) and at ``frame_rate`` publishes
 ``probe/image`` (sensor_msgs/Image, mono8) of the newest pose, stamped with that pose's time, in
-``probe_frame`` (``ProbeImaging``). It runs in a process of its own at the remote site, beside
-the robot's: in the robot's process, a frame's Python held the robot's 1 kHz loop back for the
-GIL. The process yields the cores to the loops (``niceness``). When frames take longer than
-their period they are dropped, never queued, and each starts from the newest pose: the frame is
-made in a thread of its own (``LatestWorker``) while the executor's thread goes on taking poses.
-A pose that cannot be imaged gives a dark frame, and the reason is logged once a second; a scene
-or settings that cannot image stop the node at start, naming what to fix. The kernels are
-compiled (or loaded) at start, so that the first frame is not late. Its report gives the frame
-time and the time from the pose's stamp to the frame's publication (p50, p99 over the last
-``RECENT_FRAMES``).
+``probe_frame`` (``ProbeImaging``). It runs in a process of its own at the remote site, beside the
+robot's: in the robot's process, a frame's Python held the robot's 1 kHz loop back for the GIL. The
+process yields the cores to the loops (``idle``, ``niceness``: ``haptic_util.priority``). When
+frames take longer than their period they are dropped, never queued, and each starts from the
+newest pose: the frame is made in a thread of its own (``LatestWorker``) while the executor's
+thread goes on taking poses. A pose that cannot be imaged gives a dark frame, and the reason is
+logged once a second; a scene or settings that cannot image stop the node at start, naming what to
+fix. The kernels are compiled (or loaded) at start, so that the first frame is not late. Its report
+gives the frame time and the time from the pose's stamp to the frame's publication (p50, p99 over
+the last ``RECENT_FRAMES``).
 """
 import collections
 import time
@@ -29,8 +29,8 @@ from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.priority import lower_process_priority
-from haptic_util.qos import FRAME_QOS
+from haptic_util.priority import yield_cores
+from haptic_util.qos import FRAME_QOS, NEWEST_STREAM_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from ultrasound_sim.conversions import image_cdr
@@ -50,7 +50,7 @@ class ProbeImagerNode(Node):
     def __init__(self, **kwargs):
         super().__init__('probe_imager', **kwargs)
         self.params = params = declare_parameters(self, ProbeImagerParams)
-        niceness = lower_process_priority(params.niceness)
+        priority = yield_cores(params.niceness, params.idle)
         try:
             self.imaging = ProbeImaging.from_scene_file(
                 resolve_path(params.scene_file, what='parameter scene_file'),
@@ -67,7 +67,8 @@ class ProbeImagerNode(Node):
         self._times = collections.deque(maxlen=RECENT_FRAMES)
         self._clock = self.get_clock()
         self._publisher = self.create_publisher(Image, 'probe/image', FRAME_QOS)
-        stream_subscription(self, POSE, 'robot/tcp_pose', self.on_pose, refused=self._refused)
+        stream_subscription(self, POSE, 'robot/tcp_pose', self.on_pose, refused=self._refused,
+                            qos=NEWEST_STREAM_QOS)
         self._worker = LatestWorker(self.make_frame, on_error=log_callback_error,
                                     name='probe_imager')
         self.create_timer(1.0 / params.frame_rate, self.on_timer)
@@ -76,8 +77,8 @@ class ProbeImagerNode(Node):
         self.get_logger().info(
             f'{settings.probe_type} probe at {settings.centre_frequency / 1e6:g} MHz, '
             f'{1e3 * settings.depth:g} mm deep, {settings.scanlines} lines; '
-            f'{params.frame_rate:g} frames/s on probe/image at niceness {niceness} (kernels '
-            f'ready in {warm_up:.2f} s)')
+            f'{params.frame_rate:g} frames/s on probe/image, {priority} (kernels ready in '
+            f'{warm_up:.2f} s)')
 
     def on_pose(self, fields: Sequence) -> None:
         self._pose = fields
