@@ -1,6 +1,6 @@
 """The probe's image in the telerobotic session: what it costs the 1 kHz loops, and how late it is.
 
-    .venv/bin/python bench/imaging_session.py [--pairs 3] [--imager idle 5 ...] [--json PATH]
+    .venv/bin/python bench/imaging_session.py [--pairs 3] [--imager 5 idle ...] [--json PATH]
 
 The model-mediated scan over a 50 ms link (5 ms jitter, 1 % loss), as ``make demo`` runs it,
 with the remote site's imager on and off (``LoopConfig.imaging``), alternated in one run (on,
@@ -19,11 +19,11 @@ its first pose):
   operator's bag, p50 and p99, the link's delay included (target: p99 <= 50 ms + the delay);
   and to its publication at the remote site, as the imager reports it.
 
-The imager is a process of its own beside the remote site's that yields the cores to the loops
-(``haptic_util.priority``): by default under ``SCHED_IDLE`` (``idle``), or with its niceness
-raised. ``--imager`` names how, one or more (``idle``, or a niceness such as ``5``): each is run
-beside an imaging-off run in each group of runs, the order turning from one group to the next,
-to weigh the image's lateness against the loops'. The load average is printed with each run:
+The imager is a process of its own beside the remote site's, whose frame thread yields the cores to
+the loops (``haptic_util.priority``): by default at a niceness 5 above theirs, or under
+``SCHED_IDLE``. ``--imager`` names how, one or more (a niceness such as ``5``, or ``idle``): each
+is run beside an imaging-off run in each group of runs, the order turning from one group to the
+next, to weigh the image's lateness against the loops'. The load average is printed with each run:
 the machine is shared, and only the ratios of runs side by side are figures.
 """
 import argparse
@@ -50,7 +50,7 @@ WINDOW = (3.0, 15.0)  # [s] after the scan's first pose: the press and the sweep
 TARGETS = {'rate': 0.99, 'answered': 0.99, 'p99': 1.1}
 STAMPED = {'/wand/pose': 'pose', '/remote/robot/tcp_pose': 'pose'}
 CROSSED = ('/remote/teleop/command', '/teleop/feedback')  # recorded where they arrived
-OFF, IDLE = 'off', 'idle'  # the baseline, and the imager's default (SCHED_IDLE)
+OFF, IDLE = 'off', 'idle'  # the baseline; the imager's frame thread under SCHED_IDLE
 
 
 def _in_window(times: np.ndarray, start: float) -> np.ndarray:
@@ -191,9 +191,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--pairs', type=int, default=3,
                         help='groups of runs: imaging off, and on as each --imager')
-    parser.add_argument('--imager', nargs='+', default=[IDLE], metavar='HOW',
-                        help="how the imager's process yields: idle (SCHED_IDLE, the default) or "
-                        'a niceness (0-19); the first is the summary\'s')
+    parser.add_argument('--imager', nargs='+', default=['5'], metavar='HOW',
+                        help="how the imager's frame thread yields: a niceness (0-19; the "
+                        "node's default, 5) or idle (SCHED_IDLE); the first is the summary's")
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     result_files.add_option(parser)
     args = parser.parse_args(argv)

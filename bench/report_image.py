@@ -189,8 +189,8 @@ STREAMS = {'operator_rate_hz': ('operator\'s poses a second', 'rate'),
 
 def _yielding(variant: str) -> str:
     """Say how the imager's process yields the cores (``imaging_session.imager_parameters``)."""
-    return ('under SCHED_IDLE (it runs on what the loops leave; a loop that wakes preempts it)'
-            if variant == 'idle' else f'at niceness +{variant}')
+    return ('its frame thread under SCHED_IDLE (it runs on what every other process leaves)'
+            if variant == 'idle' else f'its frame thread at niceness +{variant}')
 
 
 def _met(ratio: float, bound: float, kind: str) -> bool:

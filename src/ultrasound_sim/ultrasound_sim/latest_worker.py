@@ -1,11 +1,12 @@
-"""A thread that works on the newest item only, beside the thread feeding it.
+"""A thread that works on the newest item only, beside the thread feeding it, at its own priority.
 
 Why: a B-mode frame is milliseconds of compiled work. On the imager's executor thread it would
 leave the TCP poses waiting as long, at every frame, and the next frame would start from one
 that old. Here the executor only hands the newest pose over (``offer``) and goes on taking poses;
-the compiled kernels release the GIL, so both go on together. An item offered while one still
-waits replaces it (the newest pose is the one to image), and is counted in ``replaced``: when
-frames take longer than their period, frames are dropped, never queued.
+the compiled kernels release the GIL, so both go on together. The thread may yield the cores
+(``on_start``: ``haptic_util.priority``) while the executor's keeps its priority. An item
+offered while one still waits replaces it (the newest pose is the one to image), and is counted
+in ``replaced``: when frames take longer than their period, frames are dropped, never queued.
 """
 
 import threading
@@ -22,11 +23,14 @@ class LatestWorker:
     job : callable item -> None
     on_error : callable Exception -> None
         Told of an exception ``job`` raised; the thread goes on with the next item.
+    on_start : callable () -> None
+        Run first in the thread (to set its priority).
     """
 
     def __init__(self, job: Callable, *, on_error: Callable[[Exception], None],
+                 on_start: Callable[[], None] = lambda: None,
                  name: str = 'latest_worker') -> None:
-        self._job, self._on_error = job, on_error
+        self._job, self._on_error, self._on_start = job, on_error, on_start
         self._condition = threading.Condition()
         self._waiting = []  # at most one item
         self._closed = False
@@ -50,6 +54,7 @@ class LatestWorker:
         return not self._thread.is_alive()
 
     def _run(self) -> None:
+        self._on_start()
         while True:
             with self._condition:
                 while not self._waiting and not self._closed:

@@ -3,15 +3,15 @@
 Takes ``robot/tcp_pose`` (PoseStamped, the robot's 1 kHz stream) and at ``frame_rate`` publishes
 ``probe/image`` (sensor_msgs/Image, mono8) of the newest pose, stamped with that pose's time, in
 ``probe_frame`` (``ProbeImaging``). It runs in a process of its own at the remote site, beside the
-robot's: in the robot's process, a frame's Python held the robot's 1 kHz loop back for the GIL. The
-process yields the cores to the loops (``idle``, ``niceness``: ``haptic_util.priority``). When
-frames take longer than their period they are dropped, never queued, and each starts from the
-newest pose: the frame is made in a thread of its own (``LatestWorker``) while the executor's
-thread goes on taking poses. A pose that cannot be imaged gives a dark frame, and the reason is
-logged once a second; a scene or settings that cannot image stop the node at start, naming what to
-fix. The kernels are compiled (or loaded) at start, so that the first frame is not late. Its report
-gives the frame time and the time from the pose's stamp to the frame's publication (p50, p99 over
-the last ``RECENT_FRAMES``).
+robot's: in the robot's process, a frame's Python held the robot's 1 kHz loop back for the GIL.
+The frame is made in a thread of its own (``LatestWorker``) that yields the cores to the loops
+(``idle``, ``niceness``: ``haptic_util.priority``), while the executor's thread takes the poses,
+and another sends the frames, at the process's priority. When frames take longer than their period
+they are dropped, never queued, and each starts from the newest pose. A pose that cannot be
+imaged gives a dark frame, and the reason is logged once a second; a scene or settings that
+cannot image stop the node at start, naming what to fix. The kernels are compiled (or loaded) at
+start, so that the first frame is not late. Its report gives the frame time and the time from
+the pose's stamp to the frame's publication (p50, p99 over the last ``RECENT_FRAMES``).
 """
 import collections
 import time
@@ -29,7 +29,7 @@ from haptic_util.executor import run_nodes, StartupError
 from haptic_util.intra_process import stream_subscription
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.priority import yield_cores
+from haptic_util.priority import yield_thread
 from haptic_util.qos import FRAME_QOS, NEWEST_STREAM_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
@@ -50,7 +50,6 @@ class ProbeImagerNode(Node):
     def __init__(self, **kwargs):
         super().__init__('probe_imager', **kwargs)
         self.params = params = declare_parameters(self, ProbeImagerParams)
-        priority = yield_cores(params.niceness, params.idle)
         try:
             self.imaging = ProbeImaging.from_scene_file(
                 resolve_path(params.scene_file, what='parameter scene_file'),
@@ -69,16 +68,24 @@ class ProbeImagerNode(Node):
         self._publisher = self.create_publisher(Image, 'probe/image', FRAME_QOS)
         stream_subscription(self, POSE, 'robot/tcp_pose', self.on_pose, refused=self._refused,
                             qos=NEWEST_STREAM_QOS)
+        # Frames are made in one thread, which yields the cores, and sent from another, which
+        # does not: the EventsExecutor has no guard condition to wake its own thread with.
+        self._sender = LatestWorker(self.publish_frame, on_error=log_callback_error,
+                                    name='probe_image_sender')
         self._worker = LatestWorker(self.make_frame, on_error=log_callback_error,
-                                    name='probe_imager')
+                                    on_start=self.yield_cores, name='probe_imager')
         self.create_timer(1.0 / params.frame_rate, self.on_timer)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         settings = self.imaging.imager.settings
         self.get_logger().info(
             f'{settings.probe_type} probe at {settings.centre_frequency / 1e6:g} MHz, '
             f'{1e3 * settings.depth:g} mm deep, {settings.scanlines} lines; '
-            f'{params.frame_rate:g} frames/s on probe/image, {priority} (kernels ready in '
-            f'{warm_up:.2f} s)')
+            f'{params.frame_rate:g} frames/s on probe/image (kernels ready in {warm_up:.2f} s)')
+
+    def yield_cores(self) -> None:
+        """Let the site's loops go first for the cores (in the worker's thread)."""
+        priority = yield_thread(self.params.niceness, self.params.idle)
+        self.get_logger().info(f'frames made at {priority}')
 
     def on_pose(self, fields: Sequence) -> None:
         self._pose = fields
@@ -92,16 +99,25 @@ class ProbeImagerNode(Node):
         self._worker.offer(pose)
 
     def make_frame(self, pose: Sequence) -> None:
-        """Image one pose and publish it (in the worker's thread)."""
+        """Image one pose, and hand it to the sender (in the worker's thread).
+
+        The worker may be starved for the cores: it never holds the middleware's locks.
+        """
         started, cpu = time.perf_counter(), time.thread_time()
         imaged = self.imaging.image(pose[2], pose[3:6], pose[6:10])
         if imaged.reason:
             self._dark.add('dark frame', imaged.reason)
         stamp_ns = pose[0] * 1_000_000_000 + pose[1]
-        self._publisher.publish(image_cdr(stamp_ns, self.params.probe_frame, imaged.image))
+        frame = image_cdr(stamp_ns, self.params.probe_frame, imaged.image)
+        self._sender.offer((frame, stamp_ns, time.perf_counter() - started,
+                            time.thread_time() - cpu))
+
+    def publish_frame(self, made: tuple) -> None:
+        """Publish a frame made (in the sender's thread)."""
+        frame, stamp_ns, wall, cpu = made
+        self._publisher.publish(frame)
         self._published += 1
-        self._times.append((time.perf_counter() - started, time.thread_time() - cpu,
-                            1e-9 * (clock_ns(self._clock) - stamp_ns)))
+        self._times.append((wall, cpu, 1e-9 * (clock_ns(self._clock) - stamp_ns)))
 
     def report(self) -> Report:
         self._dark.log_new(self.get_logger().warn)
@@ -122,6 +138,7 @@ class ProbeImagerNode(Node):
 
     def destroy_node(self) -> bool:
         self._worker.close()
+        self._sender.close()
         self.diagnostics.final()
         return super().destroy_node()
 
