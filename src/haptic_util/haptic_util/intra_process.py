@@ -220,7 +220,7 @@ def stream_subscription(node: Node, codec: MessageCodec, topic: str,
     """Return a subscription of a 1 kHz stream: ``callback`` gets each message's leaf values.
 
     Malformed messages are counted in the node's ``refused`` tally, which its report logs.
-    ``qos`` must match the publishers' (the haptic streams'); the history's depth is the one
+    ``qos`` must match the publishers' (the haptic streams'); a deeper history is the one
     choice left to the reader.
     """
     return StreamSubscription(node, codec, topic, callback, refused=refused, qos=qos)

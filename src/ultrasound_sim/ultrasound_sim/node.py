@@ -3,15 +3,16 @@
 Takes ``robot/tcp_pose`` (PoseStamped, the robot's 1 kHz stream) and at ``frame_rate`` publishes
 ``probe/image`` (sensor_msgs/Image, mono8) of the newest pose, stamped with that pose's time, in
 ``probe_frame`` (``ProbeImaging``). It runs in a process of its own at the remote site, beside the
-robot's: in the robot's process, a frame's Python held the robot's 1 kHz loop back for the GIL.
-The frame is made in a thread of its own (``LatestWorker``) that yields the cores to the loops
-(``idle``, ``niceness``: ``haptic_util.priority``), while the executor's thread takes the poses,
-and another sends the frames, at the process's priority. When frames take longer than their period
-they are dropped, never queued, and each starts from the newest pose. A pose that cannot be
-imaged gives a dark frame, and the reason is logged once a second; a scene or settings that
-cannot image stop the node at start, naming what to fix. The kernels are compiled (or loaded) at
-start, so that the first frame is not late. Its report gives the frame time and the time from
-the pose's stamp to the frame's publication (p50, p99 over the last ``RECENT_FRAMES``).
+robot's: in the robot's process, a frame's Python held the robot's 1 kHz loop back for the GIL. The
+frame is made in a thread of its own (``LatestWorker``) that yields the cores to the loops
+(``idle``, ``niceness``: ``haptic_util.priority``), while the executor's thread takes the newest
+pose at each frame (``NewestMessage``: not the other 970 a second), and another thread sends the
+frames, at the process's priority. When frames take longer than their period they are dropped,
+never queued, and each starts from the newest pose. A pose that cannot be imaged gives a dark
+frame, and the reason is logged once a second; a scene or settings that cannot image stop the node
+at start, naming what to fix. The kernels are compiled (or loaded) at start, so that the first
+frame is not late. Its report gives the frame time and the time from the pose's stamp to the
+frame's publication (p50, p99 over the last ``RECENT_FRAMES``).
 """
 import collections
 import time
@@ -26,11 +27,11 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
-from haptic_util.intra_process import stream_subscription
+from haptic_util.newest import NewestMessage
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
 from haptic_util.priority import yield_thread
-from haptic_util.qos import FRAME_QOS, NEWEST_STREAM_QOS
+from haptic_util.qos import FRAME_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from ultrasound_sim.conversions import image_cdr
@@ -58,7 +59,6 @@ class ProbeImagerNode(Node):
             raise StartupError(f'{self.get_name()}: {error}') from None
         warm_up = self.imaging.warm_up()
         self._pose = None  # the newest TCP pose's fields
-        self._offered = None  # the stamp of the pose last handed to the worker
         self._published = 0
         self._dark = Tally()
         self._refused = Tally()
@@ -66,8 +66,7 @@ class ProbeImagerNode(Node):
         self._times = collections.deque(maxlen=RECENT_FRAMES)
         self._clock = self.get_clock()
         self._publisher = self.create_publisher(Image, 'probe/image', FRAME_QOS)
-        stream_subscription(self, POSE, 'robot/tcp_pose', self.on_pose, refused=self._refused,
-                            qos=NEWEST_STREAM_QOS)
+        self._poses = NewestMessage(self, POSE, 'robot/tcp_pose', refused=self._refused)
         # Frames are made in one thread, which yields the cores, and sent from another, which
         # does not: the EventsExecutor has no guard condition to wake its own thread with.
         self._sender = LatestWorker(self.publish_frame, on_error=log_callback_error,
@@ -87,16 +86,12 @@ class ProbeImagerNode(Node):
         priority = yield_thread(self.params.niceness, self.params.idle)
         self.get_logger().info(f'frames made at {priority}')
 
-    def on_pose(self, fields: Sequence) -> None:
-        self._pose = fields
-
     def on_timer(self) -> None:
-        """Hand the newest pose to the worker, unless already imaged."""
-        pose = self._pose
-        if pose is None or (pose[0], pose[1]) == self._offered:
-            return
-        self._offered = (pose[0], pose[1])
-        self._worker.offer(pose)
+        """Hand the newest pose to the worker, if one came since the last."""
+        pose = self._poses.take()
+        if pose is not None:
+            self._pose = pose
+            self._worker.offer(pose)
 
     def make_frame(self, pose: Sequence) -> None:
         """Image one pose, and hand it to the sender (in the worker's thread).
@@ -139,6 +134,7 @@ class ProbeImagerNode(Node):
     def destroy_node(self) -> bool:
         self._worker.close()
         self._sender.close()
+        self._poses.destroy()
         self.diagnostics.final()
         return super().destroy_node()
 
