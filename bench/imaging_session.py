@@ -1,6 +1,6 @@
 """The probe's image in the telerobotic session: what it costs the 1 kHz loops, and how late it is.
 
-    .venv/bin/python bench/imaging_session.py [--pairs 3] [--niceness N] [--json PATH]
+    .venv/bin/python bench/imaging_session.py [--pairs 3] [--imager 5 idle ...] [--json PATH]
 
 The model-mediated scan over a 50 ms link (5 ms jitter, 1 % loss), as ``make demo`` runs it,
 with the remote site's imager on and off (``LoopConfig.imaging``), alternated in one run (on,
@@ -19,10 +19,12 @@ its first pose):
   operator's bag, p50 and p99, the link's delay included (target: p99 <= 50 ms + the delay);
   and to its publication at the remote site, as the imager reports it.
 
-The imager makes its frames in a thread of its own, at a niceness 5 above the site's loop
-(``worker_niceness``): ``--niceness`` sets another, to weigh the image's lateness against the
-loop's. The load average is printed with each run: the machine is shared, and only the ratios
-of runs side by side are figures.
+The imager is a process of its own beside the remote site's, whose frame thread yields the cores to
+the loops (``haptic_util.priority``): by default at a niceness 5 above theirs, or under
+``SCHED_IDLE``. ``--imager`` names how, one or more (a niceness such as ``5``, or ``idle``): each
+is run beside an imaging-off run in each group of runs, the order turning from one group to the
+next, to weigh the image's lateness against the loops'. The load average is printed with each run:
+the machine is shared, and only the ratios of runs side by side are figures.
 """
 import argparse
 import os
@@ -48,6 +50,7 @@ WINDOW = (3.0, 15.0)  # [s] after the scan's first pose: the press and the sweep
 TARGETS = {'rate': 0.99, 'answered': 0.99, 'p99': 1.1}
 STAMPED = {'/wand/pose': 'pose', '/remote/robot/tcp_pose': 'pose'}
 CROSSED = ('/remote/teleop/command', '/teleop/feedback')  # recorded where they arrived
+OFF, IDLE = 'off', 'idle'  # the baseline; the imager's frame thread under SCHED_IDLE
 
 
 def _in_window(times: np.ndarray, start: float) -> np.ndarray:
@@ -65,14 +68,20 @@ def _received(bag: pathlib.Path, topic: str) -> np.ndarray:
         return np.array([t * 1e-9 for _, t, _ in reader.messages(connections=connections)])
 
 
-def run(imaging: bool, domain_id: int, niceness: int | None = None) -> dict:
-    """One scan with the imager on or off; its figures (module docstring)."""
+def imager_parameters(variant: str) -> dict:
+    """Return the imager's parameters for ``variant``: ``idle``, or a niceness."""
+    return {'idle': True} if variant == IDLE else {'idle': False, 'niceness': int(variant)}
+
+
+def run(variant: str, domain_id: int) -> dict:
+    """One scan with the imager off (``OFF``) or yielding as ``variant`` says; its figures."""
+    imaging = variant != OFF
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         stats = folder / 'loop_stats.npz'
         overrides = {'wand_driver': {'stats_file': str(stats)}}
-        if niceness is not None:
-            overrides['probe_imager'] = {'worker_niceness': niceness}
+        if imaging:
+            overrides['probe_imager'] = imager_parameters(variant)
         config = LoopConfig(teleop='model', link=dict(LINK), record=str(folder / 'bag'),
                             domain_id=domain_id, run_dir=folder / 'launch', imaging=imaging,
                             overrides=overrides)
@@ -87,7 +96,7 @@ def run(imaging: bool, domain_id: int, niceness: int | None = None) -> dict:
         start = stamped['/wand/pose'][0][0]
         ticks = np.diff(_in_window(stamped['/remote/robot/tcp_pose'][0], start))
         loop_stats = np.load(stats)
-        row = {'imaging': imaging, 'load': os.getloadavg()[0],
+        row = {'imaging': imaging, 'variant': variant, 'load': os.getloadavg()[0],
                'operator_rate_hz': float(loop_stats['rate_hz']),
                'operator_answered_percent': float(loop_stats['answered_percent']),
                'operator_round_trip_p99_s': float(loop_stats['latency_p99_s']),
@@ -115,14 +124,16 @@ def _cpu(row: dict) -> float:
     return sum(row['cpu_percent'].values())
 
 
-def summary(rows: list) -> dict:
-    """Return the ratios on / off of each stream figure, and the CPU imaging adds.
+def summary(rows: list, variant: str) -> dict:
+    """Return the ratios on (as ``variant``) / off of each stream figure, and the CPU imaging adds.
 
-    ``rows`` come in pairs, one run on and one off side by side, which share the machine's load
-    more than runs further apart: each ratio is taken within a pair, and its median and range
-    over the pairs are given.
+    ``rows`` come in groups, one run off and one with each variant side by side, which share
+    the machine's load more than runs further apart: each ratio is taken within a group, and its
+    median and range over the groups are given.
     """
-    pairs = [(a, b) if a['imaging'] else (b, a) for a, b in zip(rows[0::2], rows[1::2])]
+    groups = sorted({row['group'] for row in rows})
+    pairs = [tuple(next(r for r in rows if r['group'] == group and r['variant'] == v)
+                   for v in (variant, OFF)) for group in groups]
     on, off = [pair[0] for pair in pairs], [pair[1] for pair in pairs]
 
     def median(runs, key):
@@ -151,7 +162,7 @@ def _print_row(row: dict) -> None:
              f'{1e3 * row["pose_to_image_p50_s"]:.1f}/{1e3 * row["pose_to_image_p99_s"]:.1f} ms '
              f'(published p99 {1e3 * row["pose_to_publication_p99_s"]:.1f} ms)'
              if row['imaging'] else '')
-    print(f'imaging {"on " if row["imaging"] else "off"}: operator {row["operator_rate_hz"]:.0f}'
+    print(f'imaging {row["variant"]:>4}: operator {row["operator_rate_hz"]:.0f}'
           f' Hz, {row["operator_answered_percent"]:.1f} % answered, round trip p99 '
           f'{1e3 * row["operator_round_trip_p99_s"]:.2f} ms; robot {row["robot_rate_hz"]:.0f} '
           f'Hz, tick p99 {1e3 * row["robot_tick_p99_s"]:.2f} ms; commands '
@@ -161,37 +172,47 @@ def _print_row(row: dict) -> None:
           + f'){image}; load {row["load"]:.1f}', flush=True)
 
 
+def _print_summary(variant: str, result: dict) -> None:
+    ratios = [f'{key} {value:.3f} [{low:.3f}-{high:.3f}]' for (key, value), (low, high)
+              in zip(result['ratios'].items(), result['ranges'].values())]
+    print(f'imager {variant}, on / off within each group, median [range] (targets: rates and '
+          'answered >= 0.99, p99 <= 1.1): ' + ', '.join(ratios))
+    print(f'  CPU: {result["cpu_on_percent"]:.0f} % of a core on, '
+          f'{result["cpu_off_percent"]:.0f} % off: imaging adds {result["cpu_added_percent"]:.0f}'
+          f' % at {result["frames_hz"]:.1f} frames/s, {1e3 * result["cpu_per_frame_s"]:.1f} ms a '
+          f'frame (the imager\'s own thread: {1e3 * result["frame_cpu_p50_s"]:.1f} ms)')
+    print(f'  pose to image p99 {1e3 * result["pose_to_image_p99_s"]:.1f} ms at the operator, '
+          f'{1e3 * LINK["delay"]:.0f} ms of it the link\'s delay (target <= '
+          f'{50 + 1e3 * LINK["delay"]:.0f} ms); to publication at the remote site p99 '
+          f'{1e3 * result["pose_to_publication_p99_s"]:.1f} ms', flush=True)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--pairs', type=int, default=3, help='runs with imaging on and off')
-    parser.add_argument('--niceness', type=int, help="the imaging thread's, above the loop's "
-                        '(default: the node\'s, 5)')
+    parser.add_argument('--pairs', type=int, default=3,
+                        help='groups of runs: imaging off, and on as each --imager')
+    parser.add_argument('--imager', nargs='+', default=['5'], metavar='HOW',
+                        help="how the imager's frame thread yields: a niceness (0-19; the "
+                        "node's default, 5) or idle (SCHED_IDLE); the first is the summary's")
     parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
     result_files.add_option(parser)
     args = parser.parse_args(argv)
     add_venv_prefix()
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
+    for variant in args.imager:
+        imager_parameters(variant)  # a bad one stops here, not after the first runs
     rows = []
-    for pair in range(args.pairs):
-        for imaging in ((True, False) if pair % 2 == 0 else (False, True)):
-            rows.append(run(imaging, args.domain_id, args.niceness))
+    for group in range(args.pairs):
+        variants = [OFF, *args.imager]
+        for variant in variants[group % len(variants):] + variants[:group % len(variants)]:
+            rows.append({**run(variant, args.domain_id), 'group': group})
             _print_row(rows[-1])
-    result = summary(rows)
-    ratios = [f'{key} {value:.3f} [{low:.3f}-{high:.3f}]' for (key, value), (low, high)
-              in zip(result['ratios'].items(), result['ranges'].values())]
-    print('on / off within each pair, median [range] (targets: rates and answered >= 0.99, p99 '
-          '<= 1.1): ' + ', '.join(ratios))
-    print(f'CPU: {result["cpu_on_percent"]:.0f} % of a core on, {result["cpu_off_percent"]:.0f} '
-          f'% off: imaging adds {result["cpu_added_percent"]:.0f} % at '
-          f'{result["frames_hz"]:.1f} frames/s, {1e3 * result["cpu_per_frame_s"]:.1f} ms a frame '
-          f'(the imager\'s own thread: {1e3 * result["frame_cpu_p50_s"]:.1f} ms)')
-    print(f'pose to image p99 {1e3 * result["pose_to_image_p99_s"]:.1f} ms at the operator, '
-          f'{1e3 * LINK["delay"]:.0f} ms of it the link\'s delay (target <= '
-          f'{50 + 1e3 * LINK["delay"]:.0f} ms); to publication at the remote site p99 '
-          f'{1e3 * result["pose_to_publication_p99_s"]:.1f} ms')
-    result_files.write(args.json, {'rows': rows, 'summary': result,
-                                   'niceness': 5 if args.niceness is None else args.niceness})
+    results = {variant: summary(rows, variant) for variant in args.imager}
+    for variant, result in results.items():
+        _print_summary(variant, result)
+    result_files.write(args.json, {'rows': rows, 'summary': results[args.imager[0]],
+                                   'variant': args.imager[0], 'variants': results})
     return 0
 
 

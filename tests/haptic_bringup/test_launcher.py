@@ -5,8 +5,9 @@ import sys
 
 import yaml
 
-from haptic_bringup.launcher import (expected_endpoints, loop_environment, LoopConfig,
-                                     node_parameters, parse_args, site_nodes, teleop_endpoints)
+from haptic_bringup.launcher import (expected_endpoints, imager_argv, loop_environment,
+                                     LoopConfig, node_parameters, parse_args, site_nodes,
+                                     teleop_endpoints)
 from haptic_bringup.site import parse_args as site_args, site_config
 
 
@@ -67,8 +68,9 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
     assert operator['output'] == str(tmp_path / 'scan' / 'operator')
     assert remote['output'] == str(tmp_path / 'scan' / 'remote') and remote['prefix'] == '/remote'
     assert site_nodes(config, 'operator') == ('wand_driver', 'teleop_leader', 'operator_recorder')
-    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'probe_imager',
-                                            'remote_recorder')
+    # The imager is a process of its own beside the remote site's, as ros2 run starts it.
+    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    assert imager_argv(config, ['--ros-args'])[1:] == ['-m', 'ultrasound_sim.node', '--ros-args']
     assert operator['topics'][-1] == '/probe/image'  # recorded where it is seen
     blind = LoopConfig(teleop='model', record=str(tmp_path / 'blind'))  # no imaging by default
     assert site_nodes(blind, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
@@ -76,6 +78,10 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
         'ros__parameters']['topics']
     assert '/probe/image' not in teleop_endpoints(blind)[blind.remote_domain_id]
     assert teleop_endpoints(config)[config.remote_domain_id]['/probe/image'] == (1, 1)
+    remote_graph = teleop_endpoints(config)[config.remote_domain_id]
+    blind_graph = teleop_endpoints(blind)[blind.remote_domain_id]
+    # The imager takes the TCP pose over DDS, one subscriber more.
+    assert remote_graph['/robot/tcp_pose'][1] == blind_graph['/robot/tcp_pose'][1] + 1
     remote = site_config(site_args(['remote', '--listen', 'tls/0.0.0.0:7447', '--insecure',
                                     '--imaging']))
     assert remote.loop.imaging and parse_args(['--teleop', 'model', '--imaging']).imaging

@@ -232,15 +232,17 @@ def test_the_loop_launch_file_records_the_loop_with_the_projects_recorder(build,
 
 
 def test_the_teleop_launch_file_runs_both_sites_and_each_records_itself(build, tmp_path):
+    """With the imager, a process of its own at the remote site (``imaging:=true``)."""
     from domains import session_domain_id
     from haptic_bringup.session import SITE_PUBLISHERS, topic_counts
     launched(build, 'teleop.launch.py', 'scheme:=model', 'delay:=0.02',
              'duration:=4.0', f'remote_domain:={session_domain_id(second=True)}',
-             f'record:={tmp_path / "bag"}')
+             f'record:={tmp_path / "bag"}', 'imaging:=true')
     recorded_as_published(tmp_path / 'bag', SITE_PUBLISHERS)
     counts = topic_counts(tmp_path / 'bag')
     for topic in ('/teleop/feedback', '/remote/teleop/command'):
         assert counts.get(topic, 0) > 100, counts
+    assert counts.get('/probe/image', 0) > 10, counts  # made at the remote site, seen here
 
 
 def _duration(folder: pathlib.Path, seconds: float) -> pathlib.Path:

@@ -158,3 +158,54 @@ def test_a_pose_that_cannot_be_imaged_gives_a_dark_frame_with_its_reason_logged(
     assert list(shown.values())[0] > 20.0  # pressed: tissue
     assert all(value == 0.0 for value in list(shown.values())[1:]), shown
     assert 'dark frame' in log and "'world', not 'base_link'" in log, log
+
+
+# Frames far slower than their period: 256 lines of 2048 samples take about 37 ms of CPU here,
+# against 5 ms between frames.
+OVERLOADED = ('frame_rate:=200.0', 'scanlines:=256', 'samples:=2048')
+OVERLOAD_TIME = 4.0  # [s] of frames watched
+
+
+def test_an_imager_asked_for_more_frames_than_it_makes_drops_them_and_images_the_newest_pose(
+        tmp_path):
+    """The node alone, fed a pose each turn of the test's loop: frames come as fast as it makes
+    them, each from a pose the feeder sent shortly before it arrived. A queue of the frames
+    asked for would fall behind by a second for each second watched."""
+    domain_id = session_domain_id()
+    command = [sys.executable, '-m', 'ultrasound_sim.node', '--ros-args']
+    for parameter in OVERLOADED:
+        command += ['-p', parameter]
+    node = subprocess.Popen(command, env=loop_environment(domain_id, tmp_path / 'log'),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    context = Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    arrivals = []  # (the feeder's newest stamp when the frame arrived, the frame's stamp) ns
+    newest, first = [0], None
+    try:
+        feeder = Node('test_robot', context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(feeder)
+        feeder.create_subscription(Image, 'probe/image', lambda msg: arrivals.append(
+            (newest[0], to_nanoseconds(msg.header.stamp))), FRAME_QOS)
+        poses = feeder.create_publisher(PoseStamped, 'robot/tcp_pose', HAPTIC_STREAM_QOS)
+        pose = PoseStamped()
+        pose.header.frame_id, pose.pose.position.z = 'base_link', SKIN - 0.003
+        deadline = time.monotonic() + 60.0  # the node's start: imports and its warm-up
+        while time.monotonic() < deadline:
+            pose.header.stamp = feeder.get_clock().now().to_msg()
+            newest[0] = to_nanoseconds(pose.header.stamp)
+            poses.publish(pose)
+            executor.spin_once(timeout_sec=0.001)
+            if first is None and arrivals:  # the first frame: watch the next ones
+                deadline, first = time.monotonic() + OVERLOAD_TIME, len(arrivals)
+    finally:
+        rclpy.try_shutdown(context=context)
+        node.send_signal(signal.SIGINT)
+        log, _ = node.communicate(timeout=30)
+    assert node.returncode == 0, log
+    watched = np.array(arrivals[first:], dtype=np.int64)
+    assert len(watched) > 4, log  # it makes frames
+    assert len(watched) < 0.5 * 200.0 * OVERLOAD_TIME  # and drops most of those asked for
+    assert np.all(np.diff(watched[:, 1]) > 0)  # each from a newer pose
+    age = 1e-9 * (watched[:, 0] - watched[:, 1])  # the pose's age when its frame arrived
+    assert age.max() < 0.25 * OVERLOAD_TIME, age

@@ -42,10 +42,20 @@ def test_a_job_that_raises_is_reported_and_the_next_item_is_made():
         errors.append(error)
         failed.set()
 
-    worker = LatestWorker(job, on_error=on_error, niceness=5)
+    worker = LatestWorker(job, on_error=on_error)
     worker.offer('bad')
     assert failed.wait(WAIT)  # taken before the good one could replace it
     worker.offer('good')
     assert done.wait(WAIT)
     assert [str(error) for error in errors] == ['no frame']
     assert worker.close()  # the thread ended
+
+
+def test_the_start_hook_runs_first_in_the_workers_own_thread():
+    started, done = [], threading.Event()
+    worker = LatestWorker(lambda item: done.set(), on_error=lambda error: None,
+                          on_start=lambda: started.append(threading.get_native_id()))
+    worker.offer('item')
+    assert done.wait(WAIT)
+    assert started == [worker._thread.native_id] != [threading.get_native_id()]
+    assert worker.close()

@@ -1,4 +1,4 @@
-"""Launch actions both launch files share: SIGINT heard, and processes that stand or fall together.
+"""Launch actions the launch files share: SIGINT heard, processes that fall together, the imager.
 
 Imported by the launch files only: ``launch`` comes with a full ROS 2 install, not with the PyPI
 set-up, where the local launcher (``haptic_loop``) does the same.
@@ -15,7 +15,9 @@ from launch.events.process import SignalProcess
 from launch.substitutions import EnvironmentVariable
 from launch_ros.actions import Node
 
-__all__ = ['AllOrNothing', 'hear_sigint', 'local_discovery']
+from haptic_contract.graph import EXECUTABLES, IMAGER, TELEOP_NODES
+
+__all__ = ['AllOrNothing', 'hear_sigint', 'imager', 'local_discovery']
 
 STOP_TIMEOUT = 10.0  # [s] after a failure, the others' time to stop before launch escalates
 
@@ -24,6 +26,12 @@ def local_discovery() -> SetEnvironmentVariable:
     """Keep DDS discovery on this machine, unless the user exported another range."""
     return SetEnvironmentVariable('ROS_AUTOMATIC_DISCOVERY_RANGE', EnvironmentVariable(
         'ROS_AUTOMATIC_DISCOVERY_RANGE', default_value='LOCALHOST'))
+
+
+def imager(parameters: str, **options) -> Node:
+    """Return the remote site's imager: its node in a process of its own, as ``ros2 run``."""
+    return Node(package=TELEOP_NODES[IMAGER].package, executable=EXECUTABLES[IMAGER],
+                parameters=[parameters], output='screen', **options)
 
 
 def hear_sigint() -> None:

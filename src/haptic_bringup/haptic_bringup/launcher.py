@@ -16,14 +16,14 @@ ends, ``--duration`` passes or Ctrl-C, then stops every process and removes stal
 ``--separate``, a recorder process does (``haptic_bringup.recorder``), stopped last. On a full
 ROS 2 install, ``ros2 launch haptic_bringup haptic_loop.launch.py`` does the same.
 
-With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site
-(the wand driver and the leader, one process) in one DDS domain, the remote site (the robot with
-its F/T sensor on the patient phantom and the follower, one process, with the probe's imager
-with ``--imaging``) in the next domain, and
-both sites' gateways between them (``haptic_bringup.site.loopback_gateways``): the deployed path,
-over loopback mutual TLS, each gateway delaying, jittering and dropping what it sends. With
-``--record DIR`` each site's process records itself: DIR is the session, holding the bags
-``operator`` and ``remote`` (the remote one's topics under ``/remote/``).
+With ``--teleop direct|tdpa|model`` it runs a telerobotic session instead: the operator's site (the
+wand driver and the leader, one process) in one DDS domain, the remote site (the robot with its F/T
+sensor on the patient phantom and the follower, one process; with ``--imaging``, the probe's
+imager, a process of its own) in the next domain, and both sites' gateways between them
+(``haptic_bringup.site.loopback_gateways``): the deployed path, over loopback mutual TLS, each
+gateway delaying, jittering and dropping what it sends. With ``--record DIR`` each site's process
+records itself: DIR is the session, holding the bags ``operator`` and ``remote`` (the remote one's
+topics under ``/remote/``).
 """
 import argparse
 import dataclasses
@@ -52,7 +52,7 @@ from haptic_contract.teleop import Scheme, SCHEMES
 from haptic_util.executor import end_process
 from remote_probe.link import silence_timeout
 
-__all__ = ['LoopConfig', 'Loop', 'main', 'loop_environment', 'NODES']
+__all__ = ['LoopConfig', 'Loop', 'imager_argv', 'main', 'loop_environment', 'NODES']
 
 SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
@@ -86,9 +86,8 @@ class LoopConfig:
     python: str = sys.executable
     teleop: Optional[str] = None  # a bilateral scheme: a telerobotic session instead
     link: dict = dataclasses.field(default_factory=dict)  # delay, jitter, loss, ... (s)
-    # teleop: the remote site images the probe's view (probe_imager). Off unless asked: in the
-    # robot's process it cost the loops there (bench/imaging_session.py), and the scan tests'
-    # restarted site came back too late for them with it.
+    # teleop: the remote site images the probe's view (probe_imager, a process of its own). Off
+    # unless asked: on two cores its frames take CPU from the loops (bench/imaging_session.py).
     imaging: bool = False
     remote_domain: Optional[int] = None  # the remote site's DDS domain; None: the next one
     # Composed, the loop's process records itself; False: a recorder process does, as for three
@@ -200,10 +199,18 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
 
 
 def site_nodes(config: LoopConfig, site: str) -> tuple:
-    """Return the node names of a telerobotic site's process: its nodes, and its recorder."""
+    """Return the node names of a telerobotic site's process: its nodes, and its recorder.
+
+    The remote site's imager, if any, is a process of its own (``imager_argv``).
+    """
     nodes, recorder = ((OPERATOR_SITE, OPERATOR_RECORDER) if site == 'operator' else
-                       ((*REMOTE_SITE, *([IMAGER] if config.imaging else [])), REMOTE_RECORDER))
+                       (REMOTE_SITE, REMOTE_RECORDER))
     return (*nodes, recorder) if config.record else nodes
+
+
+def imager_argv(config: LoopConfig, ros_args: list) -> list:
+    """Return the command line of the imager's process, as ``ros2 run`` starts its node."""
+    return [config.python, '-m', TELEOP_NODES[IMAGER].module, *ros_args]
 
 
 def teleop_endpoints(config: LoopConfig) -> dict:
@@ -214,7 +221,8 @@ def teleop_endpoints(config: LoopConfig) -> dict:
     delivery, takes what crossed the link through the reader of the node that uses it. The
     recorder's reader of ``/diagnostics`` says it exists: a site builds it last, so its nodes
     then spin (a remote site still starting would miss the operator's short session). The
-    probe's image is no stream: its imager and the operator's recorder take it over DDS.
+    imager, in a process of its own, takes the TCP pose over DDS; its image is no stream: the
+    gateways and the operator's recorder take it over DDS.
     """
     site = 0 if config.intra_process else 1  # a subscriber in the publisher's process
     recording = site if config.record else 0
@@ -227,7 +235,7 @@ def teleop_endpoints(config: LoopConfig) -> dict:
                            **({IMAGE: (1, int(bool(config.record)))} if imaged else {})},
         config.remote_domain_id: {command: (1, 1 + recording), feedback: (1, 1),
                                   absolute(ROBOT_TARGET_POSE): (1, site),
-                                  absolute(ROBOT_TCP_POSE): (1, site + recording + site * imaged),
+                                  absolute(ROBOT_TCP_POSE): (1, site + recording + imaged),
                                   absolute(ROBOT_FT_WRENCH): (1, site + recording), **reports,
                                   **({IMAGE: (1, 1)} if imaged else {})},
     }
@@ -326,11 +334,17 @@ class Loop:
         remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
         self.children.append(start_child(
             'remote', self._composed(site_nodes(config, 'remote'), ros_args), remote_env))
+        self._start_imager(ros_args, remote_env)
         self.children += loopback_gateways(self.run_dir, config.python, env, remote_env,
                                            link=config.link)
         self._wait_for_discovery(config.remote_domain_id)
         self.children.insert(0, start_child(  # the operator's stops first
             'operator', self._composed(site_nodes(config, 'operator'), ros_args), env))
+
+    def _start_imager(self, ros_args: list, env: dict) -> None:
+        """Start the remote site's imager, a process of its own, if the session images."""
+        if self.config.imaging:
+            self.children.append(start_child(IMAGER, imager_argv(self.config, ros_args), env))
 
     def _wait_for_discovery(self, domain_id: int) -> None:
         """Wait until ``domain_id``'s endpoints of the loop or the session are discovered."""

@@ -4,12 +4,13 @@
     haptic_site operator --connect tls/REMOTE_HOST:7447 --certs DIR [--scheme model]
         [--record DIR] [--experiment FILE] [--duration S] [--delay S] [--jitter S] [--loss P]
 
-The operator's site runs the wand driver and the leader (one process), the remote site the
-robot and the follower (one process), each in its own DDS domain on its own machine, with
-local-only discovery; only the site gateway (``site_gateway``) talks to the other site, over
-one mutual-TLS Zenoh connection. ``--certs`` is the folder of this site's files from
-``haptic_certs`` (``ca.pem``, ``<role>.pem``, ``<role>.key``); ``--insecure`` runs plaintext
-instead, and the gateway warns at every start. Both sites must run the same ``--scheme``.
+The operator's site runs the wand driver and the leader (one process), the remote site the robot
+and the follower (one process; with ``--imaging``, the probe's imager in another), each in its own
+DDS domain on its own machine, with local-only discovery; only the site gateway (``site_gateway``)
+talks to the other site, over one mutual-TLS Zenoh connection. ``--certs`` is the folder of this
+site's files from ``haptic_certs`` (``ca.pem``, ``<role>.pem``, ``<role>.key``); ``--insecure``
+runs plaintext instead, and the gateway warns at every start. Both sites must run the same
+``--scheme``.
 ``--delay``/``--jitter``/``--loss`` add the emulated link to what this site sends, on top of the
 real network (none by default).
 
@@ -137,6 +138,8 @@ class Site(Loop):
         started = time.monotonic()
         self.children.append(start_child(
             site.role, self._composed(site_nodes(config, site.role), ros_args), env))
+        if site.role == 'remote':
+            self._start_imager(ros_args, env)
         self.children.append(start_child('gateway', gateway_argv(config.python, site.role, params),
                                          env))
         self._wait_for_own_endpoints()

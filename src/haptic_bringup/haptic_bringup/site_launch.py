@@ -3,11 +3,12 @@
     ros2 launch haptic_bringup remote_site.launch.py endpoint:=tls/0.0.0.0:7447 certs:=DIR
     ros2 launch haptic_bringup operator_site.launch.py endpoint:=tls/HOST:7447 certs:=DIR
 
-The same site as ``haptic_site`` starts (``haptic_bringup.site``), with the same parameters:
-the site's nodes in one process, its gateway, and with ``record:=`` its own bag. The remote
-site listens on ``endpoint``, the operator's connects to it. The site stands or falls together:
-when its gateway exits because the other site stopped, or the operator's experiment ends, the
-launch stops the rest. Imported by the launch files only (``launch`` comes with a full install).
+The same site as ``haptic_site`` starts (``haptic_bringup.site``), with the same parameters: the
+site's nodes in one process, its gateway, with ``record:=`` its own bag, and with ``imaging:=true``
+the remote site's imager in a process of its own (the operator's records it). The remote site
+listens on ``endpoint``, the operator's connects to it. The site stands or falls together: when its
+gateway exits because the other site stopped, or the operator's experiment ends, the launch stops
+the rest. Imported by the launch files only (``launch`` comes with a full install).
 """
 import os
 import pathlib
@@ -19,7 +20,7 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 import yaml
 
-from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
+from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, imager, local_discovery
 from haptic_bringup.launcher import LoopConfig, site_nodes
 from haptic_bringup.site import site_parameters, SiteConfig
 from haptic_contract.teleop import SCHEMES
@@ -39,6 +40,7 @@ ARGUMENTS = (  # name, default, description
     ('jitter', '0.0', 'standard deviation of the emulated delay [s]'),
     ('loss', '0.0', 'probability that the emulated link loses a message'),
     ('params_file', '', 'extra parameters YAML'),
+    ('imaging', 'false', "remote: image the probe's view (operator: record it)"),
 )
 
 
@@ -52,7 +54,8 @@ def _site(role: str, context) -> SiteConfig:
                       domain_id=int(os.environ.get('ROS_DOMAIN_ID', '0')),
                       experiment=argument('experiment') or None,
                       duration=float(argument('duration')), record=argument('record') or None,
-                      params_file=argument('params_file') or None)
+                      params_file=argument('params_file') or None,
+                      imaging=argument('imaging').lower() == 'true')
     endpoint = (argument('endpoint'),)
     return SiteConfig(role, loop, listen=endpoint if role == 'remote' else (),
                       connect=endpoint if role == 'operator' else (),
@@ -75,6 +78,8 @@ def _processes(context, role: str):
     actions += together.add('gateway', Node(
         package='site_gateway', executable='site_gateway', name=f'{role}_gateway',
         parameters=[parameters], output='screen'))
+    if role == 'remote' and site.loop.imaging:
+        actions += together.add('probe_imager', imager(parameters))
     return actions
 
 

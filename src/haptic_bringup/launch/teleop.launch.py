@@ -3,19 +3,19 @@
     ros2 launch haptic_bringup teleop.launch.py scheme:=model delay:=0.05 [jitter:=0.005]
         [loss:=0.01] [reorder:=true] [delay_trace:=<csv>] [record:=<bag dir>]
         [remote_domain:=<id>] [experiment:=<waypoint file>] [duration:=<s>]
-        [params_file:=<yaml>]
+        [params_file:=<yaml>] [imaging:=true]
 
 The operator's site (``wand_driver`` and ``teleop_leader``, one process) runs in the launch's
 ``ROS_DOMAIN_ID``; the remote site (``sim_robot`` and ``teleop_follower``, one process) in
-``remote_domain`` (default: the next domain); both sites' gateways join them over loopback mutual
-TLS with certificates made for the launch, the deployed path, each emulating the link on what it
-sends (``haptic_bringup.site.loopback_gateway_parameters``). ``record:=DIR`` has each site's
-process record itself with the project's recorder, into the session folder DIR (the bags
-``operator`` and ``remote``, the remote site's topics under ``/remote/``), so a Ctrl-C to the
-whole launch loses nothing. Parameters come from each
-package's config/, then ``params_file``, then these arguments, exactly as the local launcher
-(``haptic_loop --teleop ...``) sets them. The session stands or falls together, as the loop
-does: when one process exits, the launch stops the others.
+``remote_domain`` (default: the next domain), with ``imaging:=true`` the probe's imager
+(``probe_imager``, a process of its own) beside it; both sites' gateways join them over loopback
+mutual TLS with certificates made for the launch, the deployed path, each emulating the link on
+what it sends (``haptic_bringup.site.loopback_gateway_parameters``). ``record:=DIR`` has each
+site's process record itself with the project's recorder, into the session folder DIR (the bags
+``operator`` and ``remote``, the remote site's topics under ``/remote/``), so a Ctrl-C to the whole
+launch loses nothing. Parameters come from each package's config/, then ``params_file``, then these
+arguments, exactly as the local launcher (``haptic_loop --teleop ...``) sets them. The session
+stands or falls together, as the loop does: when one process exits, the launch stops the others.
 """
 import os
 import pathlib
@@ -27,7 +27,7 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 import yaml
 
-from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
+from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, imager, local_discovery
 from haptic_bringup.launcher import LoopConfig, node_parameters, site_nodes
 from haptic_bringup.site import loopback_gateway_parameters
 from haptic_contract.teleop import SCHEMES
@@ -44,6 +44,7 @@ ARGUMENTS = (  # name, default, description
     ('duration', '0.0', 'stop after this many seconds (0: the scan\'s own length)'),
     ('record', '', 'record both sites to this bag directory'),
     ('params_file', '', 'extra parameters YAML'),
+    ('imaging', 'false', "the remote site images the probe's view (probe/image)"),
 )
 
 
@@ -69,7 +70,8 @@ def _config(context) -> LoopConfig:
                       remote_domain=int(remote) if remote else None,
                       experiment=argument('experiment') or None,
                       duration=float(argument('duration')), record=argument('record') or None,
-                      params_file=argument('params_file') or None)
+                      params_file=argument('params_file') or None,
+                      imaging=argument('imaging').lower() == 'true')
 
 
 def _processes(context):
@@ -84,6 +86,9 @@ def _processes(context):
             package='haptic_bringup', executable='composed',
             arguments=list(site_nodes(config, site)), parameters=[parameters],
             additional_env={'ROS_DOMAIN_ID': str(domain)}, output='screen'))
+    if config.imaging:
+        actions += session.add('probe_imager', imager(parameters, additional_env={
+            'ROS_DOMAIN_ID': str(config.remote_domain_id)}))
     gateways = loopback_gateway_parameters(pathlib.Path(tempfile.mkdtemp(prefix='teleop_')),
                                            link=config.link)
     for role, domain in (('remote', config.remote_domain_id), ('operator', config.domain_id)):

@@ -107,10 +107,12 @@ EXECUTABLES = {'wand_driver': 'wand_driver', 'collision_engine': 'collision_node
                'force_renderer': 'force_node', 'teleop_leader': 'teleop_leader',
                'sim_robot': 'sim_robot', 'teleop_follower': 'teleop_follower',
                'probe_imager': 'probe_imager'}
-# Each telerobotic site is one process.
+# Each telerobotic site is one process. The remote site's ultrasound scanner, when the session
+# images, is a process of its own beside it: in the robot's, its frames held the robot's 1 kHz
+# loop back for the GIL.
 OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
-IMAGER = 'probe_imager'  # the remote site's ultrasound scanner, when the session images
+IMAGER = 'probe_imager'
 # The recorder in each kind of process (haptic_bringup.process_recorder), by its node name.
 RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
     'recorder', 'operator_recorder', 'remote_recorder')

@@ -8,8 +8,8 @@ transient-local, so that a late subscriber, such as a recorder or RViz, still re
 """
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-__all__ = ['FRAME_QOS', 'HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_QOS', 'RECORDER_QOS',
-           'RELIABLE_RECORDER_QOS', 'MARKER_QOS']
+__all__ = ['FRAME_QOS', 'HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_QOS', 'NEWEST_STREAM_QOS',
+           'RECORDER_QOS', 'RELIABLE_RECORDER_QOS', 'MARKER_QOS']
 
 STREAM_DEPTH = 10
 
@@ -25,6 +25,15 @@ HAPTIC_STREAM_QOS = QoSProfile(
 # refused the flood's (it sheds them by content, at a few microseconds each): 100 is 5 ms of a
 # 20 kHz flood, and 100 ms of the link's own 1 kHz. Not deeper: a gateway reading the commands
 # 1000 deep stopped taking them a few seconds into an attacked session (cause not found).
+# A reader of a stream that wants its newest message only (the imager's pose, 30 times a
+# second): one kept, so that a reader that was descheduled wakes to it, not to a backlog.
+NEWEST_STREAM_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1,
+    reliability=ReliabilityPolicy.BEST_EFFORT,
+    durability=DurabilityPolicy.VOLATILE,
+)
+
 LINK_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=100,

@@ -1,31 +1,18 @@
-"""A thread that works on the newest item only, at a lower priority than the thread feeding it.
+"""A thread that works on the newest item only, beside the thread feeding it, at its own priority.
 
-Why: a B-mode frame is milliseconds of compiled work. On a site's executor thread it would hold
-that site's 1 kHz loop back as long, at every frame. Here the executor only hands the newest
-pose over (``offer``) and goes on; the compiled kernels release the GIL, so the frame is made
-beside the loop, on the other core or in the loop's idle time. When the cores are busy the
-thread's added niceness lets the loop go first: a frame may come later, the loop does not. An
-item offered while one still waits replaces it (the newest pose is the one to image), and is
-counted in ``replaced``.
+Why: a B-mode frame is milliseconds of compiled work. On the imager's executor thread it would
+leave the TCP poses waiting as long, at every frame, and the next frame would start from one
+that old. Here the executor only hands the newest pose over (``offer``) and goes on taking poses;
+the compiled kernels release the GIL, so both go on together. The thread may yield the cores
+(``on_start``: ``haptic_util.priority``) while the executor's keeps its priority. An item
+offered while one still waits replaces it (the newest pose is the one to image), and is counted
+in ``replaced``: when frames take longer than their period, frames are dropped, never queued.
 """
 
-import os
 import threading
 from typing import Callable
 
 __all__ = ['LatestWorker']
-
-
-def _lower_priority(niceness: int) -> None:
-    """Add ``niceness`` to the calling thread's own (Linux sets it per thread)."""
-    if niceness <= 0 or not hasattr(os, 'setpriority'):
-        return
-    thread = threading.get_native_id()
-    try:
-        os.setpriority(os.PRIO_PROCESS, thread,
-                       os.getpriority(os.PRIO_PROCESS, thread) + niceness)
-    except OSError:
-        pass  # the thread keeps the process's priority; the frames still come
 
 
 class LatestWorker:
@@ -36,13 +23,14 @@ class LatestWorker:
     job : callable item -> None
     on_error : callable Exception -> None
         Told of an exception ``job`` raised; the thread goes on with the next item.
-    niceness : int
-        Added to the thread's niceness (0: none).
+    on_start : callable () -> None
+        Run first in the thread (to set its priority).
     """
 
     def __init__(self, job: Callable, *, on_error: Callable[[Exception], None],
-                 niceness: int = 0, name: str = 'latest_worker') -> None:
-        self._job, self._on_error, self._niceness = job, on_error, niceness
+                 on_start: Callable[[], None] = lambda: None,
+                 name: str = 'latest_worker') -> None:
+        self._job, self._on_error, self._on_start = job, on_error, on_start
         self._condition = threading.Condition()
         self._waiting = []  # at most one item
         self._closed = False
@@ -66,7 +54,7 @@ class LatestWorker:
         return not self._thread.is_alive()
 
     def _run(self) -> None:
-        _lower_priority(self._niceness)
+        self._on_start()
         while True:
             with self._condition:
                 while not self._waiting and not self._closed:

@@ -1,14 +1,18 @@
 """The ultrasound scanner at the patient's site: the probe's pose in, its B-mode image out.
 
-Takes ``robot/tcp_pose`` (PoseStamped, the robot's 1 kHz stream, handed over in the site's
-process) and at ``frame_rate`` publishes ``probe/image`` (sensor_msgs/Image, mono8) of the
-newest pose, stamped with that pose's time, in ``probe_frame`` (``ProbeImaging``). The frame is
-made in a thread of its own at a lower priority (``LatestWorker``): the executor's thread, which
-runs the site's 1 kHz loop, only hands the pose over. A pose that cannot be imaged gives a dark
-frame, and the reason is logged once a second; a scene or settings that cannot image stop the
-node at start, naming what to fix. The kernels are compiled (or loaded) at start, so that the
-first frame does not stall the site. Its report gives the frame time and the time from the
-pose's stamp to the frame's publication (p50, p99 over the last ``RECENT_FRAMES``).
+Takes ``robot/tcp_pose`` (PoseStamped, the robot's 1 kHz stream) and at ``frame_rate`` publishes
+``probe/image`` (sensor_msgs/Image, mono8) of the newest pose, stamped with that pose's time, in
+``probe_frame`` (``ProbeImaging``). It runs in a process of its own at the remote site, beside the
+robot's: in the robot's process, a frame's Python held the robot's 1 kHz loop back for the GIL. The
+frame is made in a thread of its own (``LatestWorker``) that yields the cores to the loops
+(``idle``, ``niceness``: ``haptic_util.priority``), while the executor's thread takes the newest
+pose at each frame (``NewestMessage``: not the other 970 a second), and another thread sends the
+frames, at the process's priority. When frames take longer than their period they are dropped,
+never queued, and each starts from the newest pose. A pose that cannot be imaged gives a dark
+frame, and the reason is logged once a second; a scene or settings that cannot image stop the node
+at start, naming what to fix. The kernels are compiled (or loaded) at start, so that the first
+frame is not late. Its report gives the frame time and the time from the pose's stamp to the
+frame's publication (p50, p99 over the last ``RECENT_FRAMES``).
 """
 import collections
 import time
@@ -23,9 +27,10 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
-from haptic_util.intra_process import stream_subscription
+from haptic_util.newest import NewestMessage
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
+from haptic_util.priority import yield_thread
 from haptic_util.qos import FRAME_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
@@ -54,7 +59,6 @@ class ProbeImagerNode(Node):
             raise StartupError(f'{self.get_name()}: {error}') from None
         warm_up = self.imaging.warm_up()
         self._pose = None  # the newest TCP pose's fields
-        self._offered = None  # the stamp of the pose last handed to the worker
         self._published = 0
         self._dark = Tally()
         self._refused = Tally()
@@ -62,9 +66,13 @@ class ProbeImagerNode(Node):
         self._times = collections.deque(maxlen=RECENT_FRAMES)
         self._clock = self.get_clock()
         self._publisher = self.create_publisher(Image, 'probe/image', FRAME_QOS)
-        stream_subscription(self, POSE, 'robot/tcp_pose', self.on_pose, refused=self._refused)
+        self._poses = NewestMessage(self, POSE, 'robot/tcp_pose', refused=self._refused)
+        # Frames are made in one thread, which yields the cores, and sent from another, which
+        # does not: the EventsExecutor has no guard condition to wake its own thread with.
+        self._sender = LatestWorker(self.publish_frame, on_error=log_callback_error,
+                                    name='probe_image_sender')
         self._worker = LatestWorker(self.make_frame, on_error=log_callback_error,
-                                    niceness=params.worker_niceness, name='probe_imager')
+                                    on_start=self.yield_cores, name='probe_imager')
         self.create_timer(1.0 / params.frame_rate, self.on_timer)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         settings = self.imaging.imager.settings
@@ -73,28 +81,38 @@ class ProbeImagerNode(Node):
             f'{1e3 * settings.depth:g} mm deep, {settings.scanlines} lines; '
             f'{params.frame_rate:g} frames/s on probe/image (kernels ready in {warm_up:.2f} s)')
 
-    def on_pose(self, fields: Sequence) -> None:
-        self._pose = fields
+    def yield_cores(self) -> None:
+        """Let the site's loops go first for the cores (in the worker's thread)."""
+        priority = yield_thread(self.params.niceness, self.params.idle)
+        self.get_logger().info(f'frames made at {priority}')
 
     def on_timer(self) -> None:
-        """Hand the newest pose to the worker, unless already imaged."""
-        pose = self._pose
-        if pose is None or (pose[0], pose[1]) == self._offered:
-            return
-        self._offered = (pose[0], pose[1])
-        self._worker.offer(pose)
+        """Hand the newest pose to the worker, if one came since the last."""
+        pose = self._poses.take()
+        if pose is not None:
+            self._pose = pose
+            self._worker.offer(pose)
 
     def make_frame(self, pose: Sequence) -> None:
-        """Image one pose and publish it (in the worker's thread)."""
+        """Image one pose, and hand it to the sender (in the worker's thread).
+
+        The worker may be starved for the cores: it never holds the middleware's locks.
+        """
         started, cpu = time.perf_counter(), time.thread_time()
         imaged = self.imaging.image(pose[2], pose[3:6], pose[6:10])
         if imaged.reason:
             self._dark.add('dark frame', imaged.reason)
         stamp_ns = pose[0] * 1_000_000_000 + pose[1]
-        self._publisher.publish(image_cdr(stamp_ns, self.params.probe_frame, imaged.image))
+        frame = image_cdr(stamp_ns, self.params.probe_frame, imaged.image)
+        self._sender.offer((frame, stamp_ns, time.perf_counter() - started,
+                            time.thread_time() - cpu))
+
+    def publish_frame(self, made: tuple) -> None:
+        """Publish a frame made (in the sender's thread)."""
+        frame, stamp_ns, wall, cpu = made
+        self._publisher.publish(frame)
         self._published += 1
-        self._times.append((time.perf_counter() - started, time.thread_time() - cpu,
-                            1e-9 * (clock_ns(self._clock) - stamp_ns)))
+        self._times.append((wall, cpu, 1e-9 * (clock_ns(self._clock) - stamp_ns)))
 
     def report(self) -> Report:
         self._dark.log_new(self.get_logger().warn)
@@ -115,6 +133,8 @@ class ProbeImagerNode(Node):
 
     def destroy_node(self) -> bool:
         self._worker.close()
+        self._sender.close()
+        self._poses.destroy()
         self.diagnostics.final()
         return super().destroy_node()
 

@@ -25,9 +25,12 @@ class ProbeImagerParams:
     frame_id: str = parameter('base_link', 'the TCP pose\'s frame, which the scene is in')
     probe_frame: str = parameter('ultrasound_probe', 'the image\'s frame: the centre of the '
                                  'probe\'s face, the array along y, the beams along -z')
-    worker_niceness: int = parameter(5, 'added to the niceness of the thread that makes the '
-                                     'frames, so that the site\'s 1 kHz loop goes first',
-                                     low=0, high=19)
+    niceness: int = parameter(5, 'added to the niceness of the thread that makes the frames, '
+                              'so that the site\'s 1 kHz loops go first for the cores',
+                              low=0, high=19)
+    idle: bool = parameter(False, 'the thread that makes the frames runs only on what every '
+                           'other process leaves of the cores (SCHED_IDLE): on a machine of its '
+                           'own, the loops preempt it at once; on a busy one, it may starve')
     probe_type: str = parameter(_PROBE.probe_type, 'linear or convex')
     centre_frequency: float = parameter(_PROBE.centre_frequency, 'transmit centre frequency',
                                         unit='Hz')
