@@ -39,7 +39,7 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
-from haptic_util.qos import FRAME_QOS, HAPTIC_STREAM_QOS
+from haptic_util.qos import FRAME_QOS, LINK_QOS
 from haptic_util.transport import loopback_udp
 from remote_probe.link_stage import emulated_link, ReleaseTimer
 from remote_probe.params import LinkStageParams
@@ -139,12 +139,17 @@ def _qos(kind: str) -> QoSProfile:
     (an image is many UDP fragments, and one lost would lose it) yet never blocking, as it
     keeps only the newest.
 
-    A stream is read with the haptic streams' shallow history: after a stall only the newest
-    go on. Read with ``LINK_QOS`` (1000 deep), the operator's gateway
-    stopped taking commands altogether a few seconds into the attacked session, in 2 runs of 2
-    (its timers and its other direction went on); with this depth it relayed to the end.
+    A stream is read with the link's history (``LINK_QOS``, 100 deep: 100 ms of a 1 kHz
+    stream), as the nodes behind the other gateway read it, and as many as the other gateway's
+    admission lets through at once (``inbound.BURST``). Read with the haptic streams' 10, a
+    gateway descheduled past 10 ms lost messages at its own read: at load 11, counted hop by
+    hop, all 192 of 15000 pings ``bench_link`` lost (none between the gateways, none at its
+    echo); read 100 deep, none was lost there. What a gateway then hands Zenoh at once may
+    still overflow Zenoh's queue of 16 express messages (dropped, not blocked: 20 of 16000 in
+    that run). Read 1000 deep, the operator's gateway once stopped taking commands a few
+    seconds into the attacked session (cause not found).
     """
-    return {RELIABLE: RELIABLE_QOS, FRAME: FRAME_QOS}.get(kind, HAPTIC_STREAM_QOS)
+    return {RELIABLE: RELIABLE_QOS, FRAME: FRAME_QOS}.get(kind, LINK_QOS)
 
 
 class GatewayNode(Node):
