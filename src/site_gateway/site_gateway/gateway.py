@@ -39,7 +39,7 @@ from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
-from haptic_util.qos import FRAME_QOS, HAPTIC_STREAM_QOS
+from haptic_util.qos import FRAME_QOS, LINK_QOS
 from haptic_util.transport import loopback_udp
 from remote_probe.link_stage import emulated_link, ReleaseTimer
 from remote_probe.params import LinkStageParams
@@ -54,6 +54,14 @@ __all__ = ['GatewayNode', 'GatewayParams', 'main']
 NODE_NAME = 'site_gateway'
 DIAGNOSTICS_PERIOD = 1.0  # [s]
 ZENOH_LOG = 'warn,zenoh::net::routing::hat::peer=error'
+# Zenoh's own threads (its runtimes, read from ZENOH_RUNTIME when the session opens): one
+# receiving worker, which also drives the link's socket. By default two receiving workers took
+# turns and the socket was driven by a third thread (the accepting one at the listening site,
+# the connecting one at the other) that woke them: at 1 kHz each way, about 3300 context
+# switches a second in those threads, 800 with this (a quarter of a gateway's CPU samples were
+# the kernel switching its threads, perf). Its CPU, alternated with the default in one run,
+# three runs at load 12-15: -11 %, -12 %, 0 %. A user's own ZENOH_RUNTIME wins.
+ZENOH_RUNTIME = '(rx: (worker_threads: 1), net: (handover: rx), acc: (handover: rx))'
 INSECURE_WARNING = ('INSECURE: plaintext, no authentication and no access control: anyone who '
                     'reaches this endpoint can read the session and command the robot. Use it '
                     'only on a network you control end to end; mutual TLS is the default.')
@@ -125,6 +133,7 @@ def _plan(params: GatewayParams, name: str) -> tuple:
 
 def _open(config: dict, name: str) -> zenoh.Session:
     os.environ.setdefault('NO_COLOR', '1')  # Zenoh's log lines, plain in a log file
+    os.environ.setdefault('ZENOH_RUNTIME', ZENOH_RUNTIME)
     zenoh.init_log_from_env_or(ZENOH_LOG)
     try:
         return zenoh.open(zenoh.Config.from_json5(json.dumps(config)))
@@ -139,12 +148,17 @@ def _qos(kind: str) -> QoSProfile:
     (an image is many UDP fragments, and one lost would lose it) yet never blocking, as it
     keeps only the newest.
 
-    A stream is read with the haptic streams' shallow history: after a stall only the newest
-    go on. Read with ``LINK_QOS`` (1000 deep), the operator's gateway
-    stopped taking commands altogether a few seconds into the attacked session, in 2 runs of 2
-    (its timers and its other direction went on); with this depth it relayed to the end.
+    A stream is read with the link's history (``LINK_QOS``, 100 deep: 100 ms of a 1 kHz
+    stream), as the nodes behind the other gateway read it, and as many as the other gateway's
+    admission lets through at once (``inbound.BURST``). Read with the haptic streams' 10, a
+    gateway descheduled past 10 ms lost messages at its own read: at load 11, counted hop by
+    hop, all 192 of 15000 pings ``bench_link`` lost (none between the gateways, none at its
+    echo); read 100 deep, none was lost there. What a gateway then hands Zenoh at once may
+    still overflow Zenoh's queue of 16 express messages (dropped, not blocked: 20 of 16000 in
+    that run). Read 1000 deep, the operator's gateway once stopped taking commands a few
+    seconds into the attacked session (cause not found).
     """
-    return {RELIABLE: RELIABLE_QOS, FRAME: FRAME_QOS}.get(kind, HAPTIC_STREAM_QOS)
+    return {RELIABLE: RELIABLE_QOS, FRAME: FRAME_QOS}.get(kind, LINK_QOS)
 
 
 class GatewayNode(Node):
