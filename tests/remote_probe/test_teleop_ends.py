@@ -264,6 +264,23 @@ def test_a_silence_keeps_the_books_the_hand_feels_what_it_left_and_the_robot_pre
     assert felt == pytest.approx(patient) == pytest.approx(4.0)
 
 
+def test_the_clutch_closes_the_books_as_the_device_does_for_a_free_model():
+    """Pressed 10 mm in, the operator clutches (the device renders free and closes its books),
+    moves the wand 30 mm deeper and lets go: nothing is stored at first, on either side."""
+    leader = Leader(LeaderConfig('model', force_scale=1.0, position_scale=1.0), np.zeros(3),
+                    np.zeros(3))
+    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
+    leader.receive(0.0, feedback(1.0, plane=skin))
+    assert leader.plane(0.001, np.array([0.0, 0.0, -0.01])) is not None
+    pressed = np.array([0.0, 0.0, -0.02])
+    assert stored(leader.plane(0.002, pressed), pressed) > 0.0
+    leader.map.engage(pressed)
+    assert leader.model(0.003, pressed) == (True, None)  # known: free
+    deep = np.array([0.0, 0.0, -0.05])
+    leader.map.release(deep)
+    assert stored(leader.plane(0.004, deep), deep) == pytest.approx(0.0, abs=1e-15)
+
+
 def test_a_command_of_another_session_or_out_of_the_robots_reach_is_refused_and_changes_nothing():
     end = follower('tdpa')
     assert end.receive(0.0, command(1.0, [0.0, 0.0, -0.01])) is None

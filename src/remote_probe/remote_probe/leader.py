@@ -23,13 +23,14 @@ every wand pose at once from the newest feedback it holds, never waiting on the 
   allows. A reserve rather than a ratchet: refusing every rise while keeping every fall, the
   estimate's noise alone drove the shift out to tens of millimetres.
 
-A silence (or the clutch) keeps the books: what the shown spring held when it began stays in
-the reserve, so the first model after it comes back storing no more than that, wherever the
-hand sank meanwhile: the hand feels the force it left, and the robot's target, moved out by the
-same shift, presses the patient as much. The device's port keeps the same books through the
-lapse (``port_passivity``), so the two agree; a give-back of the shift beyond that energy would
-move the robot in while the port held the hand's force where it was (in lockstep, a 1 s outage
-mid-press then left 4.4 N felt, scaled, against 17 N at the patient).
+A silence keeps the books: what the shown spring held when it began stays in the reserve, so the
+first model after it comes back storing no more than that, wherever the hand sank meanwhile: the
+hand feels the force it left, and the robot's target, moved out by the same shift, presses the
+patient as much. The device's port keeps the same books through the lapse (``port_passivity``), so
+the two agree; a give-back of the shift beyond that energy would move the robot in while the port
+held the hand's force where it was (in lockstep, a 1 s outage mid-press then left 4.4 N felt,
+scaled, against 17 N at the patient). The clutch, or a free estimate, closes the books instead: the
+device renders those as free, and its port closes its own books after a moment of zero force.
 
 Feedback older than ``link_timeout`` (on this site's clock: the sites share none) gives zero
 force and no model, and no command is sent while it lasts: the robot then holds, as it does when
@@ -200,8 +201,10 @@ class Leader:
         None too while the link is silent or the clutch is engaged.
         """
         if not self.live(now) or self.map.clutched or self._feedback.plane is None:
-            if self._shown is not None:  # the spring lapses: its energy stays booked
-                self._reserve += _stored(self._shown, wand)
+            if not self.live(now):  # the spring lapses: its energy stays booked
+                self._reserve += 0.0 if self._shown is None else _stored(self._shown, wand)
+            else:  # rendered free: the books close
+                self._reserve = 0.0
             self._shown, self._shift = None, np.zeros(3)
             return None
         remote = self._feedback.plane
