@@ -155,7 +155,7 @@ def session(tmp_path_factory):
         hosts = Hosts()
     except subprocess.CalledProcessError as error:
         pytest.skip(f'network namespaces cannot be made here: {error.stderr.strip()}')
-    sites = {}
+    sites, probe = {}, None
     try:
         sites['remote'] = start_site(hosts, 'remote', folder, domain, certs,
                                      '--listen', f'tls/{REMOTE_ADDRESS}:{PORT}')
@@ -165,7 +165,7 @@ def session(tmp_path_factory):
                                        '--duration', str(SCAN_DURATION))
         started = wait_for_text(folder / 'operator.log', 'loop closed: experiment started',
                                 sites['operator'], START_LIMIT)
-        graph = subprocess.Popen(hosts.command('operator', sys.executable, '-c', GRAPH),
+        probe = subprocess.Popen(hosts.command('operator', sys.executable, '-c', GRAPH),
                                  env=loop_environment(domain, folder / 'log'),
                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         time.sleep(max(0.0, started + CUT_AFTER - time.time()))
@@ -179,8 +179,11 @@ def session(tmp_path_factory):
                                              f'tls/{REMOTE_ADDRESS}:{PORT}'),
                                capture_output=True, text=True, timeout=60)
         codes = {role: process.wait(START_LIMIT) for role, process in sites.items()}
-        graph = subprocess.CompletedProcess(graph.args, graph.wait(60), *graph.communicate())
+        graph = subprocess.CompletedProcess(probe.args, probe.wait(60), *probe.communicate())
     finally:
+        if probe is not None and probe.poll() is None:
+            probe.kill()
+            probe.wait()
         for process in sites.values():
             if process.poll() is None:
                 os.killpg(process.pid, signal.SIGINT)
