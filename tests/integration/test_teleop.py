@@ -90,7 +90,9 @@ def scan(tmp_path_factory):
     folder = tmp_path_factory.mktemp('teleop_scan')
     with concurrent.futures.ThreadPoolExecutor(1) as requests:
         asked = requests.submit(hold_during, session_domain_id(), HELD, PRESSING[1], None, 120.0)
-        with teleop(folder) as loop:
+        # 11 s, not 9: the follower reports once a second, and a hold asked at 8 s into a 9 s
+        # scan was once over before a report showed it (a CI run).
+        with teleop(folder, duration=11.0) as loop:
             assert loop.wait(60.0) is not None, 'the scan did not end'
         assert asked.result() is not None, 'the operator\'s gateway never took the hold'
     return folder, streams(folder)
