@@ -10,22 +10,17 @@ import signal
 import time
 
 from domains import session_domain_id
-from geometry_msgs.msg import PoseStamped
 import numpy as np
 import pytest
-import rclpy
-from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
 from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import recover, typestore_with
 from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
+from haptic_bringup.scan_clock import wait_for_first_pose
 from haptic_bringup.session import (bags, published_counts, read_vectors, reported,
                                     SITE_PUBLISHERS, topic_counts)
-from haptic_util.qos import HAPTIC_STREAM_QOS
 from remote_probe.link import silence_timeout
 
 DELAY = 0.05  # [s] one way
@@ -146,26 +141,10 @@ def test_a_force_hold_asked_at_the_operator_s_site_crosses_and_the_remote_site_h
 
 
 def wait_for_the_first_pose(domain_id: int, timeout: float) -> float:
-    """Return when (time.monotonic) the wand's first pose came: the scan's time zero.
-
-    The scan starts once the loop is closed and the recorder ready, which on a busy machine
-    comes seconds after the launcher returns; its phases (``PRESSING``) count from here.
-    """
-    context = Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    node = Node('test_first_pose', context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
-    came = []
-    node.create_subscription(PoseStamped, 'wand/pose',
-                             lambda _: came or came.append(time.monotonic()), HAPTIC_STREAM_QOS)
-    deadline = time.monotonic() + timeout
-    while not came and time.monotonic() < deadline:
-        executor.spin_once(timeout_sec=0.01)
-    node.destroy_node()
-    rclpy.try_shutdown(context=context)
-    assert came, 'the wand never moved'
-    return came[0]
+    """Return when (time.monotonic) the wand's first pose came: the scan's time zero."""
+    came = wait_for_first_pose(domain_id, timeout)
+    assert came is not None, 'the wand never moved'
+    return came.monotonic
 
 
 def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_meet_again(

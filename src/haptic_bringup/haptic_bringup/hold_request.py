@@ -9,16 +9,11 @@ the wand is running hears its first pose late, and asks late (the release of a h
 """
 import time
 
-from geometry_msgs.msg import PoseStamped
-import rclpy
-from rclpy.context import Context
 from rclpy.duration import Duration
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
 from std_msgs.msg import Float64
 
-from haptic_contract.graph import TELEOP_HOLD, WAND_POSE
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_bringup.scan_clock import first_pose, site_node
+from haptic_contract.graph import TELEOP_HOLD
 
 __all__ = ['hold_during']
 
@@ -33,29 +28,14 @@ def hold_during(domain_id: int, force: float, start: float, end: float | None,
     bag's receive times), or None when no pose came, or no gateway took the request, within
     ``timeout`` s.
     """
-    context = Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    try:
-        node = Node('hold_request', context=context)
-        executor = SingleThreadedExecutor(context=context)
-        executor.add_node(node)
+    with site_node(domain_id, 'hold_request') as (node, executor):
         publisher = node.create_publisher(Float64, TELEOP_HOLD, 10)
-        came = []  # (monotonic, wall) clocks
-        poses = node.create_subscription(
-            PoseStamped, WAND_POSE,
-            lambda _: came or came.append((time.monotonic(), time.time())), HAPTIC_STREAM_QOS)
-        deadline = time.monotonic() + timeout
-        while not (came and publisher.get_subscription_count()) and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.01)
-        if not (came and publisher.get_subscription_count()):
+        came = first_pose(node, executor, timeout, also=publisher.get_subscription_count)
+        if came is None:
             return None
-        node.destroy_subscription(poses)
         for at, value in ((start, force), (end, 0.0)):
             if at is not None:
-                time.sleep(max(0.0, came[0][0] + at - time.monotonic()))
+                time.sleep(max(0.0, came.monotonic + at - time.monotonic()))
                 publisher.publish(Float64(data=float(value)))
         publisher.wait_for_all_acked(Duration(seconds=ACKED_WITHIN))  # the gateway has it
-        node.destroy_node()
-        return came[0][1]
-    finally:
-        rclpy.try_shutdown(context=context)
+        return came.wall
