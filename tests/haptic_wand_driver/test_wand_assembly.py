@@ -63,5 +63,6 @@ def test_a_device_two_packages_assemble_is_refused_naming_both(monkeypatch):
 
 def test_a_device_nothing_provides_is_refused_naming_what_is_available(monkeypatch):
     monkeypatch.setattr(assembly, 'entry_points', installed())
-    with pytest.raises(DeviceUnavailableError, match="'quanser' is not available"):
+    with pytest.raises(DeviceUnavailableError, match="'quanser' is not available; available: "
+                       r"replay, simulated\..* entry point group haptic_wand_driver\.wands\."):
         assembly.make_wand(WandDriverParams(device='quanser'))

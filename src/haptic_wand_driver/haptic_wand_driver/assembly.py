@@ -58,7 +58,12 @@ def make_wand(params: WandDriverParams,
             "device 'simulated' is moved by the simulated operator's hand: install the "
             f'simulated_operator package, which assembles it (entry point group '
             f'{WAND_ASSEMBLIES})')
-    return make_device(params.device)
+    try:
+        return make_device(params.device)
+    except DeviceUnavailableError as error:
+        raise DeviceUnavailableError(f'{error} Or its package names a function building it from '
+                                     f'these parameters in the entry point group '
+                                     f'{WAND_ASSEMBLIES}.') from None
 
 
 def port_passivity(params: WandDriverParams) -> PortPassivity:
