@@ -27,7 +27,7 @@ import machine
 import numpy as np
 import result_files
 
-from collision_engine import load_scene
+from collision_engine import load_scene, surface_projection
 from force_renderer.params import ForceRendererParams
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.contacts import contact_intervals
@@ -37,11 +37,11 @@ from haptic_bringup.session import applied_work, read_session
 from haptic_contract.contact_model import ContactModel, Kind, Plane
 from haptic_util.paths import package_file
 from haptic_wand_driver.assembly import local_renderer, port_passivity, simulated_wand_config
-from haptic_wand_driver.experiments import make_script, surface_projection
 from haptic_wand_driver.local_rendering import LocalRenderer
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
 from haptic_wand_driver.simulated import SimulatedWand
+from simulated_operator.experiments import make_script
+from simulated_operator.hand import OperatorHand
 
 __all__ = ['compare', 'ideal_depth', 'run', 'main']
 

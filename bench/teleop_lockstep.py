@@ -38,10 +38,8 @@ from haptic_contract.teleop import CommandLimits, HAND_SPEED
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.assembly import local_renderer, port_passivity, simulated_wand_config
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.params import WandDriverParams
 from haptic_wand_driver.port_passivity import PortPassivity
-from haptic_wand_driver.scripts import WaypointScript
 from haptic_wand_driver.simulated import SimulatedWand
 from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.ft_sensor import ForceTorqueSensor
@@ -52,6 +50,8 @@ from remote_probe.model_estimation import ContactModelEstimator
 from remote_probe.params import LeaderParams
 from remote_probe.safety import PatientSafety, SafetyConfig
 from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
+from simulated_operator.hand import OperatorHand
+from simulated_operator.scripts import WaypointScript
 
 __all__ = ['as_series', 'hold_error', 'late_ticks', 'scan', 'SCHEMES']
 

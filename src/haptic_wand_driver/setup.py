@@ -13,7 +13,7 @@ setup(
         ('share/' + package_name, ['package.xml']),
         ('share/' + package_name + '/config', glob('config/*.yaml')),
     ],
-    install_requires=['setuptools', 'numpy', 'pyyaml', 'rosbags'],
+    install_requires=['setuptools', 'numpy', 'rosbags'],
     zip_safe=False,
     maintainer='Haptic toolkit maintainers',
     maintainer_email='maintainers@haptic-telesono.invalid',

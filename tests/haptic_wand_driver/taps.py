@@ -21,10 +21,10 @@ import numpy as np
 from haptic_bringup.contacts import contacts
 from haptic_contract.contact_model import ContactModel
 from haptic_wand_driver.local_rendering import LocalRenderer
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.port_passivity import PortPassivity
-from haptic_wand_driver.scripts import WaypointScript
 from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from simulated_operator.hand import OperatorHand
+from simulated_operator.scripts import WaypointScript
 
 __all__ = ['TapResult', 'tap']
 

@@ -17,10 +17,10 @@ from taps import tap
 
 from haptic_contract.contact_model import ContactModel, Kind
 from haptic_wand_driver.local_rendering import LocalRenderer, MAX_DAMPING_PER_MASS
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.port_passivity import PortPassivity
-from haptic_wand_driver.scripts import WaypointScript
 from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from simulated_operator.hand import OperatorHand
+from simulated_operator.scripts import WaypointScript
 
 STILL = [0.0, 0.0, 0.0, 0.0, 0.0]
 MASS = 0.15  # [kg] the simulated wand's default

@@ -13,9 +13,9 @@ from scipy.optimize import fsolve
 
 from force_renderer.contact import Contact, FaceContact
 from force_renderer.probe import ProbeSpringDamper
-from haptic_wand_driver.operator import OperatorHand
-from haptic_wand_driver.scripts import WaypointScript
 from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from simulated_operator.hand import OperatorHand
+from simulated_operator.scripts import WaypointScript
 
 K, C = 1000.0, 2.0
 SURFACE = -0.025

@@ -16,9 +16,9 @@ import pytest
 
 from haptic_contract.contact_model import ContactModel, Kind
 from haptic_wand_driver.local_rendering import LocalRenderer
-from haptic_wand_driver.operator import OperatorHand
 from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from simulated_operator.hand import OperatorHand
 
 TICK = 0.001  # [s]
 TICKS = 400

@@ -5,9 +5,9 @@ import pytest
 from wand_ground_truth import HalfSpace, rotation_z, wall_force
 
 from haptic_wand_driver.device import DeviceClosedError, DeviceLimits, Workspace
-from haptic_wand_driver.operator import OperatorHand
-from haptic_wand_driver.scripts import WaypointScript
 from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig
+from simulated_operator.hand import OperatorHand
+from simulated_operator.scripts import WaypointScript
 
 TICK = 1e-3
 HAND_STIFFNESS = 50.0

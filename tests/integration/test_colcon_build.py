@@ -16,8 +16,8 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SRC = ROOT / 'src'
 PYTHON_PACKAGES = ('haptic_util', 'haptic_contract', 'collision_engine', 'force_renderer',
-                   'haptic_wand_driver', 'haptic_bringup', 'remote_probe', 'ultrasound_sim',
-                   'site_gateway')
+                   'haptic_wand_driver', 'simulated_operator', 'haptic_bringup', 'remote_probe',
+                   'ultrasound_sim', 'site_gateway')
 SOURCES = {'haptic_msgs': SRC / 'msgs', **{name: SRC / name for name in PYTHON_PACKAGES}}
 BUILD_TIMEOUT = 900  # [s] about 40 s here; the margin is for a busy shared machine
 
@@ -174,6 +174,20 @@ def test_an_installed_node_starts_and_refuses_a_bad_parameter_in_one_line(build)
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
     assert lines[0].startswith('error: force_renderer:') and "'law'" in lines[0], lines[0]
+
+
+def test_the_installed_driver_takes_its_simulated_wand_from_the_installed_operator(build):
+    """The driver imports no operator: it finds the simulated wand by the operator's entry point
+    (the script it refuses is the operator's to check)."""
+    node = build.install / 'haptic_wand_driver' / 'lib' / 'haptic_wand_driver' / 'wand_driver'
+    result = build.run_sourced(str(node), '--ros-args', '-p', 'experiment:=nonsense')
+    assert result.returncode == 2, result.stderr
+    assert "error: wand_driver: experiment 'nonsense' is not one of" in result.stderr
+    code = ('from importlib.metadata import entry_points\n'
+            "(simulated,) = entry_points(group='haptic_wand_driver.wands', name='simulated')\n"
+            'print(__import__(simulated.module).__file__)')
+    assembly = build.run_sourced(sys.executable, '-c', code)
+    assert pathlib.Path(assembly.stdout.strip()).is_relative_to(build.install), assembly.stderr
 
 
 # What ``ros2 launch FILE name:=value ...`` does, for a shell without ros2cli.

@@ -20,7 +20,7 @@ from collision_engine.errors import MeshError, SceneError
 from collision_engine.gjk import (STATUS_INVALID_INPUT, STATUS_NO_OBJECT, STATUS_NOT_CONVERGED,
                                   STATUS_OK)
 from collision_engine.results import BatchResult, QueryResult, ToolResult
-from collision_engine.scene import load_scene, Scene, SceneObject
+from collision_engine.scene import load_scene, Scene, SceneObject, surface_projection
 from collision_engine.scene_file import read_scene, SceneSpec
 from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, TriangleMesh
 from collision_engine.tool import load_tool
@@ -31,5 +31,5 @@ __all__ = [
     'DistanceResult', 'MeshError', 'PairResult', 'Pose', 'QueryResult', 'Scene', 'SceneError',
     'SceneObject', 'SceneSpec', 'Sphere', 'STATUS_INVALID_INPUT', 'STATUS_NO_OBJECT',
     'STATUS_NOT_CONVERGED', 'STATUS_OK', 'ToolResult', 'TriangleMesh', 'distance',
-    'distance_between', 'load_scene', 'load_tool', 'read_scene',
+    'distance_between', 'load_scene', 'load_tool', 'read_scene', 'surface_projection',
 ]

@@ -29,7 +29,7 @@ from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, 
 from collision_engine.tool import DEFAULT_SHELL_SPACING, load_tool, mount_tool, pack_tool
 from collision_engine.transforms import Pose
 
-__all__ = ['Scene', 'SceneObject', 'load_scene']
+__all__ = ['Scene', 'SceneObject', 'load_scene', 'surface_projection']
 
 _LOG = logging.getLogger(__name__)
 _query_tool = _kernels.query_tool  # one lookup fewer a call, in the haptic loop
@@ -312,6 +312,15 @@ class Scene:
 
     def __repr__(self) -> str:
         return f'Scene(frame_id={self.frame_id!r}, objects={list(self._names)})'
+
+
+def surface_projection(scene: Scene) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """``project(point) -> (closest surface point, outward normal)`` on a collision scene."""
+
+    def project(point):
+        result = scene.query(point)
+        return result.point, result.normal
+    return project
 
 
 def load_scene(path, *, request: DistanceRequest | None = None,

@@ -11,8 +11,9 @@ __all__ = ['WandDriverParams']
 
 @dataclass(frozen=True)
 class WandDriverParams:
-    device: str = parameter('simulated', 'device backend: simulated, replay, or one registered '
-                            'with haptic_wand_driver.register_device')
+    device: str = parameter('simulated', 'device backend: simulated (its hand from the '
+                            'simulated_operator package), replay, or one a package names in the '
+                            'entry point group haptic_wand_driver.wands')
     rate: float = parameter(LOOP_RATE, 'pose publishing rate', unit='Hz', low=1.0, high=10000.0)
     frame_id: str = parameter('world', 'frame of the published pose, twist and expected wrench')
     experiment: str = parameter('cuboid', 'simulated operator script: cuboid, cylinder, hand, '

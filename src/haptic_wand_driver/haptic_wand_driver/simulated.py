@@ -36,8 +36,8 @@ from haptic_contract.plane_law import saturate_components
 from haptic_contract.shared_defaults import DEVICE_DAMPING, FORCE_LIMIT
 from haptic_contract.wand import roll_axis
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState
+from haptic_wand_driver.hand_coupling import Hand, impedance
 from haptic_wand_driver.local_rendering import LocalRenderer
-from haptic_wand_driver.operator import impedance, OperatorHand
 
 __all__ = ['DEVICE_MASS', 'SERVO_RATE', 'SimulatedWand', 'SimulatedWandConfig', 'TORQUE_LIMIT']
 
@@ -125,12 +125,13 @@ class SimulatedWand(HapticDevice):
     Parameters
     ----------
     config : SimulatedWandConfig
-    operator : OperatorHand or None
-        The hand holding it; None leaves the wand free (only the applied wrench moves it).
+    operator : Hand or None
+        The hand holding it (``simulated_operator.OperatorHand``, a scripted one); None leaves the
+        wand free (only the applied wrench moves it).
     """
 
     def __init__(self, config: SimulatedWandConfig = SimulatedWandConfig(), *,
-                 operator: OperatorHand | None = None):
+                 operator: Hand | None = None):
         self._config = config
         inverse_inertia = 1.0 / config.inertia
         if operator is not None:
@@ -319,7 +320,7 @@ class SimulatedWand(HapticDevice):
         self._steps_done = target_steps
 
 
-def _check_step_resolves(step: float, operator: OperatorHand,
+def _check_step_resolves(step: float, operator: Hand,
                          inverse_inertia: np.ndarray) -> None:
     """Refuse a step too long for the hand's explicit spring-damper on this inertia."""
     stiffness_ratio = step * np.sqrt(operator.stiffness * inverse_inertia).max()

@@ -19,7 +19,7 @@ import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Empty, Float64
 
-from collision_engine import load_scene
+from collision_engine import load_scene, surface_projection
 from haptic_contract.graph import (ROBOT_FT_WRENCH, ROBOT_IMPEDANCE, ROBOT_TARGET_POSE,
                                    ROBOT_TCP_POSE, TELEOP_COMMAND, TELEOP_FEEDBACK, TELEOP_HOLD,
                                    TELEOP_RE_ENGAGE)
@@ -36,7 +36,6 @@ from haptic_util.paths import resolve_path
 from haptic_util.qos import LATCHED_QOS, LINK_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
-from haptic_wand_driver.experiments import surface_projection
 from remote_probe.admission import Admission, AdmissionConfig, Refusal
 from remote_probe.follower import Follower, FollowerConfig
 from remote_probe.model_estimation import ContactModelEstimator

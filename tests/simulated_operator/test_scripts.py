@@ -10,11 +10,11 @@ import pytest
 from wand_ground_truth import Box, Cylinder, HalfSpace, wall_force
 
 from haptic_wand_driver.device import Workspace
-from haptic_wand_driver.operator import OperatorHand
-from haptic_wand_driver.scripts import (
+from haptic_wand_driver.simulated import SimulatedWand
+from simulated_operator.hand import OperatorHand
+from simulated_operator.scripts import (
     cuboid_face_tapping, cylinder_side_tapping, hand_dorsum_tapping, probe_sweep, ScriptError,
     TappingScript, TappingSite, WaypointScript)
-from haptic_wand_driver.simulated import SimulatedWand
 
 TICK = 1e-3
 THIRTY_DEGREES = np.radians(30.0)

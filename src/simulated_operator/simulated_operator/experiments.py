@@ -8,11 +8,11 @@ A name picks a script; the scene only tells the scripted hand where the object's
 from pathlib import Path
 from typing import Optional
 
-from haptic_wand_driver.scripts import (cuboid_face_tapping, cylinder_side_tapping,
+from simulated_operator.scripts import (cuboid_face_tapping, cylinder_side_tapping,
                                         hand_dorsum_tapping, probe_sweep, Projection,
                                         ScriptError, WaypointScript)
 
-__all__ = ['EXPERIMENTS', 'make_script', 'needs_scene', 'surface_projection']
+__all__ = ['EXPERIMENTS', 'make_script', 'needs_scene']
 
 EXPERIMENTS = {
     'cuboid': cuboid_face_tapping,
@@ -41,12 +41,3 @@ def make_script(name: str, project: Optional[Projection] = None, *, start=(0.0, 
         return WaypointScript.from_file(name)
     raise ScriptError(f'experiment {name!r} is not one of {[*EXPERIMENTS, HOLD]} '
                       'nor a waypoint file (.yaml, .yml, .csv)')
-
-
-def surface_projection(scene) -> Projection:
-    """``project(point) -> (closest surface point, outward normal)`` on a collision scene."""
-
-    def project(point):
-        result = scene.query(point)
-        return result.point, result.normal
-    return project

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from haptic_wand_driver.operator import OperatorHand
-from haptic_wand_driver.scripts import Target, WaypointScript
+from simulated_operator.hand import OperatorHand
+from simulated_operator.scripts import Target, WaypointScript
 
 LEG = np.array([0.04, -0.02, 0.0, 0.1, -0.2])
 

@@ -12,29 +12,10 @@ from typing import Callable
 import numpy as np
 
 from haptic_contract.checks import finite_components, finite_number, read_only_vector
-from haptic_wand_driver.scripts import Script, TargetComponents
+from haptic_wand_driver.hand_coupling import impedance
+from simulated_operator.scripts import Script, TargetComponents
 
-__all__ = ['OperatorHand', 'impedance']
-
-
-def impedance(stiffness, damping, target, target_rate, coordinate, rate):
-    """Return the spring-damper effort pulling a joint toward a moving target.
-
-    Plain arithmetic, so it takes floats (the simulated wand's substeps, one joint at a time)
-    and arrays (:meth:`OperatorHand.effort`, every joint at once) alike.
-
-    Parameters
-    ----------
-    stiffness : float or (5,) float, N/m or N·m/rad
-    damping : float or (5,) float, N·s/m or N·m·s/rad
-    target, coordinate : float or (5,) float, m or rad
-    target_rate, rate : float or (5,) float, m/s or rad/s
-
-    Returns
-    -------
-    effort : float or (5,) float, N or N·m
-    """
-    return stiffness * (target - coordinate) + damping * (target_rate - rate)
+__all__ = ['OperatorHand']
 
 
 class OperatorHand:
