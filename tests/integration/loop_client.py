@@ -39,6 +39,7 @@ class LoopClient:
         self.twist_pub = self.node.create_publisher(TwistStamped, 'wand/twist',
                                                     HAPTIC_STREAM_QOS)
         self.wrenches = {}
+        self.answer_stamps = {'force_renderer': [], 'collision_engine': []}  # [ns] every one
         self.arrivals = {}  # stamp key -> when its first wrench arrived [ns, this clock]
         self.states = {}
         self.wrench_sub = self.node.create_subscription(
@@ -51,6 +52,7 @@ class LoopClient:
 
     def _on_wrench(self, msg: WrenchStamped) -> None:
         key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+        self.answer_stamps['force_renderer'].append(key[0] * 1_000_000_000 + key[1])
         if key not in self.wrenches:  # the answer; a watchdog's zero for the same stamp follows
             self.wrenches[key] = msg
             self.arrivals[key] = self.node.get_clock().now().nanoseconds
@@ -61,6 +63,8 @@ class LoopClient:
                              math.sqrt(f.x * f.x + f.y * f.y + f.z * f.z)))
 
     def _on_state(self, msg: CollisionState) -> None:
+        self.answer_stamps['collision_engine'].append(
+            msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec)
         self.states[(msg.header.stamp.sec, msg.header.stamp.nanosec)] = msg
 
     def wait_connected(self, timeout: float = 20.0) -> None:
