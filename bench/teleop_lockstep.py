@@ -43,22 +43,22 @@ from haptic_wand_driver.params import WandDriverParams
 from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.scripts import WaypointScript
 from haptic_wand_driver.simulated import SimulatedWand
-from remote_probe.follower import Follower, FollowerConfig
-from remote_probe.ft_sensor import ForceTorqueSensor
-from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
-from remote_probe.leader import Leader, LeaderConfig
-from remote_probe.link import EmulatedLink, LinkConfig, silence_timeout
-from remote_probe.model_estimation import ContactModelEstimator
-from remote_probe.params import LeaderParams
-from remote_probe.safety import PatientSafety, SafetyConfig
-from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
+from link_emulator.link import EmulatedLink, LinkConfig, silence_timeout
+from robot_site.follower import Follower, FollowerConfig
+from robot_site.ft_sensor import ForceTorqueSensor
+from robot_site.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
+from robot_site.model_estimation import ContactModelEstimator
+from robot_site.safety import PatientSafety, SafetyConfig
+from robot_site.tissue import ABDOMEN, PlaneSurface, Tissue
+from teleop_leader.leader import Leader, LeaderConfig
+from teleop_leader.params import LeaderParams
 
 __all__ = ['as_series', 'hold_error', 'late_ticks', 'scan', 'SCHEMES']
 
 PLAIN_TDPA = 'tdpa-plain'  # TDPA's controller on the wand itself: the baseline of the coupling
 SCHEMES = ('direct', PLAIN_TDPA, 'tdpa', 'model')
 
-SCAN = 'package://remote_probe/config/scan.yaml'
+SCAN = 'package://teleop_leader/config/scan.yaml'
 SKIN = -0.025  # [m] the phantom's front, under the probe's start
 TICK = 1e-3  # [s]
 MODEL_LIFETIME = LeaderParams().model_lifetime  # [s]
