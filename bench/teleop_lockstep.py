@@ -34,7 +34,7 @@ import teleop_scan
 from haptic_bringup.launcher import LATE_POSE_HOLD, LINK_TIMEOUT, MODEL_STEP_RATE, \
     SCAN_DURATION
 from haptic_contract.contact_model import ContactModel, Kind, Plane
-from haptic_contract.teleop import CommandLimits, HAND_SPEED
+from haptic_contract.teleop import CommandLimits
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.assembly import local_renderer, port_passivity, simulated_wand_config
@@ -44,12 +44,9 @@ from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.scripts import WaypointScript
 from haptic_wand_driver.simulated import SimulatedWand
 from link_emulator.link import EmulatedLink, LinkConfig, silence_timeout
-from robot_site.follower import Follower, FollowerConfig
-from robot_site.ft_sensor import ForceTorqueSensor
-from robot_site.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
-from robot_site.model_estimation import ContactModelEstimator
-from robot_site.safety import PatientSafety, SafetyConfig
-from robot_site.tissue import ABDOMEN, PlaneSurface, Tissue
+from robot_site.assembly import follower as make_follower, ft_sensor, impedance_robot, tissue
+from robot_site.params import FollowerParams, SimulatedRobotParams
+from robot_site.tissue import PlaneSurface
 from teleop_leader.leader import Leader, LeaderConfig
 from teleop_leader.params import LeaderParams
 
@@ -115,17 +112,15 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     device, renderer = _device(scheme, easing)
     port = PortPassivity(WandDriverParams().passivity_max_damping if scheme == 'tdpa' else 0.0)
     answers = AnswerDeadline(hold)
-    robot_config = ImpedanceRobotConfig()
-    robot = ImpedanceRobot(robot_config, environment=Tissue(
-        ABDOMEN, PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])))
-    sensor = ForceTorqueSensor()
+    robot_params = SimulatedRobotParams()
+    follower_params = dataclasses.replace(FollowerParams(), scheme=scheme, link_timeout=timeout)
     skin = PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])
-    follower = Follower(FollowerConfig(scheme, robot_config.stiffness),
-                        PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness,
-                                                   link_timeout=timeout)),
-                        CommandLimits(robot_config.workspace_lower,
-                                      robot_config.workspace_upper, HAND_SPEED),
-                        ContactModelEstimator(), surface=lambda tcp: (skin.point, skin.normal))
+    robot = impedance_robot(robot_params, tissue(robot_params, skin))
+    sensor = ft_sensor(robot_params)
+    robot_config = robot.config
+    follower = make_follower(follower_params, CommandLimits(
+        robot_config.workspace_lower, robot_config.workspace_upper,
+        follower_params.max_command_speed), surface=lambda tcp: (skin.point, skin.normal))
     leader = Leader(leader_config, ZERO, robot_config.initial_position)
     link = LinkConfig(delay, jitter, loss, seed=seed)
     to_robot, to_operator = EmulatedLink(link), EmulatedLink(LinkConfig(

@@ -37,11 +37,10 @@ from haptic_util.qos import LATCHED_QOS, LINK_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from haptic_wand_driver.experiments import surface_projection
-from robot_site.follower import Follower, FollowerConfig
-from robot_site.model_estimation import ContactModelEstimator
-from robot_site.params import envelope, FollowerParams
-from robot_site.safety import PatientSafety, SafetyConfig
-from teleop_protocol.admission import Admission, AdmissionConfig, Refusal
+from robot_site.assembly import admission_config, follower, follower_config, follower_safety
+from robot_site.follower import Follower
+from robot_site.params import FollowerParams
+from teleop_protocol.admission import Refusal
 
 __all__ = ['FollowerNode', 'main', 'take_command']
 
@@ -57,22 +56,13 @@ class FollowerNode(Node):
         super().__init__('teleop_follower', **kwargs)
         self.params = params = declare_parameters(self, FollowerParams)
         try:
-            self._safety = PatientSafety(SafetyConfig(
-                robot_stiffness=params.robot_stiffness,
-                max_patient_force=params.max_patient_force, force_margin=params.force_margin,
-                link_timeout=params.link_timeout, release_force=params.release_force,
-                retract_speed=params.retract_speed, rejoin_speed=params.rejoin_speed,
-                envelope=envelope(params, params.hard_stop_force)))
+            self._safety = follower_safety(params)
             self._surface = None
             if params.scene_file:
                 self._surface = surface_projection(load_scene(
                     resolve_path(params.scene_file, what='parameter scene_file'),
                     announce=self.get_logger().info))
-            self._config = FollowerConfig(params.scheme, params.robot_stiffness,
-                                          params.drift_rate)
-            self._admission = AdmissionConfig(
-                max_age=params.max_command_age, max_lead=params.max_stamp_lead,
-                session_timeout=params.session_timeout, max_rate=params.max_command_rate)
+            follower_config(params), admission_config(params)  # a bad one stops the start
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self.follower: Follower | None = None  # once the robot has said what it is
@@ -129,9 +119,8 @@ class FollowerNode(Node):
             self.follower, self._robot_problem = None, (ERROR, problem)
             self.get_logger().error(f'not commanding the robot: {problem}')
         elif self.follower is None:
-            self.follower = Follower(self._config, self._safety, report.limits,
-                                     ContactModelEstimator(), surface=self._surface,
-                                     admission=Admission(self._admission))
+            self.follower = follower(self.params, report.limits, self._surface,
+                                     safety=self._safety)
             self.get_logger().info(f'the robot is as expected ({report.stiffness:g} N/m): '
                                    'following')
         else:

@@ -36,11 +36,9 @@ from haptic_util.paths import resolve_path
 from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
-from robot_site.ft_sensor import ForceTorqueSensor, ForceTorqueSensorConfig
-from robot_site.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
-from robot_site.params import envelope, SimulatedRobotParams
-from robot_site.safety import PatientSafety, SafetyConfig
-from robot_site.tissue import HuntCrossley, SceneSurface, Tissue
+from robot_site.assembly import ft_sensor, impedance_robot, robot_safety, tissue
+from robot_site.params import SimulatedRobotParams
+from robot_site.tissue import SceneSurface
 
 __all__ = ['SimulatedRobotNode', 'main']
 
@@ -54,22 +52,9 @@ class SimulatedRobotNode(Node):
         try:
             scene = load_scene(resolve_path(params.scene_file, what='parameter scene_file'),
                                announce=self.get_logger().info)
-            law = HuntCrossley(params.tissue_stiffness, params.tissue_exponent,
-                               params.tissue_damping)
-            self.robot = ImpedanceRobot(ImpedanceRobotConfig(
-                mass=params.mass, stiffness=params.stiffness, max_speed=params.max_speed,
-                workspace_lower=np.array(params.workspace_lower),
-                workspace_upper=np.array(params.workspace_upper),
-                initial_position=np.array(params.initial_position)),
-                environment=Tissue(law, SceneSurface(scene)))
-            self.sensor = ForceTorqueSensor(ForceTorqueSensorConfig(
-                force_bias=np.array(params.force_bias), force_noise=params.force_noise,
-                bandwidth=params.sensor_bandwidth, seed=params.seed))
-            self.guard = PatientSafety(SafetyConfig(
-                robot_stiffness=params.stiffness, max_patient_force=params.max_patient_force,
-                force_margin=params.force_margin, link_timeout=params.target_timeout,
-                release_force=params.release_force, retract_speed=params.retract_speed,
-                envelope=envelope(params)))
+            self.robot = impedance_robot(params, tissue(params, SceneSurface(scene)))
+            self.sensor = ft_sensor(params)
+            self.guard = robot_safety(params)
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self._start = time.monotonic()
