@@ -62,7 +62,7 @@ class FollowerNode(Node):
                 self._surface = surface_projection(load_scene(
                     resolve_path(params.scene_file, what='parameter scene_file'),
                     announce=self.get_logger().info))
-            follower_config(params), admission_config(params)  # a bad one stops the start
+            follower_config(params), admission_config(params)  # checked now, used later
         except ValueError as error:
             raise StartupError(f'{self.get_name()}: {error}') from None
         self.follower: Follower | None = None  # once the robot has said what it is
