@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.setup-complete
 DEV_STAMP := $(VENV)/.dev-complete
 PACKAGES := haptic_util haptic_contract collision_engine force_renderer haptic_wand_driver simulated_operator \
-	haptic_bringup remote_probe ultrasound_sim site_gateway
+	haptic_bringup teleop_protocol teleop_leader robot_site link_emulator ultrasound_sim site_gateway
 SETUP_INPUTS := requirements.txt constraints.txt tools/setup_venv.sh tools/fix_wheel_cmake_paths.py \
 	$(wildcard src/msgs/*.txt src/msgs/*.xml src/msgs/msg/*.msg) \
 	$(foreach p,$(PACKAGES),$(wildcard src/$(p)/setup.py src/$(p)/setup.cfg src/$(p)/package.xml \

@@ -22,10 +22,10 @@ import numpy as np
 from haptic_contract.teleop import Command, CommandLimits, HAND_SPEED
 from haptic_contract.teleop_fields import COMMAND, command_fields
 from haptic_util.cdr import MalformedMessage
-from remote_probe.admission import Admission, AdmissionConfig
-from remote_probe.follower import Follower, FollowerConfig
-from remote_probe.follower_node import take_command
-from remote_probe.safety import PatientSafety, SafetyConfig
+from robot_site.follower import Follower, FollowerConfig
+from robot_site.follower_node import take_command
+from robot_site.safety import PatientSafety, SafetyConfig
+from teleop_protocol.admission import Admission, AdmissionConfig
 
 __all__ = ['main', 'rows']
 

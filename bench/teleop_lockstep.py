@@ -34,31 +34,28 @@ import teleop_scan
 from haptic_bringup.launcher import LATE_POSE_HOLD, LINK_TIMEOUT, MODEL_STEP_RATE, \
     SCAN_DURATION
 from haptic_contract.contact_model import ContactModel, Kind, Plane
-from haptic_contract.teleop import CommandLimits, HAND_SPEED
+from haptic_contract.teleop import CommandLimits
 from haptic_util.paths import package_file
 from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.assembly import local_renderer, port_passivity, simulated_wand_config
 from haptic_wand_driver.params import WandDriverParams
 from haptic_wand_driver.port_passivity import PortPassivity
 from haptic_wand_driver.simulated import SimulatedWand
-from remote_probe.follower import Follower, FollowerConfig
-from remote_probe.ft_sensor import ForceTorqueSensor
-from remote_probe.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
-from remote_probe.leader import Leader, LeaderConfig
-from remote_probe.link import EmulatedLink, LinkConfig, silence_timeout
-from remote_probe.model_estimation import ContactModelEstimator
-from remote_probe.params import LeaderParams
-from remote_probe.safety import PatientSafety, SafetyConfig
-from remote_probe.tissue import ABDOMEN, PlaneSurface, Tissue
+from link_emulator.link import EmulatedLink, LinkConfig, silence_timeout
+from robot_site.assembly import follower as make_follower, ft_sensor, impedance_robot, tissue
+from robot_site.params import FollowerParams, SimulatedRobotParams
+from robot_site.tissue import PlaneSurface
 from simulated_operator.hand import OperatorHand
 from simulated_operator.scripts import WaypointScript
+from teleop_leader.leader import Leader, LeaderConfig
+from teleop_leader.params import LeaderParams
 
 __all__ = ['as_series', 'hold_error', 'late_ticks', 'scan', 'SCHEMES']
 
 PLAIN_TDPA = 'tdpa-plain'  # TDPA's controller on the wand itself: the baseline of the coupling
 SCHEMES = ('direct', PLAIN_TDPA, 'tdpa', 'model')
 
-SCAN = 'package://remote_probe/config/scan.yaml'
+SCAN = 'package://teleop_leader/config/scan.yaml'
 SKIN = -0.025  # [m] the phantom's front, under the probe's start
 TICK = 1e-3  # [s]
 MODEL_LIFETIME = LeaderParams().model_lifetime  # [s]
@@ -115,17 +112,15 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
     device, renderer = _device(scheme, easing)
     port = PortPassivity(WandDriverParams().passivity_max_damping if scheme == 'tdpa' else 0.0)
     answers = AnswerDeadline(hold)
-    robot_config = ImpedanceRobotConfig()
-    robot = ImpedanceRobot(robot_config, environment=Tissue(
-        ABDOMEN, PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])))
-    sensor = ForceTorqueSensor()
+    robot_params = SimulatedRobotParams()
+    follower_params = dataclasses.replace(FollowerParams(), scheme=scheme, link_timeout=timeout)
     skin = PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])
-    follower = Follower(FollowerConfig(scheme, robot_config.stiffness),
-                        PatientSafety(SafetyConfig(robot_stiffness=robot_config.stiffness,
-                                                   link_timeout=timeout)),
-                        CommandLimits(robot_config.workspace_lower,
-                                      robot_config.workspace_upper, HAND_SPEED),
-                        ContactModelEstimator(), surface=lambda tcp: (skin.point, skin.normal))
+    robot = impedance_robot(robot_params, tissue(robot_params, skin))
+    sensor = ft_sensor(robot_params)
+    robot_config = robot.config
+    follower = make_follower(follower_params, CommandLimits(
+        robot_config.workspace_lower, robot_config.workspace_upper,
+        follower_params.max_command_speed), surface=lambda tcp: (skin.point, skin.normal))
     leader = Leader(leader_config, ZERO, robot_config.initial_position)
     link = LinkConfig(delay, jitter, loss, seed=seed)
     to_robot, to_operator = EmulatedLink(link), EmulatedLink(LinkConfig(

@@ -31,7 +31,7 @@ applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor
 
 The jitter is given as a fraction of the delay (20 %, and 5 % loss: issue 28's harsher link, to
 500 ms one way). ``--delay-trace`` runs each scheme once more over a measured link: a CSV of
-one-way delays (``time,delay`` in s, ``remote_probe.link.DelayTrace``), with no jitter added
+one-way delays (``time,delay`` in s, ``link_emulator.link.DelayTrace``), with no jitter added
 (the trace has its own) and the same loss; no such trace of an intercontinental link ships with
 the project (none with its per-sample delays could be found in public reach). Each site is one
 process; its nodes hand their streams over in the process (``in-process``, the default) or
@@ -64,7 +64,7 @@ from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_vectors
-from remote_probe.link import DelayTrace
+from link_emulator.link import DelayTrace
 
 __all__ = ['figures', 'felt_steps', 'hold_error', 'read_scan', 'run', 'main']
 

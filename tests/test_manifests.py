@@ -57,7 +57,7 @@ def test_every_import_is_declared_once(package):
 
 def test_the_manifests_were_read():
     """What the checks above compare is there: each package imports something of ROS."""
-    assert {'haptic_util', 'collision_engine', 'remote_probe'} <= set(PACKAGES)
+    assert {'haptic_util', 'collision_engine', 'robot_site'} <= set(PACKAGES)
     assert all('rclpy' in manifest(package) for package in PACKAGES if 'rclpy' in
                imported(package))
     assert 'numpy' in imported('collision_engine')

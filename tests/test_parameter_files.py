@@ -21,10 +21,11 @@ FILES = {
         'force_renderer': 'force_renderer.params.ForceRendererParams'},
     'haptic_wand_driver/config/haptic_wand_driver.yaml': {
         'wand_driver': 'haptic_wand_driver.params.WandDriverParams'},
-    'remote_probe/config/remote_probe.yaml': {
-        'sim_robot': 'remote_probe.params.SimulatedRobotParams',
-        'teleop_follower': 'remote_probe.params.FollowerParams',
-        'teleop_leader': 'remote_probe.params.LeaderParams'},
+    'robot_site/config/robot_site.yaml': {
+        'sim_robot': 'robot_site.params.SimulatedRobotParams',
+        'teleop_follower': 'robot_site.params.FollowerParams'},
+    'teleop_leader/config/teleop_leader.yaml': {
+        'teleop_leader': 'teleop_leader.params.LeaderParams'},
     'ultrasound_sim/config/ultrasound_sim.yaml': {
         'probe_imager': 'ultrasound_sim.params.ProbeImagerParams'},
     'site_gateway/config/site_gateway.yaml': {

@@ -76,7 +76,8 @@ build_msgs &
 msgs=$!
 
 packages=(haptic_util haptic_contract collision_engine force_renderer haptic_wand_driver
-  simulated_operator haptic_bringup remote_probe ultrasound_sim site_gateway)
+  simulated_operator haptic_bringup teleop_protocol teleop_leader robot_site link_emulator
+  ultrasound_sim site_gateway)
 step "installing the toolkit's packages: ${packages[*]}"
 # compat mode puts src/<pkg> on sys.path, so a tests/<pkg>/ folder can never shadow it.
 editable=()
@@ -102,7 +103,7 @@ for scene in sorted(pathlib.Path('src/collision_engine/scenes').glob('*.yaml')):
     load_scene(scene)
 "
 "$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, haptic_contract, collision_engine, \
-force_renderer, haptic_wand_driver, simulated_operator, haptic_bringup, remote_probe, ultrasound_sim, \
-site_gateway, zenoh" || { echo "[setup] import check failed"; exit 1; }
+force_renderer, haptic_wand_driver, simulated_operator, haptic_bringup, teleop_protocol, teleop_leader, \
+robot_site, link_emulator, ultrasound_sim, site_gateway, zenoh" || { echo "[setup] import check failed"; exit 1; }
 finish_step
 printf '[setup] done in %s s: %s\n' "$(since "$setup_started")" "$venv"

@@ -9,7 +9,7 @@ import teleop_lockstep
 import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD
-from remote_probe.leader import LeaderConfig
+from teleop_leader.leader import LeaderConfig
 
 MAX_PATIENT_FORCE = 20.0  # [N] the safety's default
 

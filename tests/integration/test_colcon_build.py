@@ -16,7 +16,8 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SRC = ROOT / 'src'
 PYTHON_PACKAGES = ('haptic_util', 'haptic_contract', 'collision_engine', 'force_renderer',
-                   'haptic_wand_driver', 'simulated_operator', 'haptic_bringup', 'remote_probe',
+                   'haptic_wand_driver', 'simulated_operator', 'haptic_bringup',
+                   'teleop_protocol', 'teleop_leader', 'robot_site', 'link_emulator',
                    'ultrasound_sim', 'site_gateway')
 SOURCES = {'haptic_msgs': SRC / 'msgs', **{name: SRC / name for name in PYTHON_PACKAGES}}
 BUILD_TIMEOUT = 900  # [s] about 40 s here; the margin is for a busy shared machine

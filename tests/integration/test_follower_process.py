@@ -93,7 +93,7 @@ def follower(tmp_path):
     domain = session_domain_id()
     # A sensor timeout far above this test's own hiccups on a busy machine: it is not tested here.
     child = start_child('teleop_follower', [
-        sys.executable, '-m', 'remote_probe.follower_node', '--ros-args', '-p', 'scheme:=model',
+        sys.executable, '-m', 'robot_site.follower_node', '--ros-args', '-p', 'scheme:=model',
         '-p', 'sensor_timeout:=0.5'], loop_environment(domain, tmp_path / 'log'))
     sites = RobotAndLink(domain)
     try:

@@ -21,7 +21,7 @@ from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.scan_clock import wait_for_first_pose
 from haptic_bringup.session import (bags, published_counts, read_vectors, reported,
                                     SITE_PUBLISHERS, topic_counts)
-from remote_probe.link import silence_timeout
+from link_emulator.link import silence_timeout
 
 DELAY = 0.05  # [s] one way
 FORCE_SCALE = 0.3  # the leader's default

@@ -1,7 +1,7 @@
 """The routing table: which topic crosses which way, under which key, and how."""
 import pytest
 
-from remote_probe.relay import Route
+from link_emulator.relay import Route
 from site_gateway.routes import (bye_key, FRAME, other_role, RELIABLE, role_in_key,
                                  site_routes, STREAM)
 

@@ -50,11 +50,11 @@ from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGE
                                    WAND_WRENCH)
 from haptic_contract.teleop import Scheme, SCHEMES
 from haptic_util.executor import end_process
-from remote_probe.link import silence_timeout
+from link_emulator.link import silence_timeout
 
 __all__ = ['LoopConfig', 'Loop', 'imager_argv', 'main', 'loop_environment', 'NODES']
 
-SCAN_SCRIPT = ('remote_probe', 'config/scan.yaml')
+SCAN_SCRIPT = ('teleop_leader', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
 LATE_POSE_HOLD = 0.5  # [s] past the stalls seen with the machine fully loaded (up to 0.45 s)
 MODEL_STEP_RATE = 5.0  # [N/s] at the hand: 17 N/s at the patient, above the scan's 13 (p99)
@@ -175,7 +175,7 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     the hand fall in, and the next one threw it back out (``haptic_wand_driver.answer_deadline``).
     Each new model eases in at ``MODEL_STEP_RATE`` (``haptic_wand_driver.model_easing``): at
     once, every estimate's move since the last jolted the hand (issue 28). Both ends' watchdogs
-    wait out the link's jitter (``remote_probe.link.silence_timeout``).
+    wait out the link's jitter (``link_emulator.link.silence_timeout``).
     """
     scheme = config.teleop
     driver = options.setdefault('wand_driver', {})

@@ -97,9 +97,9 @@ NODES = {
     'force_renderer': NodeEntry('force_renderer', 'force_renderer.node', 'ForceNode'),
 }
 TELEOP_NODES = {
-    'teleop_leader': NodeEntry('remote_probe', 'remote_probe.leader_node', 'LeaderNode'),
-    'sim_robot': NodeEntry('remote_probe', 'remote_probe.robot_node', 'SimulatedRobotNode'),
-    'teleop_follower': NodeEntry('remote_probe', 'remote_probe.follower_node', 'FollowerNode'),
+    'teleop_leader': NodeEntry('teleop_leader', 'teleop_leader.leader_node', 'LeaderNode'),
+    'sim_robot': NodeEntry('robot_site', 'robot_site.robot_node', 'SimulatedRobotNode'),
+    'teleop_follower': NodeEntry('robot_site', 'robot_site.follower_node', 'FollowerNode'),
     'probe_imager': NodeEntry('ultrasound_sim', 'ultrasound_sim.node', 'ProbeImagerNode'),
 }
 # Each node's executable in its package (``ros2 run``, the launch files), by node name.

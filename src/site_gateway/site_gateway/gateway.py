@@ -5,7 +5,7 @@
 
 Each site runs one, in its own DDS domain. What this site publishes of the crossing topics
 (``routes``) is read from DDS as serialized CDR bytes, held by the emulated link
-(``remote_probe.link``: delay, jitter, loss, reorder, a delay trace; none by default) and put to
+(``link_emulator.link``: delay, jitter, loss, reorder, a delay trace; none by default) and put to
 Zenoh; what the other site publishes is judged (``inbound``) and published into DDS, the same
 bytes. Nothing is converted, so the gateway depends on no message's fields.
 
@@ -41,9 +41,9 @@ from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter
 from haptic_util.qos import FRAME_QOS, LINK_QOS
 from haptic_util.transport import loopback_udp
-from remote_probe.link_stage import emulated_link, ReleaseTimer
-from remote_probe.params import LinkStageParams
-from remote_probe.relay import message_class, Relay
+from link_emulator.link_stage import emulated_link, ReleaseTimer
+from link_emulator.params import LinkStageParams
+from link_emulator.relay import message_class, Relay
 from site_gateway.inbound import Inbound
 from site_gateway.routes import bye_key, FRAME, other_role, RELIABLE, ROLES, site_routes
 from site_gateway.zenoh_config import (check_endpoints, Credentials, LEASE, publisher_options,

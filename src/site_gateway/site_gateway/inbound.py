@@ -15,7 +15,7 @@ from typing import NamedTuple
 
 from haptic_util.cdr import MalformedMessage, MessageCodec
 from haptic_util.tally import Tally
-from remote_probe.relay import message_class
+from link_emulator.relay import message_class
 from site_gateway.routes import role_in_key
 
 __all__ = ['BURST', 'Inbound', 'Verdict']

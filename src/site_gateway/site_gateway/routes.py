@@ -7,7 +7,7 @@ arrives is authenticated: a command under ``haptic/remote/...`` was put by a hol
 remote site's certificate, and the gateway refuses it by name, where a key alone would say
 nothing of who sent it.
 
-Topics are written ``'topic:pkg/msg/Type'`` (``remote_probe.relay``).
+Topics are written ``'topic:pkg/msg/Type'`` (``link_emulator.relay``).
 A topic crosses as a 1 kHz stream (the newest message matters, a late one is worthless: drop
 rather than block) unless it is listed as reliable (it must arrive, as the clutch must) or as a
 frame (an image: tens of kilobytes at tens of hertz, for a person to look at; the newest
@@ -17,7 +17,7 @@ is congested).
 from dataclasses import dataclass
 from typing import Iterable
 
-from remote_probe.relay import check_no_loop, parse_routes, Route
+from link_emulator.relay import check_no_loop, parse_routes, Route
 
 __all__ = ['Crossing', 'FRAME', 'RELIABLE', 'ROLES', 'STREAM', 'SiteRoutes', 'bye_key',
            'other_role', 'role_in_key', 'site_routes']

@@ -2,7 +2,7 @@
 
 Why: the ultrasound image needs what lies under the skin, and the phantom ships no patient data.
 The layers under the abdomen's front are the phantom's own superellipsoid
-(``remote_probe.phantom``) made smaller by twice each layer's depth, so that each starts that
+(``robot_site.phantom``) made smaller by twice each layer's depth, so that each starts that
 deep under the front: fat under 2 mm of skin, muscle under 12 mm of fat, the abdomen's contents
 under 10 mm of muscle. The organ (liver-like) is an ellipsoid. The vessel, the cyst and the rib
 are primitives in the scene file and need no mesh. ``make_anatomy`` rewrites the meshes, byte for
@@ -36,7 +36,7 @@ def anatomy_meshes() -> dict:
     """
     import trimesh
 
-    from remote_probe.phantom import phantom_mesh, TORSO_SIZE
+    from robot_site.phantom import phantom_mesh, TORSO_SIZE
 
     meshes = {f'anatomy_{name}': phantom_mesh(np.asarray(TORSO_SIZE) - 2.0 * depth)
               for name, depth in LAYER_DEPTHS.items()}

@@ -1,5 +1,0 @@
-"""The remote site of telerobotic ultrasound, pure core: robot, sensor, patient, safety, link.
-
-Pure Python and numpy (trimesh only to make the patient phantom); the ROS nodes come on top of
-it.
-"""

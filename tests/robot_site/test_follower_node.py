@@ -1,0 +1,55 @@
+"""The follower node follows only a robot that says it is the one its force bound was set for."""
+import pytest
+import rclpy
+from rclpy.context import Context
+
+from haptic_contract.teleop_fields import impedance_message
+from haptic_util.diagnostics import ERROR, WARN
+from robot_site.follower_node import FollowerNode
+
+ROBOT = dict(max_speed=0.25, workspace_lower=(-0.4,) * 3, workspace_upper=(0.4,) * 3,
+             max_patient_force=20.0)
+
+
+def command(sequence=1):
+    """A TeleopCommand's fields: now-ish, in the robot's frame, at its start."""
+    return (1_795_000_000, 1000 * sequence, 'base_link', 0x5E55, sequence, 0.0, 0.0, 0.0,
+            0.0, 0.0, 0.0, 0.0)
+
+
+@pytest.fixture
+def follower():
+    context = Context()
+    rclpy.init(context=context, domain_id=97)
+    node = FollowerNode(context=context, parameter_overrides=[
+        rclpy.parameter.Parameter('scene_file', value=''),
+        rclpy.parameter.Parameter('robot_stiffness', value=1500.0)])
+    yield node
+    node.destroy_node()
+    rclpy.try_shutdown(context=context)
+
+
+def test_it_commands_nothing_until_the_robot_says_what_it_is(follower):
+    assert follower.report().level == WARN and 'robot/impedance' in follower.report().message
+    follower.on_command(command())
+    assert follower._refused.counts == {'command before the robot is known': 1}
+    follower.on_impedance(impedance_message('base_link', stiffness=1500.0, **ROBOT))
+    follower.on_command(command(2))
+    assert follower._refused.total() == 1 and follower.report().level != ERROR
+
+
+def test_a_robot_of_another_stiffness_is_not_commanded_and_an_error_says_why(follower):
+    follower.on_impedance(impedance_message('base_link', stiffness=1500.0, **ROBOT))
+    assert follower.follower is not None
+    follower.on_impedance(impedance_message('base_link', stiffness=3000.0, **ROBOT))
+    assert follower.follower is None
+    report = follower.report()
+    assert report.level == ERROR and '3000 N/m' in report.message
+    follower.on_command(command())
+    assert follower._refused.counts == {'command before the robot is known': 1}
+    follower.tick()  # no target while it is not known: the robot holds on its own
+
+
+def test_a_robot_in_another_frame_is_not_commanded(follower):
+    follower.on_impedance(impedance_message('world', stiffness=1500.0, **ROBOT))
+    assert follower.follower is None and follower.report().level == ERROR

@@ -1,0 +1,121 @@
+"""The contact estimator converges on known tissues, through the robot and the noisy sensor."""
+import math
+
+import numpy as np
+import pytest
+
+from robot_site.ft_sensor import ForceTorqueSensor
+from robot_site.impedance_robot import ImpedanceRobot, ImpedanceRobotConfig
+from robot_site.model_estimation import ContactModelEstimator, EstimatorConfig
+from robot_site.tissue import ABDOMEN, PlaneSurface, Tissue
+
+NORMAL = np.array([0.0, 0.6, 0.8])  # a tilted skin
+SKIN = PlaneSurface([0.0, 0.0, -0.05], NORMAL)
+TICK = 1e-3
+
+
+class KelvinVoigt:
+    """A linear spring-damper skin, F = k·d + c·ḋ: the estimator's own model, known exactly."""
+
+    def __init__(self, stiffness, damping):
+        self.stiffness, self.damping = stiffness, damping
+
+    def __call__(self, position, velocity):
+        depth, normal = SKIN.penetration(position)
+        if depth <= 0.0:
+            return np.zeros(3)
+        return max(0.0, self.stiffness * depth - self.damping * velocity @ normal) * normal
+
+
+def scan(environment, duration, depth=lambda t: 0.02 + 0.004 * math.sin(2 * math.pi * t)):
+    """Press the skin, breathing in and out at 1 Hz and sliding along it at 2 cm/s.
+
+    Return the last estimate and the depths the TCP went through in the last half.
+    """
+    robot = ImpedanceRobot(ImpedanceRobotConfig(initial_position=SKIN.point),
+                           environment=environment)
+    sensor = ForceTorqueSensor()  # 0.05 N RMS noise, 200 Hz
+    estimator = ContactModelEstimator()
+    depths = []
+    steps = round(duration / TICK)
+    for k in range(steps):
+        time = k * TICK
+        state = robot.read(time)
+        estimate = estimator.update(time, sensor.measure(time, state.external_force).force,
+                                    state.position, state.velocity)
+        robot.command(SKIN.point - depth(time) * NORMAL + [0.02 * time, 0.0, 0.0])
+        if k >= steps // 2:
+            depths.append(SKIN.penetration(state.position)[0])
+    return estimate, np.array(depths)
+
+
+def test_on_a_linear_skin_it_finds_the_plane_stiffness_and_damping():
+    estimate, _ = scan(KelvinVoigt(800.0, 10.0), 6.0)
+    assert estimate.stiffness == pytest.approx(800.0, rel=0.01)
+    assert estimate.damping == pytest.approx(10.0, rel=0.03)  # 0.2 N of damping in 0.05 N noise
+    np.testing.assert_allclose(estimate.normal, NORMAL, atol=1e-3)
+    assert (estimate.point - SKIN.point) @ NORMAL == pytest.approx(0.0, abs=1e-4)
+
+
+def test_on_the_hunt_crossley_abdomen_it_finds_the_tangent_where_the_probe_presses():
+    estimate, depths = scan(Tissue(ABDOMEN, SKIN), 6.0)
+    depth = depths.mean()
+    assert estimate.stiffness == pytest.approx(ABDOMEN.tangent_stiffness(depth), rel=0.02)
+    assert estimate.damping == pytest.approx(ABDOMEN.tangent_damping(depth), rel=0.1)
+    # The tangent at depth d crosses zero force at d·(1 − 1/n) below the skin.
+    tangent_plane = -depth * (1.0 - 1.0 / ABDOMEN.exponent)
+    assert (estimate.point - SKIN.point) @ NORMAL == pytest.approx(tangent_plane, abs=2e-4)
+    np.testing.assert_allclose(estimate.normal, NORMAL, atol=1e-3)
+
+
+def test_a_long_steady_press_does_not_wind_the_estimate_up():
+    def depth(time):  # breathing for 4 s, then 20 s held still, then breathing again
+        return 0.02 + (0.004 * math.sin(2 * math.pi * time) if time < 4 or time > 24 else 0.0)
+
+    estimate, _ = scan(KelvinVoigt(800.0, 10.0), 24.5, depth)
+    assert estimate.stiffness == pytest.approx(800.0, rel=0.02)
+
+
+def test_out_of_contact_there_is_no_estimate():
+    estimator = ContactModelEstimator()
+    assert estimator.update(0.0, [0.0, 0.0, 0.3], np.zeros(3), np.zeros(3)) is None
+    assert estimator.update(0.001, [0.0, 0.0, 5.0], np.zeros(3), np.zeros(3)) is not None
+
+
+@pytest.mark.parametrize('fields, message', [
+    (dict(forgetting=0.0), 'forgetting must be finite > 0 <= 1'),
+    (dict(forgetting=1.5), 'forgetting must be finite > 0 <= 1'),
+    (dict(contact_force=-1.0), 'contact_force must be finite >= 0'),
+    (dict(sensor_bandwidth=math.nan), 'sensor_bandwidth must be finite > 0'),
+    (dict(stiffness_spread=0.0), 'stiffness_spread must be finite > 0'),
+])
+def test_bad_configurations_are_refused(fields, message):
+    with pytest.raises(ValueError, match=message):
+        EstimatorConfig(**fields)
+
+
+def test_nan_samples_and_a_clock_going_back_are_refused():
+    estimator = ContactModelEstimator()
+    with pytest.raises(ValueError, match='force must be 3 finite numbers'):
+        estimator.update(0.0, [0.0, math.nan, 5.0], np.zeros(3), np.zeros(3))
+    with pytest.raises(ValueError, match='velocity must be 3 finite numbers'):
+        estimator.update(0.0, [0.0, 0.0, 5.0], np.zeros(3), [math.inf, 0.0, 0.0])
+    estimator.update(1.0, [0.0, 0.0, 5.0], np.zeros(3), np.zeros(3))
+    with pytest.raises(ValueError, match='must not go back'):
+        estimator.update(0.5, [0.0, 0.0, 5.0], np.zeros(3), np.zeros(3))
+
+
+def test_a_contact_that_begins_tilted_by_noise_starts_from_the_surfaces_normal():
+    """A first force at the threshold, tilted 10° by the sensor's noise: the known surface's
+    normal keeps the estimate's normal on the skin's from the first sample on."""
+    tilt = np.radians(10.0)
+    first = 0.6 * np.array([math.sin(tilt), 0.0, math.cos(tilt)])
+    force = 3.0 * np.array([0.0, 0.0, 1.0])
+    angles = []
+    for normal in (None, lambda: np.array([0.0, 0.0, 1.0])):
+        estimator = ContactModelEstimator()
+        estimator.update(0.0, first, np.zeros(3), np.zeros(3), normal)
+        estimate = estimator.update(0.001, force, np.zeros(3), np.zeros(3), normal)
+        angles.append(math.degrees(math.acos(estimate.normal[2])))
+    assert angles[0] > 5.0  # from the first force: still tilted
+    assert angles[1] < 1e-9
