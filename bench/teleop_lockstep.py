@@ -26,10 +26,8 @@ import itertools
 import math
 import sys
 
-import machine
+from bench import machine, result_files, teleop_scan
 import numpy as np
-import result_files
-import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD, LINK_TIMEOUT, MODEL_STEP_RATE, \
     SCAN_DURATION

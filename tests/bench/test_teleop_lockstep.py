@@ -3,10 +3,9 @@
 The figures are ``teleop_scan.figures`` of the force the simulated device applied to the hand and
 the force the patient's tissue put on the probe; the schemes' own books are not read.
 """
+from bench import teleop_lockstep, teleop_scan
 import numpy as np
 import pytest
-import teleop_lockstep
-import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD
 from remote_probe.leader import LeaderConfig
