@@ -7,7 +7,8 @@ STAMP := $(VENV)/.setup-complete
 DEV_STAMP := $(VENV)/.dev-complete
 PACKAGES := haptic_util haptic_contract collision_engine force_renderer haptic_wand_driver simulated_operator \
 	haptic_bringup teleop_protocol teleop_leader robot_site link_emulator ultrasound_sim site_gateway
-SETUP_INPUTS := requirements.txt constraints.txt tools/setup_venv.sh tools/fix_wheel_cmake_paths.py \
+SETUP_INPUTS := requirements.txt constraints.txt pyproject.toml tools/setup_venv.sh \
+	tools/fix_wheel_cmake_paths.py \
 	$(wildcard src/msgs/*.txt src/msgs/*.xml src/msgs/msg/*.msg) \
 	$(foreach p,$(PACKAGES),$(wildcard src/$(p)/setup.py src/$(p)/setup.cfg src/$(p)/package.xml \
 	  src/$(p)/config/* src/$(p)/launch/* src/$(p)/scenes/* src/$(p)/scenes/meshes/*))
@@ -35,11 +36,11 @@ $(DEV_STAMP): $(STAMP) requirements-dev.txt
 # last stored results (bench/results/, which `make bench` refreshes; nothing is benchmarked here).
 demo: $(STAMP)
 	$(VENV)/bin/demo --out build/demo
-	$(PY) bench/report.py --demo-dir build/demo --out report
+	$(PY) report_generator/report.py --demo-dir build/demo --out report
 
 # The report again from the last demo's bags and the stored results (after `make bench`).
 report: $(STAMP)
-	$(PY) bench/report.py --demo-dir build/demo --out report
+	$(PY) report_generator/report.py --demo-dir build/demo --out report
 
 # Deterministic: Hypothesis's ci profile draws the same examples on every run.
 test: $(DEV_STAMP)

@@ -11,7 +11,7 @@ box, within +-2 mm of the surface half inside, a 1 kHz tapping trajectory that g
 at 20 sites, and uniform inside the object: the penetration depth, by EPA on a convex mesh),
 every method answers the same points: printed are the median and p99 time of
 a call (the timer's own cost is printed apart: it is included in every figure) and the largest
-error against exact ground truth (``tests/ground_truth.py``: analytic for the primitives, brute
+error against exact ground truth (``ground_truth/distances.py``: analytic for the primitives, brute
 force with a winding-number sign for meshes), with the number of sign errors.
 
 The methods: ours (``Scene.query``, the public API, points as tuples of floats); ours-kernel
@@ -25,14 +25,12 @@ rows as dicts.
 
 import argparse
 import math
-from pathlib import Path
-import sys
 import time
 
-import machine
+from bench import machine
+from ground_truth import distances
 import numpy as np
 
-import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
 from collision_engine import _kernels
 from collision_engine._jit import jit
 from collision_engine.epa import epa, scratch_size as epa_scratch_size
@@ -40,9 +38,6 @@ from collision_engine.gjk import gjk
 from collision_engine.scene import load_scene, Scene, SceneObject
 from collision_engine.shapes import Box, ConvexMesh, Cylinder, TriangleMesh
 from collision_engine.support import pack_convex, POINT
-
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
-import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
 
 __all__ = ['OBJECTS', 'point_sets', 'run', 'main']
 
@@ -62,11 +57,11 @@ def _truth_function(scene_object):
     """Exact signed distance for world points: analytic for primitives, brute force for meshes."""
     shape, pose = scene_object.shape, scene_object.pose
     if isinstance(shape, Box):
-        local = (lambda p: ground_truth.box_signed_distance(p, shape.size))
+        local = (lambda p: distances.box_signed_distance(p, shape.size))
     elif isinstance(shape, Cylinder):
-        local = (lambda p: ground_truth.cylinder_signed_distance(p, shape.radius, shape.height))
+        local = (lambda p: distances.cylinder_signed_distance(p, shape.radius, shape.height))
     else:  # a TriangleMesh, or a ConvexMesh's hull
-        local = (lambda p: ground_truth.mesh_signed_distance(p, shape.vertices, shape.faces)[0])
+        local = (lambda p: distances.mesh_signed_distance(p, shape.vertices, shape.faces)[0])
     return lambda world: local(pose.to_local(world))
 
 
@@ -80,8 +75,8 @@ def _outward(truth, points, step=1e-7):
 def _near_surface(scene_object, truth, count, rng):
     shape = scene_object.shape
     if isinstance(shape, (TriangleMesh, ConvexMesh)):
-        local, distance = ground_truth.sample_near_surface(shape.vertices, shape.faces, count,
-                                                           NEAR_BAND, rng)
+        local, distance = distances.sample_near_surface(shape.vertices, shape.faces, count,
+                                                        NEAR_BAND, rng)
         return scene_object.pose.to_world(local), distance
     centre, radius = shape.bounding_sphere()
     inside, outside = [], []
@@ -264,7 +259,7 @@ def run(objects=tuple(OBJECTS), *, random: int = 2000, near: int = 2000, tapping
     """
     rows = []
     for name in objects:
-        scene_object = load_scene(ground_truth.scene_path(OBJECTS[name])).objects[0]
+        scene_object = load_scene(distances.scene_path(OBJECTS[name])).objects[0]
         sets = point_sets(scene_object, random=random, near=near, tapping=tapping,
                           inside=inside, seed=seed)
         for method in methods:
@@ -325,7 +320,7 @@ def epa_scratch_figures(name: str = 'cylinder_stl', count: int = 2000, rounds: i
     The same contacts (points inside the object, GJK run beforehand) in one compiled batch per
     timing, the two variants alternated ``rounds`` times; returns the medians in us a call.
     """
-    scene_object = load_scene(ground_truth.scene_path(OBJECTS[name])).objects[0]
+    scene_object = load_scene(distances.scene_path(OBJECTS[name])).objects[0]
     shape = scene_object.shape
     sets = point_sets(scene_object, random=1, near=TAP_SITES, tapping=0.02, inside=count,
                       seed=seed)

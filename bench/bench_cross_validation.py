@@ -17,21 +17,15 @@ GIL. A checker in a process of its own would remove that wait.
 """
 
 import argparse
-from pathlib import Path
-import sys
 import time
 
-import machine
+from bench import bench_collision, machine
+from ground_truth import distances
 import numpy as np
 
-import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
 from collision_engine.cross_validation import FclCrossValidator
 from collision_engine.scene import load_scene, Scene
 from collision_engine.scene_file import CrossValidationSpec
-
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
-import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
-import bench_collision  # noqa: E402,I100,I202 -- a bench script beside this one
 
 RATE = 1000.0
 SPIN = 3e-4  # s: the last part of a tick spent spinning, for a punctual start
@@ -74,7 +68,7 @@ def inline_checked(scene: Scene, every: int):
 
 def run(name: str, seconds: float, every: int) -> list[dict]:
     """Time the three ways on one shipped scene's object; one row per way."""
-    shipped = load_scene(ground_truth.scene_path(name))
+    shipped = load_scene(distances.scene_path(name))
     sets = bench_collision.point_sets(shipped.objects[0], random=10, near=200, tapping=seconds)
     points = [tuple(p) for p in sets['tapping'][0]]
     plain = Scene(shipped.objects, frame_id=shipped.frame_id)

@@ -15,7 +15,7 @@ The load average is printed before and after: on a busy machine the wall figures
 load, the CPU ones the model.
 
 Truth tables. The point target's axial and lateral FWHM against SIMUS (PyMUST, the same probe,
-frequency, pulse and f-number; ``tests/ultrasound_sim/psf_reference.py``), and the speckle's
+frequency, pulse and f-number; ``ground_truth/psf_reference.py``), and the speckle's
 envelope mean over standard deviation against Rayleigh's 1.91 in a uniform block at three
 frequencies. ``--json PATH`` writes every figure for the report.
 """
@@ -24,22 +24,17 @@ import argparse
 import math
 import os
 from pathlib import Path
-import sys
 import tempfile
 import time
 
-import machine
+from bench import machine, result_files
+from ground_truth.imaging_scenes import block_scene
+from ground_truth.psf_reference import model_psf, PROBES, simus_psf
 import numpy as np
-import result_files
 
-import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
 from collision_engine import load_scene
 from collision_engine.probe import query_probe
 from ultrasound_sim import _kernels, Imager, load_anatomy, ProbeSettings, scanline_coupling
-
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests' / 'ultrasound_sim'))
-from imaging_scenes import block_scene  # noqa: E402,I100,I202 -- needs tests/ on the path
-from psf_reference import model_psf, PROBES, simus_psf  # noqa: E402,I100
 
 __all__ = ['frame_times', 'main', 'psf_table', 'speckle_table']
 

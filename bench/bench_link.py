@@ -23,8 +23,8 @@ import tempfile
 import threading
 import time
 
+from bench import machine, result_files
 from geometry_msgs.msg import PoseStamped
-import machine
 import numpy as np
 import psutil
 import rclpy
@@ -33,7 +33,6 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.serialization import serialize_message
 from rclpy.task import Future
-import result_files
 
 from haptic_bringup.launcher import add_venv_prefix, loop_environment
 from haptic_bringup.processes import start_child, stop_children

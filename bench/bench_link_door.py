@@ -16,7 +16,7 @@ import statistics
 import sys
 import time
 
-import machine
+from bench import machine
 import numpy as np
 
 from haptic_contract.teleop import Command, CommandLimits, HAND_SPEED

@@ -34,10 +34,9 @@ import sys
 import tempfile
 import time
 
-import machine
+from bench import machine, result_files
 import numpy as np
 import psutil
-import result_files
 import yaml
 
 from haptic_bringup.launcher import add_venv_prefix, Loop, loop_environment, LoopConfig

@@ -20,7 +20,7 @@ import sys
 import tempfile
 import time
 
-import machine
+from bench import machine
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 MODULE = 'src/haptic_wand_driver/haptic_wand_driver/loop_stats.py'
@@ -62,8 +62,8 @@ def measure(module_path: str, hours: list) -> list:
 
 def run(label: str, module_path: str, hours: list) -> list:
     """Measure in a fresh process, so one implementation's memory cannot count for another."""
-    code = (f'import sys; sys.path.insert(0, {str(ROOT / "bench")!r}); import json, '
-            f'bench_loop_stats as b; print(json.dumps(b.measure({module_path!r}, {hours!r})))')
+    code = ('import json; from bench import bench_loop_stats as b; '
+            f'print(json.dumps(b.measure({module_path!r}, {hours!r})))')
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                          check=True).stdout
     return [dict(row, implementation=label) for row in json.loads(out.splitlines()[-1])]

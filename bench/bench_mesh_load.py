@@ -14,7 +14,7 @@ import argparse
 from pathlib import Path
 import time
 
-import machine
+from bench import machine
 import numpy as np
 
 from collision_engine.mesh_io import load_mesh

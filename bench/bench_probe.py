@@ -15,7 +15,7 @@ import math
 from pathlib import Path
 import time
 
-import machine
+from bench import machine
 import numpy as np
 
 from collision_engine import load_scene

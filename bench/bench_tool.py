@@ -15,7 +15,7 @@ per pose, from a Python loop, as a haptic loop makes them, after a warm-up. The 
 * cuboid near: the same placement on the paper's cuboid (``scenes/cuboid.yaml``), a primitive.
 
 Printed per method and set: the median and p99 time of a call (the timer's own cost, printed
-apart, is included) and the largest error against independent truth (``tests/ground_truth.py``)
+apart, is included) and the largest error against independent truth (``ground_truth/distances.py``)
 over the first ``--truth`` poses of each set: the least polytope distance of the probe to the
 triangles apart, and in overlap the least exact signed distance over our point shell, the
 method ``tool_mesh`` states; for the cuboid, the probe's polytope distance to the box. Every
@@ -28,17 +28,14 @@ cleared per call; a BVH in either answers overlap without a depth.
 import argparse
 import time
 
-import machine
+from bench import bench_collision, machine
+from ground_truth import distances
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
 from collision_engine import _kernels, Box, TriangleMesh
 from collision_engine.scene import load_scene
 from collision_engine.tool import pack_tool, point_shell
-
-import bench_collision  # noqa: I100,I202 -- puts tests/ on the path, for ground_truth
-import ground_truth  # noqa: E402,I100,I202
 
 __all__ = ['PROBE_SIZE', 'pose_sets', 'run', 'main']
 
@@ -56,7 +53,7 @@ def _surface(shape) -> tuple[np.ndarray, np.ndarray]:
     """Return the object's surface as triangles (vertices, faces), local frame."""
     if isinstance(shape, TriangleMesh):
         return shape.vertices, shape.faces
-    faces, _ = ground_truth.outward_hull(_box_corners(shape.size))
+    faces, _ = distances.outward_hull(_box_corners(shape.size))
     return _box_corners(shape.size), faces
 
 
@@ -65,9 +62,9 @@ def _truth(scene_object, rotation, position, spacing) -> float:
     vertices, faces = _surface(scene_object.shape)
     probe = _box_corners(PROBE_SIZE) @ rotation.T + position
     if isinstance(scene_object.shape, Box):
-        return ground_truth.polytope_pair_distance(vertices, probe)
+        return distances.polytope_pair_distance(vertices, probe)
     shell = point_shell(Box(PROBE_SIZE), spacing) @ rotation.T + position
-    deepest = float(ground_truth.mesh_signed_distance(shell, vertices, faces)[0].min())
+    deepest = float(distances.mesh_signed_distance(shell, vertices, faces)[0].min())
     if deepest < 0.0:
         return deepest
     centre = probe.mean(axis=0)
@@ -76,12 +73,12 @@ def _truth(scene_object, rotation, position, spacing) -> float:
     centroids = triangles.mean(axis=1)
     spans = np.linalg.norm(triangles - centroids[:, None], axis=2).max(axis=1)
     near = np.linalg.norm(centroids - centre, axis=1) - spans - reach <= NEAR_BAND + 0.02
-    return max(0.0, min(ground_truth.polytope_pair_distance(t, probe) for t in triangles[near]))
+    return max(0.0, min(distances.polytope_pair_distance(t, probe) for t in triangles[near]))
 
 
 def _tapping(vertices, faces, seconds, rng):
     """Upright taps at 20 sites: (rotations, positions), local frame, 1 kHz."""
-    rotations, positions = ground_truth.tool_poses_near_surface(
+    rotations, positions = distances.tool_poses_near_surface(
         vertices, faces, PROBE_SIZE, TAP_SITES, 0.0, rng, tilt=0.0)
     normals = rotations[:, :, 2]
     per_site = int(round(seconds * RATE / TAP_SITES))
@@ -101,10 +98,10 @@ def pose_sets(*, near: int, tapping: float, truth: int, spacing: float, seed: in
     rng = np.random.default_rng(seed)
     sets = []
     for name in ('hand', 'cuboid'):
-        scene_object = load_scene(ground_truth.scene_path(name)).objects[0]
+        scene_object = load_scene(distances.scene_path(name)).objects[0]
         vertices, faces = _surface(scene_object.shape)
-        local = {'near': ground_truth.tool_poses_near_surface(vertices, faces, PROBE_SIZE, near,
-                                                              NEAR_BAND, rng)}
+        local = {'near': distances.tool_poses_near_surface(vertices, faces, PROBE_SIZE, near,
+                                                           NEAR_BAND, rng)}
         if name == 'hand' and tapping:
             local['tapping'] = _tapping(vertices, faces, tapping, rng)
         for set_name, (rotations, positions) in local.items():
@@ -226,7 +223,7 @@ def run(*, near: int = 2000, tapping: float = 10.0, truth: int = 100,
         One row per (scene, pose set, method): ``scene``, ``poses``, ``method``, ``n``,
         ``median_us``, ``p99_us``, ``max_error_m`` (over the poses with truth), ``checked``.
     """
-    scenes = {name: load_scene(ground_truth.scene_path(name)) for name in ('hand', 'cuboid')}
+    scenes = {name: load_scene(distances.scene_path(name)) for name in ('hand', 'cuboid')}
     probe = Box(PROBE_SIZE)
     sets = pose_sets(near=near, tapping=tapping, truth=truth,
                      spacing=scenes['hand'].shell_spacing, seed=seed)

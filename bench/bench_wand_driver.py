@@ -6,7 +6,7 @@ Timed, one call (or call group) at a time with ``time.perf_counter_ns`` after a 
 
 - ``tick``: ``SimulatedWand.read(now)`` + ``WrenchCommand.current(now, yaw)`` + ``apply`` -- the
   node's timer callback without publishing. The wand is held by the operator hand running the
-  paper's cuboid tapping script (exact box projection from ``tests/wand_ground_truth.py``), and a
+  paper's cuboid tapping script (exact box projection from ``ground_truth.wand``), and a
   160 N/m wall force on the cuboid is fed back every tick, so the wrench is fresh and the tip
   really taps.
 - ``update``: ``WrenchCommand.update`` with the wall force as tuples of floats, as the node passes
@@ -24,7 +24,8 @@ import sys
 import tempfile
 import time
 
-import machine
+from bench import machine
+from ground_truth.wand import Box, wall_force
 import numpy as np
 
 from haptic_wand_driver.replay import ReplayDevice
@@ -32,9 +33,6 @@ from haptic_wand_driver.simulated import SimulatedWand
 from haptic_wand_driver.wrench_input import WrenchCommand
 from simulated_operator.hand import OperatorHand
 from simulated_operator.scripts import cuboid_face_tapping
-
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
-from wand_ground_truth import Box, wall_force  # noqa: E402,I100 -- needs the tests on the path
 
 __all__ = ['run_repeat', 'main']
 

@@ -15,15 +15,13 @@ import argparse
 import math
 import sys
 
-import bench_collision
-import machine
+from bench import bench_collision, machine, result_files
 import numpy as np
-from paper_method import PaperMethod
-from report_experiments import Experiment, EXPERIMENTS
-from report_format import format_number
-from report_metrics import error_summary, false_samples
-from report_paper_replay import paper_rows
-import result_files
+from report_generator.paper_method import PaperMethod
+from report_generator.report_experiments import Experiment, EXPERIMENTS
+from report_generator.report_format import format_number
+from report_generator.report_metrics import error_summary, false_samples
+from report_generator.report_paper_replay import paper_rows
 
 from collision_engine import ConvexMesh, load_scene
 from collision_engine.scene import SceneObject

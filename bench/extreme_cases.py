@@ -3,7 +3,7 @@
     .venv/bin/python bench/extreme_cases.py [--points 200] [--seed 0] [--json PATH]
 
 Each case queries ``collision_engine.distance`` (the public one-shape API, default request) on
-a few hundred points and reports, against exact ground truth (``tests/ground_truth.py``:
+a few hundred points and reports, against exact ground truth (``ground_truth/distances.py``:
 analytic for boxes and cylinders, brute force with a winding-number sign for meshes; points
 are taken to the local frame here with numpy, not with the engine's ``Pose``): the largest
 error in metres and as a fraction of the object's size, the most iterations, the statuses, and
@@ -20,22 +20,17 @@ from dataclasses import dataclass
 import math
 import multiprocessing
 import os
-from pathlib import Path
-import sys
 import tempfile
 from typing import Callable
 
+from bench import result_files
+from ground_truth import distances
 import numpy as np
-import result_files
 from scipy.spatial.transform import Rotation
 
-import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
 from collision_engine import (Box, ConvexMesh, Cylinder, distance, Pose, STATUS_NOT_CONVERGED,
                               STATUS_OK, TriangleMesh)
 from collision_engine.cross_validation import FclCrossValidator
-
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
-import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
 
 __all__ = ['ExtremeRow', 'format_rows', 'rows', 'main']
 
@@ -123,7 +118,7 @@ def _box_case(name: str, size, count: int, rng, *, rotation=None, translation=(0
               else np.vstack((_around(size, count // 2, rng), near)))
     return _Case(name, Box(size), np.eye(3) if rotation is None else rotation,
                  np.asarray(translation, dtype=np.float64),
-                 lambda p: ground_truth.box_signed_distance(p, size), points, float(size.max()))
+                 lambda p: distances.box_signed_distance(p, size), points, float(size.max()))
 
 
 def _cylinder_case(name: str, radius: float, height: float, count: int, rng, *,
@@ -133,16 +128,16 @@ def _cylinder_case(name: str, radius: float, height: float, count: int, rng, *,
     points = (_cylinder_side(radius, height, count, GRAZE, rng) if graze
               else np.vstack((_around(2 * extent, count // 2, rng), near)))
     return _Case(name, Cylinder(radius, height), np.eye(3), np.zeros(3),
-                 lambda p: ground_truth.cylinder_signed_distance(p, radius, height), points,
+                 lambda p: distances.cylinder_signed_distance(p, radius, height), points,
                  float(max(2 * radius, height)))
 
 
 def _mesh_case(name: str, shape, count: int, rng) -> _Case:
     """Points GRAZE m off random points of a closed mesh (or hull), truth by brute force."""
-    points, _ = ground_truth.sample_near_surface(shape.vertices, shape.faces, count, GRAZE, rng)
+    points, _ = distances.sample_near_surface(shape.vertices, shape.faces, count, GRAZE, rng)
     extent = shape.vertices.max(axis=0) - shape.vertices.min(axis=0)
     return _Case(name, shape, np.eye(3), np.zeros(3),
-                 lambda p: ground_truth.mesh_signed_distance(p, shape.vertices, shape.faces)[0],
+                 lambda p: distances.mesh_signed_distance(p, shape.vertices, shape.faces)[0],
                  points, float(extent.max()))
 
 
@@ -169,7 +164,7 @@ def _cube_with_ties(edge: float) -> tuple[ConvexMesh, np.ndarray]:
 def _hand() -> TriangleMesh:
     from collision_engine.mesh_io import load_mesh
 
-    mesh = load_mesh(ground_truth.hand_mesh_path(), scale=0.001, check_self_intersection=False)
+    mesh = load_mesh(distances.hand_mesh_path(), scale=0.001, check_self_intersection=False)
     return TriangleMesh(mesh.vertices, mesh.faces)
 
 
@@ -192,7 +187,7 @@ def _cases(count: int, rng) -> list[_Case]:
         _box_case('box, aspect 1e6 (plate 1 x 1 x 1e-6 m)', (1.0, 1.0, 1e-6), count, rng),
         _box_case('box, aspect 1e6 (needle 1 x 1e-6 x 1e-6 m)', needle, count, rng),
         _Case('hull of the needle (8 corners), aspect 1e6', ConvexMesh(needle_corners),
-              np.eye(3), np.zeros(3), lambda p: ground_truth.box_signed_distance(p, needle),
+              np.eye(3), np.zeros(3), lambda p: distances.box_signed_distance(p, needle),
               _box_case('', needle, count, rng).local_points, 1.0),
         _box_case('box 0.1 m, points 1e-12 m off a face', (0.2, 0.1, 0.1), count, rng,
                   graze=True),
@@ -202,7 +197,7 @@ def _cases(count: int, rng) -> list[_Case]:
         _mesh_case('hand mesh, points 1e-12 m off a face', _hand(), min(count, 100), rng),
         _Case('cube hull from duplicated, coplanar, collinear points (tied supports)', hull,
               np.eye(3), np.zeros(3),
-              lambda p: ground_truth.box_signed_distance(p, (0.1, 0.1, 0.1)), tie_points, 0.1),
+              lambda p: distances.box_signed_distance(p, (0.1, 0.1, 0.1)), tie_points, 0.1),
     ]
 
 

@@ -11,14 +11,12 @@ tapping: ``bench_collision.point_sets``), against exact truth. The report's chap
 import argparse
 import sys
 
-import bench_collision
-from error_time import hull_object
-import machine
+from bench import bench_collision, machine, result_files
+from bench.error_time import hull_object
 import numpy as np
-from report_experiments import EXPERIMENTS
-from report_format import format_number
-from report_metrics import error_summary
-import result_files
+from report_generator.report_experiments import EXPERIMENTS
+from report_generator.report_format import format_number
+from report_generator.report_metrics import error_summary
 
 from collision_engine import DistanceRequest, load_scene, Scene, STATUS_NOT_CONVERGED
 

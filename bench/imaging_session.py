@@ -32,11 +32,10 @@ import pathlib
 import sys
 import tempfile
 
-import machine
+from bench import machine, result_files
+from bench.teleop_scan import process_cpu
 import numpy as np
-import result_files
 from rosbags.highlevel import AnyReader
-from teleop_scan import process_cpu
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig

@@ -12,7 +12,7 @@ s²/(2(R - d)), beside them. ``valid_radius`` (2 mm by default) bounds s.
 """
 import argparse
 
-import machine
+from bench import machine
 import numpy as np
 
 from collision_engine import load_scene

@@ -30,7 +30,7 @@ import sys
 import tempfile
 import time
 
-import machine
+from bench import machine
 import numpy as np
 import psutil
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import sys
 
 import numpy as np
-from report_provenance import provenance
+from report_generator.report_provenance import provenance
 
 __all__ = ['RESULTS', 'Stored', 'add_option', 'describe', 'missing', 'read', 'write']
 

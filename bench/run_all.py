@@ -24,7 +24,7 @@ import subprocess
 import sys
 import time
 
-import result_files
+from bench import result_files
 
 __all__ = ['BENCHMARKS', 'Benchmark', 'Outcome', 'main', 'run', 'summary']
 

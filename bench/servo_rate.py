@@ -4,7 +4,7 @@
                                          [--stiffness 160 1000 5000 20000 100000 500000]
                                          [--json PATH]
 
-The simulated wand taps a wall (``tests/haptic_wand_driver/taps.py``: pushed 10 mm in, held,
+The simulated wand taps a wall (``bench/taps.py``: pushed 10 mm in, held,
 lifted), the model of each pose reaching the device one 1 ms tick later. Per servo rate, with the
 contact rendered on the device: the cost of one servo period (the wand's dynamics and the local
 law, median and p99 in µs, over every tick of every tap; in the wand's Python loop, observed
@@ -15,14 +15,10 @@ the tip crossing into the wall to the first period with a force). Beside it, rem
 latency, the baseline.
 """
 import argparse
-from pathlib import Path
-import sys
 
-import machine
+from bench import machine, result_files
+from bench.taps import servo_cost, tap
 import numpy as np
-import result_files
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests' / 'haptic_wand_driver'))
-from taps import servo_cost, tap  # noqa: E402 -- the harness the tests use
 
 __all__ = ['main', 'rows']
 

@@ -23,9 +23,8 @@ import pathlib
 import sys
 import tempfile
 
-import machine
+from bench import machine, result_files
 import numpy as np
-import result_files
 
 from collision_engine import load_scene, surface_projection
 from force_renderer.params import ForceRendererParams

@@ -16,8 +16,8 @@ import sys
 import tempfile
 import time
 
+from bench import machine
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
-import machine
 import numpy as np
 import psutil
 from rclpy.node import Node

@@ -28,11 +28,9 @@ import sys
 import tempfile
 import time
 
-import machine
+from bench import machine, result_files, teleop_scan
 import numpy as np
-import result_files
 from rosbags.highlevel import AnyReader
-import teleop_scan
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import add_venv_prefix

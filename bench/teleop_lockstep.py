@@ -26,10 +26,8 @@ import itertools
 import math
 import sys
 
-import machine
+from bench import machine, result_files, teleop_scan
 import numpy as np
-import result_files
-import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD, LINK_TIMEOUT, MODEL_STEP_RATE, \
     SCAN_DURATION
@@ -50,7 +48,7 @@ from simulated_operator.scripts import WaypointScript
 from teleop_leader.leader import Leader, LeaderConfig
 from teleop_leader.params import LeaderParams
 
-__all__ = ['as_series', 'hold_error', 'late_ticks', 'scan', 'SCHEMES']
+__all__ = ['as_series', 'hold_error', 'late_ticks', 'scan', 'ScanOptions', 'SCHEMES']
 
 PLAIN_TDPA = 'tdpa-plain'  # TDPA's controller on the wand itself: the baseline of the coupling
 SCHEMES = ('direct', PLAIN_TDPA, 'tdpa', 'model')
@@ -86,32 +84,50 @@ def _model(time: float, plane, tip) -> ContactModel:
                         MODEL_LIFETIME, math.inf, tuple(tip), (0.0,) * 6)
 
 
-def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
-         duration: float = SCAN_DURATION, seed: int = 0, ticks=None, hold: float = 0.0,
-         easing: float = MODEL_STEP_RATE, link_timeout: float | None = None,
-         force_hold: tuple | None = None, outage: tuple | None = None) -> dict:
+@dataclasses.dataclass(frozen=True)
+class ScanOptions:
+    """How one scan runs, beside its scheme and delay: the defaults are the launcher's (SI).
+
+    ``jitter`` (s), ``loss`` and ``seed``: the link's, both ways. ``ticks``: the tick numbers at
+    which the operator's site runs (a busy machine skips periods, as a ROS timer does), None for
+    every one; the remote site runs every tick. ``hold``: the site's ``AnswerDeadline`` (the
+    driver's ``hold_while_late``). ``easing``: the driver's ``model_step_rate`` (N/s; 0: each
+    model at once, the baseline). ``link_timeout``: both ends' watchdogs (s); None waits out the
+    jitter, as the launcher sets. ``force_hold``: (start, end) s, the remote site holding the
+    force it measured at the start (``Follower.hold_force``) until the end. ``outage``: (start,
+    end) s, the link carries nothing either way.
+    """
+
+    jitter: float = 0.0
+    loss: float = 0.0
+    duration: float = SCAN_DURATION
+    seed: int = 0
+    ticks: np.ndarray | None = None
+    hold: float = 0.0
+    easing: float = MODEL_STEP_RATE
+    link_timeout: float | None = None
+    force_hold: tuple | None = None
+    outage: tuple | None = None
+
+
+def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dict:
     """Run the scan; return the operator's and the remote site's per-tick arrays.
 
-    ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``. ``ticks``: the tick
-    numbers at which the operator's site runs (a busy machine skips periods, as a ROS timer
-    does), None for every one; the remote site runs every tick. The site takes each answer as
-    the driver does: held by ``AnswerDeadline(hold)`` (the driver's ``hold_while_late``), a
-    wrench through the device port's passivity controller unless the scheme is ``direct``.
-    ``easing``: the driver's ``model_step_rate`` (N/s; 0: each model at once, the baseline).
-    ``link_timeout``: both ends' watchdogs (s); None waits out the jitter, as the launcher sets.
-    ``force_hold``: (start, end) s, the remote site holding the force it measured at the start
-    (``Follower.hold_force``) until the end; the run then has ``held`` (N). ``outage``: (start,
-    end) s, the link carries nothing either way.
+    ``scheme`` is one of ``SCHEMES``: the launcher's, or ``tdpa-plain``. The site takes each
+    answer as the driver does: held by ``AnswerDeadline(options.hold)``, a wrench through the
+    device port's passivity controller unless the scheme is ``direct``. With
+    ``options.force_hold`` the run has ``held`` (N).
     Returns ``time``, ``wand``, ``felt`` (applied since the tick before) at the operator's
     ticks, and ``remote_time``, ``patient``, ``tcp``.
     """
-    timeout = silence_timeout(LINK_TIMEOUT, jitter) if link_timeout is None else link_timeout
+    timeout = (silence_timeout(LINK_TIMEOUT, options.jitter) if options.link_timeout is None
+               else options.link_timeout)
     leader_config = (LeaderConfig('tdpa', coupling=None, link_timeout=timeout)
                      if scheme == PLAIN_TDPA else LeaderConfig(scheme, link_timeout=timeout))
     scheme = leader_config.scheme
-    device, renderer = _device(scheme, easing)
+    device, renderer = _device(scheme, options.easing)
     port = PortPassivity(WandDriverParams().passivity_max_damping if scheme == 'tdpa' else 0.0)
-    answers = AnswerDeadline(hold)
+    answers = AnswerDeadline(options.hold)
     robot_params = SimulatedRobotParams()
     follower_params = dataclasses.replace(FollowerParams(), scheme=scheme, link_timeout=timeout)
     skin = PlaneSurface([0.0, 0.0, SKIN], [0.0, 0.0, 1.0])
@@ -122,15 +138,15 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
         robot_config.workspace_lower, robot_config.workspace_upper,
         follower_params.max_command_speed), surface=lambda tcp: (skin.point, skin.normal))
     leader = Leader(leader_config, ZERO, robot_config.initial_position)
-    link = LinkConfig(delay, jitter, loss, seed=seed)
+    link = LinkConfig(delay, options.jitter, options.loss, seed=options.seed)
     to_robot, to_operator = EmulatedLink(link), EmulatedLink(LinkConfig(
-        delay, jitter, loss, seed=seed + 1))
-    count = round(duration / TICK)
+        delay, options.jitter, options.loss, seed=options.seed + 1))
+    count = round(options.duration / TICK)
     cut = np.zeros(count + 1, dtype=bool)
-    if outage is not None:
-        cut[round(outage[0] / TICK):round(outage[1] / TICK)] = True
-    operating = np.ones(count + 1, dtype=bool) if ticks is None else np.isin(
-        np.arange(count + 1), ticks)
+    if options.outage is not None:
+        cut[round(options.outage[0] / TICK):round(options.outage[1] / TICK)] = True
+    operating = np.ones(count + 1, dtype=bool) if options.ticks is None else np.isin(
+        np.arange(count + 1), options.ticks)
     operator_rows, remote_rows, held = [], [], np.nan
     state, remote = device.read(0.0), robot.read(0.0)
     for k in range(1, count):
@@ -143,10 +159,10 @@ def scan(scheme: str, delay: float, *, jitter: float = 0.0, loss: float = 0.0,
                 to_robot.send(now, command)
         for delivery in to_robot.deliver(now):
             follower.receive(now, delivery.payload)
-        if force_hold is not None and k == round(force_hold[0] / TICK):
+        if options.force_hold is not None and k == round(options.force_hold[0] / TICK):
             follower.hold_force(None)
             held = follower.hold.force
-        elif force_hold is not None and k == round(force_hold[1] / TICK):
+        elif options.force_hold is not None and k == round(options.force_hold[1] / TICK):
             follower.hold_force(0.0)
         reading = sensor.measure(now, remote.external_force).force
         robot.command(follower.target(now, remote.position, remote.velocity, reading, TICK))
@@ -229,29 +245,23 @@ def main(argv=None) -> int:
     ticks = late_ticks(SCAN_DURATION, 0) if args.late else None
     rows = []
     for delay in args.delays:
+        options = ScanOptions(jitter=args.jitter * delay, loss=args.loss, ticks=ticks)
         for scheme in args.schemes:
             rates = args.model_step_rates if scheme == 'model' else [MODEL_STEP_RATE]
             for hold, rate in itertools.product((LATE_POSE_HOLD, 0.0) if args.late else (0.0,),
                                                 rates):
-                run = scan(scheme, delay, jitter=args.jitter * delay, loss=args.loss,
-                           ticks=ticks, hold=hold, easing=rate)
+                run = scan(scheme, delay, dataclasses.replace(options, hold=hold, easing=rate))
                 notes = ([f'late, hold {1e3 * hold:g} ms'] if args.late else []) + (
                     [f'ease {rate:g}'] if len(rates) > 1 else [])
                 rows.append({'scheme': scheme, **teleop_scan.figures(as_series(run), delay),
                              'site_streams': ', '.join(notes), **hold_error(run, *SWEEP)})
                 teleop_scan.print_row(rows[-1])
         if args.force_hold:
-            run = scan('model', delay, jitter=args.jitter * delay, loss=args.loss, ticks=ticks,
-                       force_hold=SWEEP)
+            run = scan('model', delay, dataclasses.replace(options, force_hold=SWEEP))
             rows.append({'scheme': 'model', **teleop_scan.figures(as_series(run), delay),
                          'site_streams': 'force held', **hold_error(run, *SWEEP)})
             teleop_scan.print_row(rows[-1])
-    print('\nThe patient\'s force through the sweep against the held one (unheld: its mean):')
-    for r in rows:
-        if r['scheme'] == 'model':
-            print(f'{1e3 * r["delay"]:6.0f} ms {r["site_streams"]:>18} held {r["held_n"]:5.2f} N'
-                  f'  error max {r["hold_error_max_n"]:5.2f} N'
-                  f'  rms {r["hold_error_rms_n"]:5.2f} N')
+    teleop_scan.print_hold_errors(rows)
     result_files.write(args.json, rows)
     return 0
 

@@ -54,10 +54,9 @@ import sys
 import tempfile
 import time
 
-import machine
+from bench import machine, result_files
 import numpy as np
 import psutil
-import result_files
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.hold_request import hold_during
@@ -343,7 +342,7 @@ def main(argv=None) -> int:
               + f' {sum(r["cpu"].values()):7.1f}')
     result_files.write(args.json, rows)
     if traces:
-        from report_figures import teleop_figure
+        from report_generator.report_figures import teleop_figure
 
         teleop_figure(traces, FORCE_SCALE, args.json.with_suffix('.png'))
     return 0

@@ -1,4 +1,8 @@
-"""Shared test set-up: ``tests/`` is importable, so ``ground_truth`` is one module for all.
+"""Shared test set-up: domains, Hypothesis profiles, and no shared memory left behind.
+
+The tests' helpers here (``domains``, ``fuzzing``, ``load``) import by name: pytest puts this
+file's folder on the path as it loads it (its default import mode). The ground truth, the
+benchmarks and the report are packages of their own (``make setup`` installs them).
 
 Hypothesis profiles: ``ci`` (loaded when ``CI`` is set, as ``make test`` and ``.ci/run`` do)
 draws the same examples on every run, so CI is deterministic; ``fuzz`` (``make fuzz``) draws
@@ -6,15 +10,11 @@ fresh random examples, ten times as many (``fuzzing.examples``); ``dev`` is Hypo
 ``HYPOTHESIS_PROFILE`` picks one explicitly.
 """
 import os
-import pathlib
-import sys
 
 from hypothesis import HealthCheck, settings
 import pytest
 
-TESTS = pathlib.Path(__file__).resolve().parent
 _SEGMENTS_BEFORE = pytest.StashKey[set]()
-sys.path.insert(0, str(TESTS))
 
 # Anything a test starts that speaks DDS stays on this machine, in a domain of its own.
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'

@@ -1,7 +1,11 @@
 """The ground truth itself, checked against closed forms and hand-worked points."""
 
+import ast
+from pathlib import Path
+
 from fuzzing import examples
-from ground_truth import (
+import ground_truth
+from ground_truth.distances import (
     box_signed_distance,
     capsule_signed_distance,
     cylinder_signed_distance,
@@ -31,6 +35,7 @@ CUBE_FACES = np.array([
     [1, 5, 7], [1, 7, 3],  # z = +0.5
 ])
 UNIT = np.ones(3)
+ROOT = Path(__file__).resolve().parents[1]
 EXACT = 1e-15  # m: rounding in coordinates of order 1 m
 
 
@@ -276,3 +281,33 @@ def test_shipped_files_are_found():
 def test_unknown_scene_names_the_shipped_ones():
     with pytest.raises(FileNotFoundError, match='cuboid'):
         scene_path('no_such_scene')
+
+
+# The toolkit's own packages: what the references must not compute their answers with.
+TOOLKIT = ({path.parent.name for path in (ROOT / 'src').glob('*/package.xml')}
+           | {'haptic_msgs', 'rclpy'})
+# The two harnesses that drive a toolkit package, and the one each drives.
+DRIVES = {'virtual_wall': {'force_renderer'}, 'psf_reference': {'ultrasound_sim'}}
+
+
+def imported_roots(path: Path) -> set:
+    """Return the top-level names a module's code imports (every statement, at any depth)."""
+    roots = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            roots.update(alias.name.split('.')[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0:
+            roots.add(node.module.split('.')[0])
+    return roots
+
+
+def test_the_references_import_no_toolkit_package_and_the_harnesses_only_theirs():
+    modules = sorted(Path(ground_truth.__file__).parent.glob('*.py'))
+    assert {path.stem for path in modules} >= {'distances', 'wand', 'virtual_wall'}
+    found = {path.stem: imported_roots(path) & TOOLKIT for path in modules}
+    assert found == {path.stem: DRIVES.get(path.stem, set()) for path in modules}
+
+
+def test_the_ground_truth_is_no_ros_package():
+    folder = Path(ground_truth.__file__).parent
+    assert folder.parent == ROOT and not (folder / 'package.xml').exists()

@@ -6,7 +6,7 @@ import sys
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-SOURCES = ['src', 'tests', 'bench', 'tools']
+SOURCES = ['src', 'tests', 'bench', 'ground_truth', 'report_generator', 'tools']
 
 
 @pytest.mark.parametrize('linter', ['flake8', 'pydocstyle'])

@@ -1,8 +1,8 @@
 """The closed-loop simulator against closed-form motion, and its servo timing model."""
 
+from ground_truth.virtual_wall import Device, HalfSpace, OperatorHand, ServoTiming, simulate
 import numpy as np
 import pytest
-from virtual_wall import Device, HalfSpace, OperatorHand, ServoTiming, simulate
 
 from force_renderer.errors import ForceRendererError
 

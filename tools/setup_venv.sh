@@ -78,12 +78,14 @@ msgs=$!
 packages=(haptic_util haptic_contract collision_engine force_renderer haptic_wand_driver
   simulated_operator haptic_bringup teleop_protocol teleop_leader robot_site link_emulator
   ultrasound_sim site_gateway)
-step "installing the toolkit's packages: ${packages[*]}"
-# compat mode puts src/<pkg> on sys.path, so a tests/<pkg>/ folder can never shadow it.
+step "installing the toolkit's packages: ${packages[*]}; and ground_truth, bench, report_generator"
+# compat mode puts src/<pkg> on sys.path, so a tests/<pkg>/ folder can never shadow it; and, for
+# the repository's own packages (pyproject.toml: the ground truth, the benchmarks, the report),
+# the repository's root.
 editable=()
 for pkg in "${packages[@]}"; do editable+=(-e "src/$pkg"); done
 pip_install --no-deps --no-build-isolation --use-pep517 --config-settings editable_mode=compat \
-  "${editable[@]}"
+  "${editable[@]}" -e .
 for pkg in "${packages[@]}"; do
   # PEP 660 editable installs skip data_files: install the ament index marker, package.xml,
   # config, launch and scene files into <venv>/share the way colcon would.
@@ -104,6 +106,7 @@ for scene in sorted(pathlib.Path('src/collision_engine/scenes').glob('*.yaml')):
 "
 "$venv/bin/python" -c "import rclpy, haptic_msgs.msg, haptic_util, haptic_contract, collision_engine, \
 force_renderer, haptic_wand_driver, simulated_operator, haptic_bringup, teleop_protocol, teleop_leader, \
-robot_site, link_emulator, ultrasound_sim, site_gateway, zenoh" || { echo "[setup] import check failed"; exit 1; }
+robot_site, link_emulator, ultrasound_sim, site_gateway, zenoh, ground_truth, bench, report_generator" \
+  || { echo "[setup] import check failed"; exit 1; }
 finish_step
 printf '[setup] done in %s s: %s\n' "$(since "$setup_started")" "$venv"

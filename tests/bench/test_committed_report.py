@@ -10,9 +10,9 @@ from pathlib import Path
 import re
 import subprocess
 
+from bench.result_files import describe, read, RESULTS
 import pytest
-from report_benchmarks import STORED, TELEOP_FIGURE
-from result_files import describe, read, RESULTS
+from report_generator.report_benchmarks import STORED, TELEOP_FIGURE
 
 ROOT = Path(__file__).resolve().parents[2]
 REPORT = ROOT / 'report'

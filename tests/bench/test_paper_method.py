@@ -1,4 +1,4 @@
-"""The paper's collision code as re-implemented in ``bench/paper_method.py``, on cases by hand.
+"""The paper's collision code, re-implemented in ``report_generator/paper_method.py``: by hand.
 
 The expected values are worked out in the docstrings from the geometry and from the MATLAB
 code's steps; ``ground_truth`` (analytic box and cylinder, brute-force triangle distance) shares
@@ -7,12 +7,13 @@ no code with the re-implementation.
 import math
 
 from fuzzing import examples
-from ground_truth import box_signed_distance, cylinder_signed_distance, mesh_signed_distance
+from ground_truth.distances import (box_signed_distance, cylinder_signed_distance,
+                                    mesh_signed_distance)
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
-from paper_method import _point_triangle_distance, PaperMethod
 import pytest
+from report_generator.paper_method import _point_triangle_distance, PaperMethod
 
 # The unit cube [0, 1]^3 as 12 outward-wound triangles (36 vertex rows), like the authors' STL.
 CUBE_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],

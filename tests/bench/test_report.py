@@ -1,13 +1,13 @@
 """The report's entry point and the benchmarks' part of it: stored results, never measured here."""
 from pathlib import Path
 
-from report import main
-from report_benchmarks import STORED, stored_results
-from report_document import (_image_chapter, _stability_chapter, _teleop_chapter,
-                             _timing_chapter, Findings)
-from result_files import describe, missing, write
-from run_all import BENCHMARKS
-from stiffness_sweep import SweepRow
+from bench.result_files import describe, missing, write
+from bench.run_all import BENCHMARKS
+from bench.stiffness_sweep import SweepRow
+from report_generator.report import main
+from report_generator.report_benchmarks import STORED, stored_results
+from report_generator.report_document import (_image_chapter, _stability_chapter, _teleop_chapter,
+                                              _timing_chapter, Findings)
 
 
 def findings(benchmarks: dict, results: Path, teleop=None) -> Findings:

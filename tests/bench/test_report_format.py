@@ -1,7 +1,7 @@
 """How the report writes numbers, lengths, dates and tables; expected strings typed by hand."""
 import math
 
-from report_format import format_length, format_number, format_utc, markdown_table
+from report_generator.report_format import format_length, format_number, format_utc, markdown_table
 
 
 def test_markdown_table():

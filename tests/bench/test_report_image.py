@@ -1,7 +1,7 @@
 """The report's probe images: which frames it shows, and how it states the image's figures."""
 import numpy as np
-from report_image import (ALONG, cost_section, ImageScan, pressure_frames, scan_frames,
-                          scan_section, variants_section)
+from report_generator.report_image import (ALONG, cost_section, ImageScan, pressure_frames,
+                                           scan_frames, scan_section, variants_section)
 
 from haptic_bringup.session import Frames
 

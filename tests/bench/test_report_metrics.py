@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
-from report_metrics import (angle_stats, angles_to_normal, error_summary, false_events,
-                            false_samples, runs)
+from report_generator.report_metrics import (angle_stats, angles_to_normal, error_summary,
+                                             false_events, false_samples, runs)
 
 
 def test_runs_finds_each_stretch_and_drops_short_ones():

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from report_probe import continuous_face, probe_section, ProbeFindings
+from report_generator.report_probe import continuous_face, probe_section, ProbeFindings
 
 
 def midpoint_sum(depth: float, roll: float, length: float, stiffness: float, cells=200_000):

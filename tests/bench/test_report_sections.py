@@ -1,8 +1,8 @@
 """The report's Markdown sections that decide what to say, on rows made by hand."""
 from pathlib import Path
 
-from report_sections import force_effect_section, identical_modes
-from stiffness_sweep import SweepRow
+from bench.stiffness_sweep import SweepRow
+from report_generator.report_sections import force_effect_section, identical_modes
 
 
 def sweep_row(stiffness, mode, energy):

@@ -5,9 +5,9 @@ import json
 import math
 from pathlib import Path
 
+from bench.result_files import add_option, describe, missing, read, RESULTS, write
 import numpy as np
 import pytest
-from result_files import add_option, describe, missing, read, RESULTS, write
 
 
 @dataclass(frozen=True)

@@ -6,10 +6,10 @@ runner is driven on throw-away scripts.
 from pathlib import Path
 import re
 
-from run_all import BENCH, Benchmark, BENCHMARKS, run, summary
+from bench.run_all import BENCH, Benchmark, BENCHMARKS, run, summary
 
-NOT_BENCHMARKS = {'run_all.py', 'report.py', 'loop_floor.py'}  # the runner, the report, and
-# the processes bench_loop.py starts
+NOT_BENCHMARKS = {'run_all.py', 'loop_floor.py'}  # the runner, and the processes bench_loop.py
+# starts
 
 
 def runnable_scripts() -> set[str]:

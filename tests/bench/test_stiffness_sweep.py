@@ -1,5 +1,5 @@
 """``bench/stiffness_sweep.py``: every mode runs, and the comparison it draws can fail."""
-import stiffness_sweep
+from bench import stiffness_sweep
 
 
 def test_at_1e5_n_per_m_only_our_controller_keeps_the_wall_passive():

@@ -1,7 +1,7 @@
 """The scan's smoothness and force-rise figures on series whose answer is known by construction."""
+from bench import teleop_scan
 import numpy as np
 import pytest
-import teleop_scan
 
 GRID = teleop_scan.GRID
 

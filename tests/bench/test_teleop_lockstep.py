@@ -3,10 +3,12 @@
 The figures are ``teleop_scan.figures`` of the force the simulated device applied to the hand and
 the force the patient's tissue put on the probe; the schemes' own books are not read.
 """
+from dataclasses import replace
+
+from bench import teleop_lockstep, teleop_scan
+from bench.teleop_lockstep import ScanOptions
 import numpy as np
 import pytest
-import teleop_lockstep
-import teleop_scan
 
 from haptic_bringup.launcher import LATE_POSE_HOLD
 from teleop_leader.leader import LeaderConfig
@@ -15,7 +17,8 @@ MAX_PATIENT_FORCE = 20.0  # [N] the safety's default
 
 
 def figures(scheme: str, delay: float, **options) -> dict:
-    run = teleop_lockstep.scan(scheme, delay, jitter=0.1 * delay, loss=0.01, **options)
+    options = ScanOptions(jitter=0.1 * delay, loss=0.01, **options)
+    run = teleop_lockstep.scan(scheme, delay, options)
     return teleop_scan.figures(teleop_lockstep.as_series(run), delay)
 
 
@@ -98,11 +101,11 @@ def test_at_500_ms_the_model_is_stable_and_transparent_once_the_watchdogs_wait_o
 
     With 100 ms watchdogs at both ends (the baseline) every such gap read as a dead link.
     """
-    options = {'jitter': 0.1, 'loss': 0.05}
-    patient = teleop_lockstep.scan('model', 0.5, **options)
+    options = ScanOptions(jitter=0.1, loss=0.05)
+    patient = teleop_lockstep.scan('model', 0.5, options)
     waited = teleop_scan.figures(teleop_lockstep.as_series(patient), 0.5)
     hasty = teleop_scan.figures(teleop_lockstep.as_series(
-        teleop_lockstep.scan('model', 0.5, link_timeout=0.1, **options)), 0.5)
+        teleop_lockstep.scan('model', 0.5, replace(options, link_timeout=0.1))), 0.5)
     assert not hasty['stable'], hasty
     assert waited['stable'] and waited['smooth'], waited
     assert waited['transparency_percent'] <= 10.0
@@ -114,9 +117,9 @@ def test_a_force_held_through_the_sweep_stays_within_half_a_newton_of_the_set_on
 
     Read from the tissue's force; the operator's own hand, unheld, wanders by more (0.43 N).
     """
-    options = {'jitter': 0.1, 'loss': 0.05}
-    held = teleop_lockstep.scan('model', 0.5, force_hold=teleop_lockstep.SWEEP, **options)
-    unheld = teleop_lockstep.scan('model', 0.5, **options)
+    options = ScanOptions(jitter=0.1, loss=0.05)
+    held = teleop_lockstep.scan('model', 0.5, replace(options, force_hold=teleop_lockstep.SWEEP))
+    unheld = teleop_lockstep.scan('model', 0.5, options)
     error = teleop_lockstep.hold_error(held, *teleop_lockstep.SWEEP)
     own = teleop_lockstep.hold_error(unheld, *teleop_lockstep.SWEEP)
     assert 5.0 < error['held_n'] < 20.0
@@ -133,7 +136,7 @@ def test_after_a_link_outage_mid_press_the_hand_feels_what_the_patient_gets():
     patient, to the end of the sweep.
     """
     outage = (teleop_lockstep.SWEEP[0], teleop_lockstep.SWEEP[0] + 1.0)
-    run = teleop_lockstep.scan('model', 0.1, jitter=0.01, loss=0.01, outage=outage)
+    run = teleop_lockstep.scan('model', 0.1, ScanOptions(jitter=0.01, loss=0.01, outage=outage))
     scale = LeaderConfig().force_scale
 
     def median(times, values, start, end):

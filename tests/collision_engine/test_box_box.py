@@ -10,7 +10,7 @@ pair query (EPA) still answers exactly.
 
 from itertools import product
 
-from ground_truth import box_signed_distance, polytope_pair_distance
+from ground_truth.distances import box_signed_distance, polytope_pair_distance
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation

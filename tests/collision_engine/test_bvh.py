@@ -5,8 +5,8 @@ number: no tree, no pseudonormals, no code shared with the engine.
 """
 
 from fuzzing import examples
-from ground_truth import (hand_mesh_path, mesh_signed_distance, sample_near_surface,
-                          simplex_distance)
+from ground_truth.distances import (hand_mesh_path, mesh_signed_distance, sample_near_surface,
+                                    simplex_distance)
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays

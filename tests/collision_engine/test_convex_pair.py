@@ -9,7 +9,7 @@ box-plane). Every case within 1e-9 m.
 from itertools import product
 
 from fuzzing import examples
-from ground_truth import (box_signed_distance, polytope_pair_distance, segment_distance)
+from ground_truth.distances import (box_signed_distance, polytope_pair_distance, segment_distance)
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np

@@ -4,7 +4,7 @@ sign), never changes or delays one, and stops."""
 import gc
 import threading
 
-from ground_truth import scene_path, winding_number
+from ground_truth.distances import scene_path, winding_number
 import numpy as np
 import pytest
 

@@ -6,9 +6,9 @@ frame, with the world-to-local transform done here by scipy's ``Rotation``. The 
 """
 
 from fuzzing import examples
-from ground_truth import (box_signed_distance, capsule_signed_distance,
-                          cylinder_signed_distance, exact_norm, mesh_signed_distance,
-                          outward_hull, sphere_signed_distance)
+from ground_truth.distances import (box_signed_distance, capsule_signed_distance,
+                                    cylinder_signed_distance, exact_norm, mesh_signed_distance,
+                                    outward_hull, sphere_signed_distance)
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays

@@ -1,7 +1,7 @@
 """EPA's penetration depth inside convex meshes, against brute force on scipy's hull facets."""
 
 from fuzzing import examples
-from ground_truth import mesh_signed_distance, outward_hull
+from ground_truth.distances import mesh_signed_distance, outward_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays

@@ -5,7 +5,7 @@ The reference shares no code with the engine: the distance to a polytope by
 """
 
 from fuzzing import examples
-from ground_truth import capsule_signed_distance, mesh_signed_distance, outward_hull
+from ground_truth.distances import capsule_signed_distance, mesh_signed_distance, outward_hull
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays

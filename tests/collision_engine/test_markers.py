@@ -4,7 +4,7 @@ import os
 from pathlib import Path
 import sys
 
-from ground_truth import scene_path
+from ground_truth.distances import scene_path
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation

@@ -8,7 +8,7 @@ import sys
 import tempfile
 
 from fuzzing import examples
-from ground_truth import triangles_meet
+from ground_truth.distances import triangles_meet
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np

@@ -3,7 +3,7 @@
 from decimal import Decimal
 import math
 
-from ground_truth import exact_norm, exact_unit
+from ground_truth.distances import exact_norm, exact_unit
 from hypothesis import example, given
 from hypothesis import strategies as st
 import numpy as np

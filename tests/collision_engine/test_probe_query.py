@@ -6,7 +6,7 @@ distance is its height above it, and the box probe's deepest point is a corner o
 
 import math
 
-from ground_truth import scene_path
+from ground_truth.distances import scene_path
 import numpy as np
 import pytest
 

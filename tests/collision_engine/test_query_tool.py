@@ -9,9 +9,9 @@ polytope truth. Every case within 1e-9 m.
 
 from itertools import product
 
-from ground_truth import (box_signed_distance, cylinder_signed_distance, mesh_signed_distance,
-                          outward_hull, polytope_pair_distance, scene_path,
-                          tool_poses_near_surface)
+from ground_truth.distances import (box_signed_distance, cylinder_signed_distance,
+                                    mesh_signed_distance, outward_hull, polytope_pair_distance,
+                                    scene_path, tool_poses_near_surface)
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation

@@ -8,10 +8,10 @@ import subprocess
 import sys
 import textwrap
 
-from ground_truth import (box_signed_distance, capsule_signed_distance,
-                          cylinder_signed_distance, exact_norm, exact_unit, hand_mesh_path,
-                          mesh_signed_distance, sample_near_surface, scene_path,
-                          sphere_signed_distance)
+from ground_truth.distances import (box_signed_distance, capsule_signed_distance,
+                                    cylinder_signed_distance, exact_norm, exact_unit,
+                                    hand_mesh_path, mesh_signed_distance, sample_near_surface,
+                                    scene_path, sphere_signed_distance)
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation

@@ -7,7 +7,7 @@ import sys
 import textwrap
 
 from fuzzing import examples
-from ground_truth import scene_path
+from ground_truth.distances import scene_path
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np

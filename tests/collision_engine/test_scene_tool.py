@@ -3,7 +3,7 @@
 from pathlib import Path
 import textwrap
 
-from ground_truth import scene_path
+from ground_truth.distances import scene_path
 import numpy as np
 import pytest
 

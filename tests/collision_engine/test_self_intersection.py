@@ -1,7 +1,7 @@
 """The compiled self-intersection check, against linear programming on triangle pairs."""
 
 from fuzzing import examples
-from ground_truth import triangles_meet
+from ground_truth.distances import triangles_meet
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays

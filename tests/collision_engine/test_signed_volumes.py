@@ -6,7 +6,7 @@ enumerating every face, edge and vertex with a least-squares affine projection
 """
 
 from fuzzing import examples
-from ground_truth import simplex_distance
+from ground_truth.distances import simplex_distance
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays

@@ -5,8 +5,8 @@ from itertools import product
 import math
 
 from fuzzing import examples
-from ground_truth import (box_signed_distance, capsule_signed_distance,
-                          cylinder_signed_distance, sphere_signed_distance)
+from ground_truth.distances import (box_signed_distance, capsule_signed_distance,
+                                    cylinder_signed_distance, sphere_signed_distance)
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays

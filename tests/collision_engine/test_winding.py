@@ -1,6 +1,6 @@
 """The compiled winding number, against ground_truth's numpy one and the brute-force sign."""
 
-from ground_truth import hand_mesh_path, mesh_signed_distance, winding_number as truth
+from ground_truth.distances import hand_mesh_path, mesh_signed_distance, winding_number as truth
 import numpy as np
 import pytest
 

@@ -25,7 +25,7 @@ def test_exports_resolve_and_nothing_heavy_is_imported():
 
 
 def test_the_virtual_wall_harness_is_not_in_the_package():
-    """The closed-loop wall simulation is a test harness (``tests/virtual_wall.py``)."""
+    """The closed-loop wall simulation is a test harness (``ground_truth/virtual_wall.py``)."""
     probe = 'import importlib.util; print(importlib.util.find_spec("force_renderer.virtual_wall"))'
     result = subprocess.run([sys.executable, '-c', probe], capture_output=True, text=True,
                             check=True, cwd='/')

@@ -1,8 +1,8 @@
 """Passivity: the Colgate bound, the observer's bookkeeping, and the closed-loop guarantee."""
 
+from ground_truth.virtual_wall import Device, HalfSpace, OperatorHand, simulate
 import numpy as np
 import pytest
-from virtual_wall import Device, HalfSpace, OperatorHand, simulate
 
 from force_renderer.contact import Contact
 from force_renderer.errors import ForceRendererError

@@ -4,11 +4,11 @@ import math
 
 from analytic_fields import Box
 from fuzzing import examples
+from ground_truth.virtual_wall import Device, HalfSpace, OperatorHand, ServoTiming, simulate
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
-from virtual_wall import Device, HalfSpace, OperatorHand, ServoTiming, simulate
 
 from force_renderer.contact import (Contact, STATUS_INVALID_INPUT, STATUS_NO_OBJECT,
                                     STATUS_NOT_CONVERGED)

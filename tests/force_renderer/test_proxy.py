@@ -1,10 +1,10 @@
 """God-object proxy: it stays on the surface it entered, so the force never flips."""
 
 from analytic_fields import Box, contact_with, Sphere, Union
-from ground_truth import angle_between
+from ground_truth.distances import angle_between
+from ground_truth.virtual_wall import Device, OperatorHand, simulate
 import numpy as np
 import pytest
-from virtual_wall import Device, OperatorHand, simulate
 
 from force_renderer.errors import ForceRendererError
 from force_renderer.pipeline import ForcePipeline

@@ -4,7 +4,7 @@ import itertools
 
 from analytic_fields import Box, contact_with
 from fuzzing import examples
-from ground_truth import angle_between
+from ground_truth.distances import angle_between
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np

@@ -3,9 +3,9 @@
 import subprocess
 import sys
 
+from ground_truth.wand import matrix_from_quaternion, rotation_x, rotation_z
 import numpy as np
 import pytest
-from wand_ground_truth import matrix_from_quaternion, rotation_x, rotation_z
 
 from haptic_wand_driver import device
 from haptic_wand_driver.device import (

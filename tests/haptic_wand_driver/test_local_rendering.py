@@ -10,10 +10,10 @@ miniature). Contacts are counted as the report counts them (a lift under 0.1 mm 
 """
 import math
 
+from bench.taps import tap
 from contact_model_fields import fields, plane
 import numpy as np
 import pytest
-from taps import tap
 
 from haptic_contract.contact_model import ContactModel, Kind
 from haptic_wand_driver.local_rendering import LocalRenderer, MAX_DAMPING_PER_MASS

@@ -1,12 +1,12 @@
 """Roll/yaw quaternions and the roll-yaw Jacobian against rotation matrices built independently."""
 
 from fuzzing import examples
+from ground_truth.wand import (matrix_from_quaternion, quaternion_from_matrix, rotation_x,
+                               rotation_y, rotation_z)
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
-from wand_ground_truth import (
-    matrix_from_quaternion, quaternion_from_matrix, rotation_x, rotation_y, rotation_z)
 
 from haptic_contract.wand import (
     PitchError, quaternion_from_roll_yaw, roll_yaw_from_quaternion, roll_yaw_jacobian)

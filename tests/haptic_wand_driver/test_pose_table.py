@@ -1,8 +1,8 @@
 """Pose tables and their CSV form: round trip, orientation columns, and errors naming the line."""
 
+from ground_truth.wand import quaternion_from_matrix, rotation_x, rotation_z
 import numpy as np
 import pytest
-from wand_ground_truth import quaternion_from_matrix, rotation_x, rotation_z
 
 from haptic_wand_driver.pose_table import PoseFileError, PoseTable, read_pose_csv, write_pose_csv
 

@@ -1,10 +1,10 @@
 """ReplayDevice: CSV and rosbag2 (mcap, sqlite3) round trips, playback options, bad recordings."""
 
+from ground_truth.wand import quaternion_from_matrix, rotation_x, rotation_y, rotation_z
 import numpy as np
 import pytest
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import get_typestore, Stores
-from wand_ground_truth import quaternion_from_matrix, rotation_x, rotation_y, rotation_z
 
 from haptic_wand_driver.pose_table import PoseTable, write_pose_csv
 from haptic_wand_driver.replay import ReplayDevice, ReplayError

@@ -1,8 +1,8 @@
 """SimulatedWand: free motion, resting on a wall, energy, workspace stops, determinism, clock."""
 
+from ground_truth.wand import HalfSpace, rotation_z, wall_force
 import numpy as np
 import pytest
-from wand_ground_truth import HalfSpace, rotation_z, wall_force
 
 from haptic_wand_driver.device import DeviceClosedError, DeviceLimits, Workspace
 from haptic_wand_driver.simulated import SimulatedWand, SimulatedWandConfig

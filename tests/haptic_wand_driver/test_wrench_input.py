@@ -3,11 +3,11 @@
 import math
 
 from fuzzing import examples
+from ground_truth.wand import rotation_z
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
-from wand_ground_truth import rotation_z
 
 from haptic_contract.plane_law import saturate, saturate_components
 from haptic_wand_driver.wrench_input import WrenchCommand

@@ -7,7 +7,7 @@ face's cell centres, with no code of the toolkit's.
 import math
 
 from domains import session_domain_id
-from ground_truth import scene_path
+from ground_truth.distances import scene_path
 from loop_client import MAX_POSES, TIMELY, WATCHDOG
 import numpy as np
 import pytest

@@ -3,11 +3,11 @@
 from functools import lru_cache
 
 from fuzzing import examples
+from ground_truth.wand import Box, Cylinder, HalfSpace, wall_force
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
-from wand_ground_truth import Box, Cylinder, HalfSpace, wall_force
 
 from haptic_wand_driver.device import Workspace
 from haptic_wand_driver.simulated import SimulatedWand

@@ -1,6 +1,6 @@
 """One scene serves both: the anatomy changes no force or distance, and is what the image sees."""
 
-from ground_truth import scene_path
+from ground_truth.distances import scene_path
 import numpy as np
 import trimesh
 

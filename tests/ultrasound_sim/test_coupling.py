@@ -7,7 +7,7 @@ theta about x on a flat slab, the face's point at y is y sin(theta) above it.
 
 import math
 
-from ground_truth import scene_path
+from ground_truth.distances import scene_path
 import numpy as np
 import pytest
 

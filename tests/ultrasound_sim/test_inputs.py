@@ -1,7 +1,7 @@
 """Bad input gets a clear error that names the field, before any frame is made."""
 
-from ground_truth import scene_path
-from imaging_scenes import block_scene
+from ground_truth.distances import scene_path
+from ground_truth.imaging_scenes import block_scene
 import numpy as np
 import pytest
 

@@ -9,7 +9,7 @@ import os
 import subprocess
 import sys
 
-from imaging_scenes import block_scene, HALF_TURN_Y
+from ground_truth.imaging_scenes import block_scene, HALF_TURN_Y
 import numpy as np
 import pytest
 from scipy import ndimage

@@ -8,8 +8,8 @@ pressed 3 mm in, every scanline is coupled and the tissue shows.
 from dataclasses import fields
 import math
 
-from ground_truth import scene_path
-from imaging_scenes import block_scene
+from ground_truth.distances import scene_path
+from ground_truth.imaging_scenes import block_scene
 import numpy as np
 import pytest
 

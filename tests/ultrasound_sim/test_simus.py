@@ -1,6 +1,6 @@
 """A point target's axial and lateral widths within 20 % of SIMUS's, for the same probe."""
 
-from psf_reference import model_psf, PROBES, simus_psf
+from ground_truth.psf_reference import model_psf, PROBES, simus_psf
 import pytest
 
 DEPTH = 0.02  # m

@@ -10,7 +10,7 @@ dynamic range over 255.
 
 import math
 
-from imaging_scenes import block_scene, HALF_TURN_Y, straight_down, TOP
+from ground_truth.imaging_scenes import block_scene, HALF_TURN_Y, straight_down, TOP
 import numpy as np
 import pytest
 from scipy import ndimage

@@ -6,12 +6,8 @@ a telerobotic ultrasound system*); the report prints them beside ours, labelled 
 
 from dataclasses import dataclass
 from pathlib import Path
-import sys
 
-import collision_engine  # noqa: F401,I100 -- before tests/ joins sys.path (a namesake folder)
-
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
-import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
+from ground_truth import distances
 
 __all__ = ['EXPERIMENTS', 'Experiment', 'PAPER', 'PAPER_TABLE_3', 'PaperReported']
 
@@ -73,12 +69,12 @@ class Experiment:
     @property
     def scene_file(self) -> Path:
         """The shipped scene file the demo ran (the exact object)."""
-        return ground_truth.scene_path(self.scene)
+        return distances.scene_path(self.scene)
 
     @property
     def paper_scene_file(self) -> Path:
         """The shipped scene file with the paper's STL placed as the exact object."""
-        return ground_truth.scene_path(self.paper_scene)
+        return distances.scene_path(self.paper_scene)
 
 
 EXPERIMENTS = {

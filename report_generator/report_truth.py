@@ -1,22 +1,18 @@
 """The exact signed distance and outward normal along each recorded tip path.
 
-From ``tests/ground_truth.py``, which shares no code with the engine: analytic for the box and
+From ``ground_truth/distances.py``, which shares no code with the engine: analytic for the box and
 the cylinder, brute force with a winding-number sign for the hand.
 """
 
 from dataclasses import dataclass
-from pathlib import Path
-import sys
 
-import bench_collision
+from bench import bench_collision
+from ground_truth import distances
 import numpy as np
-from report_experiments import Experiment
+from report_generator.report_experiments import Experiment
 
 from collision_engine import read_scene
 from collision_engine.mesh_io import load_mesh
-
-sys.path.append(str(Path(__file__).resolve().parents[1] / 'tests'))
-import ground_truth  # noqa: E402,I100,I202 -- needs tests/ on the path
 
 __all__ = ['Truth', 'exact_truth']
 
@@ -44,16 +40,16 @@ def exact_truth(experiment: Experiment, points: np.ndarray) -> Truth:
     shape = spec.shape
     if hasattr(shape, 'file'):
         mesh = load_mesh(shape.file, scale=shape.scale, check_self_intersection=False)
-        signed, closest = ground_truth.mesh_signed_distance(local(points), mesh.vertices,
-                                                            mesh.faces)
+        signed, closest = distances.mesh_signed_distance(local(points), mesh.vertices,
+                                                         mesh.faces)
         with np.errstate(invalid='ignore', divide='ignore'):
             normal = (local(points) - closest) / signed[:, None]
         return Truth(signed, normal @ rotation.T)
     if hasattr(shape, 'size'):
         def field(world):
-            return ground_truth.box_signed_distance(local(world), shape.size)
+            return distances.box_signed_distance(local(world), shape.size)
     else:
         def field(world):
-            return ground_truth.cylinder_signed_distance(local(world), shape.radius,
-                                                         shape.height)
+            return distances.cylinder_signed_distance(local(world), shape.radius,
+                                                      shape.height)
     return Truth(field(points), bench_collision._outward(field, points))

@@ -12,7 +12,7 @@ maximum along depth and across, through the peak, interpolated between samples.
 
 import math
 
-from imaging_scenes import block_scene, HALF_TURN_Y, TOP
+from ground_truth.imaging_scenes import block_scene, HALF_TURN_Y, TOP
 import numpy as np
 
 from ultrasound_sim import Imager, load_anatomy, ProbeSettings

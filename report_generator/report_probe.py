@@ -1,6 +1,6 @@
 """The probe experiments: a linear probe's face swept over a flat slab and the patient phantom.
 
-The demo's ``probe-flat`` and ``probe-phantom`` runs (``haptic_wand_driver.scripts.probe_sweep``:
+The demo's ``probe-flat`` and ``probe-phantom`` runs (``simulated_operator.scripts.probe_sweep``:
 pressed, rolled +-20 degrees, slid and yawed) are read from their bags. On the flat slab the
 torque about the wand's roll axis has an analytic value: for a face of length L along its roll
 lever, rolled by theta with the tip a depth d under the plane of stiffness k, every point y of
@@ -21,7 +21,7 @@ import math
 from pathlib import Path
 
 import numpy as np
-from report_format import format_number, markdown_table
+from report_generator.report_format import format_number, markdown_table
 
 from collision_engine import read_scene
 from haptic_bringup.session import read_session
@@ -168,7 +168,7 @@ def probe_section(findings: ProbeFindings) -> str:
 
 def probe_figure(findings: ProbeFindings, path: Path) -> None:
     """Draw (a) tilt, (b) force and (c) torque against time, and (d) torque against roll."""
-    from report_figures import _pyplot, _save
+    from report_generator.report_figures import _pyplot, _save
 
     plt = _pyplot()
     figure, axes = plt.subplots(2, 2, figsize=(12.0, 7.5))

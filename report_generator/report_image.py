@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from report_format import markdown_table
+from report_generator.report_format import markdown_table
 
 from haptic_bringup.session import Frames, read_frames, read_vectors
 
@@ -102,7 +102,7 @@ def _frame_panel(axes, scan: ImageScan, index: int) -> None:
 
 def image_figures(scan: ImageScan, out: Path) -> list[str]:
     """Draw the scan's figure and the pressure strip into ``out``; return their file names."""
-    from report_figures import _pyplot, _save
+    from report_generator.report_figures import _pyplot, _save
 
     plt = _pyplot()
     along, pressed = scan_frames(scan), pressure_frames(scan)

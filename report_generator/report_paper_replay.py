@@ -7,8 +7,8 @@ twists, so its distance, flag and force can be set sample by sample beside ours.
 from dataclasses import dataclass
 
 import numpy as np
-from paper_method import PaperMethod, stl_vertex_rows
-from report_experiments import Experiment
+from report_generator.paper_method import PaperMethod, stl_vertex_rows
+from report_generator.report_experiments import Experiment
 
 from collision_engine import read_scene
 

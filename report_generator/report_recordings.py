@@ -10,8 +10,8 @@ import math
 from pathlib import Path
 
 import numpy as np
-from report_experiments import Experiment
-from report_format import format_utc
+from report_generator.report_experiments import Experiment
+from report_generator.report_format import format_utc
 
 from haptic_bringup.contacts import contact_intervals
 from haptic_bringup.session import published_counts, PUBLISHERS, read_session, topic_counts

@@ -6,8 +6,8 @@ import platform
 import subprocess
 import time
 
-import machine as bench_machine
-from report_format import format_utc
+from bench import machine as bench_machine
+from report_generator.report_format import format_utc
 
 __all__ = ['OUTPUTS', 'VERSIONED', 'provenance']
 

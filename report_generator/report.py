@@ -1,11 +1,11 @@
 """The report: the paper's three experiments, reproduced over ROS 2, measured against exact truth.
 
-    .venv/bin/python bench/report.py [--demo-dir build/demo] [--results bench/results]
-                                     [--out report]
+    .venv/bin/python report_generator/report.py [--demo-dir build/demo] [--results bench/results]
+                                                [--out report]
 
 Reads the bags ``demo`` recorded (the simulated wand tapping the hand, the cylinder and the
 cuboid over ROS 2, the probe, the telerobotic scan), computes the exact signed distance and
-outward normal along each recorded tip trajectory (``tests/ground_truth.py``: analytic for the
+outward normal along each recorded tip trajectory (``ground_truth/distances.py``: analytic for the
 box and the cylinder, brute force with a winding-number sign for the hand; it shares no code
 with the engine), replays the paper's own collision code (``paper_method.py``, on the paper's
 STL objects) along the same trajectories, and writes ``README.md`` with PNG figures into
@@ -35,19 +35,19 @@ from pathlib import Path
 import sys
 import time
 
-from report_benchmarks import copy_teleop_figure, stored_results, teleop_demo_row
-from report_document import Findings, readme
-from report_experiments import EXPERIMENTS
-from report_figures import (error_time_figure, experiment_figure, headline_figure, sweep_figure,
-                            tradeoff_figure)
-from report_image import image_figures, read_image_scan
-from report_metrics import measure
-from report_paper_replay import replay_paper
-from report_probe import probe_figure, read_probe_runs
-from report_provenance import provenance
-from report_recordings import control_contacts, read_recording, typestore
-from report_truth import exact_truth
-import result_files
+from bench import result_files
+from report_generator.report_benchmarks import copy_teleop_figure, stored_results, teleop_demo_row
+from report_generator.report_document import Findings, readme
+from report_generator.report_experiments import EXPERIMENTS
+from report_generator.report_figures import (error_time_figure, experiment_figure, headline_figure,
+                                             sweep_figure, tradeoff_figure)
+from report_generator.report_image import image_figures, read_image_scan
+from report_generator.report_metrics import measure
+from report_generator.report_paper_replay import replay_paper
+from report_generator.report_probe import probe_figure, read_probe_runs
+from report_generator.report_provenance import provenance
+from report_generator.report_recordings import control_contacts, read_recording, typestore
+from report_generator.report_truth import exact_truth
 
 __all__ = ['STAGES', 'build', 'main']
 

@@ -9,11 +9,10 @@ patient phantom, is read from the demo's bag here too, beside the benchmarks' ro
 from pathlib import Path
 import shutil
 
-from extreme_cases import ExtremeRow
-import result_files
-from run_all import BENCHMARKS
-from stiffness_sweep import SweepRow
-import teleop_scan
+from bench import result_files, teleop_scan
+from bench.extreme_cases import ExtremeRow
+from bench.run_all import BENCHMARKS
+from bench.stiffness_sweep import SweepRow
 
 __all__ = ['STORED', 'TELEOP_DEMO_DELAY', 'TELEOP_FIGURE', 'copy_teleop_figure', 'stored_results',
            'teleop_demo_row']

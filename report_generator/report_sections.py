@@ -7,16 +7,17 @@ measured. ``report_document`` puts the sections in order with the prose around t
 import math
 from pathlib import Path
 
+from bench import stiffness_sweep
+from bench.teleop_load import verdict
 import numpy as np
-from report_experiments import Experiment, EXPERIMENTS, PAPER, PAPER_TABLE_3
-from report_format import format_length, format_number, markdown_table
-from report_metrics import (angle_stats, angles_to_normal, FALSE_ERROR, FELT_FORCE, MAX_ANGLE,
-                            Measures, SIGN_FLOOR, STRONG_FORCE)
-from report_paper_replay import PaperReplay
-from report_recordings import NO_FORCE_RUN, Recording
-from report_truth import Truth
-import stiffness_sweep
-from teleop_load import verdict
+from report_generator.report_experiments import Experiment, EXPERIMENTS, PAPER, PAPER_TABLE_3
+from report_generator.report_format import format_length, format_number, markdown_table
+from report_generator.report_metrics import (angle_stats, angles_to_normal, FALSE_ERROR,
+                                             FELT_FORCE, MAX_ANGLE, Measures, SIGN_FLOOR,
+                                             STRONG_FORCE)
+from report_generator.report_paper_replay import PaperReplay
+from report_generator.report_recordings import NO_FORCE_RUN, Recording
+from report_generator.report_truth import Truth
 
 from collision_engine import read_scene
 from collision_engine.mesh_io import load_mesh
@@ -34,8 +35,8 @@ def provenance_section(info: dict, recordings: dict, argv: list) -> str:
     versions = ', '.join(f'{k} {v}' for k, v in info['versions'].items())
     bags = ', '.join(f'{n} {r.recorded_at}' for n, r in recordings.items())
     return '\n'.join([
-        f'- **Made** {info["date"]} by `python bench/report.py {" ".join(argv)}`, commit '
-        f'`{info["commit"]}`',
+        f'- **Made** {info["date"]} by `python report_generator/report.py {" ".join(argv)}`, '
+        f'commit `{info["commit"]}`',
         f'- **Machine** {info["cpu"]}, {info["cores"]} cores, {info["platform"]}; Python '
         f'{info["python"]}; load average {" / ".join(f"{v:.1f}" for v in info["load"])}',
         f'- **Versions** {versions}',
@@ -68,9 +69,9 @@ How to read it:
 - **Error** is the answer minus the exact signed distance at the same tip position (negative
   inside), over every answered pose of the 10 s run. *Ours* is what the collision engine
   published during the run, read from the bag. *The paper's method* is the paper's own MATLAB
-  collision code, re-implemented line by line (`bench/paper_method.py`), run on the same tip
-  positions against the paper's STL object placed as ours: its distance is unsigned, so it is
-  signed here by its own collision flag (negative when the flag is set), the reading most
+  collision code, re-implemented line by line (`report_generator/paper_method.py`), run on the
+  same tip positions against the paper's STL object placed as ours: its distance is unsigned,
+  so it is signed here by its own collision flag (negative when the flag is set), the reading most
   favourable to it. *Paper (reported)* is the number printed in the paper, for its own runs;
   for the cylinder and the cuboid its text gives that average over its miscalculated instants
   only, so it compares with a *max* here more than with a mean.
@@ -87,7 +88,8 @@ How to read it:
   on). *The paper's law* is F = (r/|r|) k dist - kd v with r = tip - centroid of the STL's
   vertex rows, its distance and flag from its code, v the recorded twist.
 - The exact truth: analytic for the box and the cylinder, brute force over every triangle with
-  a winding-number sign for the hand (`tests/ground_truth.py`, no code shared with the engine)."""
+  a winding-number sign for the hand (`ground_truth/distances.py`, no code shared with the
+  engine)."""
 
 
 def _worst(angles: np.ndarray, time: np.ndarray, force: np.ndarray) -> str:
@@ -264,7 +266,7 @@ def tradeoff_section(rows: list[dict]) -> str:
 
 def loop_section(comparisons: list[dict]) -> str:
     """Tabulate the loop against its floor: ratios, the loop's own figures, the targets."""
-    import bench_loop
+    from bench import bench_loop
 
     table = []
     for c in comparisons:

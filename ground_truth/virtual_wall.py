@@ -11,11 +11,9 @@ Times are counted in whole `substep`s internally, so events never drift. Everyth
 deterministic given `seed`. Sign convention of `port_energy`: as in `force_renderer.passivity`
 (energy absorbed by the rendering; positive means passive).
 
-It lives in `tests/`, not in the `force_renderer` package: it is a test harness, and nothing
-that runs the loop uses it. Most of its users are tests (the stability tests of the pipeline,
-the passivity controller and the proxy), which find it as they find `ground_truth.py`, since
-`tests/conftest.py` puts `tests/` on the path; `bench/stiffness_sweep.py` adds `tests/` to its
-path for it as the other bench scripts do for `ground_truth`.
+It lives in `ground_truth`, not in the `force_renderer` package: it is a test harness, and
+nothing that runs the loop uses it. Its users are the stability tests of the pipeline, the
+passivity controller and the proxy, and `bench/stiffness_sweep.py`.
 """
 
 from collections import deque

@@ -8,9 +8,9 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from report_paper_replay import PaperReplay
-from report_recordings import CONTACT_SAMPLES, Recording
-from report_truth import Truth
+from report_generator.report_paper_replay import PaperReplay
+from report_generator.report_recordings import CONTACT_SAMPLES, Recording
+from report_generator.report_truth import Truth
 
 from haptic_bringup.contacts import FELT_FORCE, MIN_FORCE
 

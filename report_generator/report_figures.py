@@ -7,14 +7,14 @@ measures anything itself.
 import io
 from pathlib import Path
 
+from bench import stiffness_sweep
 import numpy as np
-from report_experiments import EXPERIMENTS, PAPER
-from report_format import format_length
-from report_metrics import angle_stats, FALSE_ERROR, FELT_FORCE, Measures
-from report_paper_replay import PaperReplay
-from report_recordings import Recording
-from report_truth import Truth
-import stiffness_sweep
+from report_generator.report_experiments import EXPERIMENTS, PAPER
+from report_generator.report_format import format_length
+from report_generator.report_metrics import angle_stats, FALSE_ERROR, FELT_FORCE, Measures
+from report_generator.report_paper_replay import PaperReplay
+from report_generator.report_recordings import Recording
+from report_generator.report_truth import Truth
 
 __all__ = ['ERROR_FLOOR', 'error_time_figure', 'experiment_figure', 'headline_figure',
            'sweep_figure', 'tradeoff_figure']

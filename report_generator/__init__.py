@@ -1,0 +1,1 @@
+"""The report: ``python report_generator/report.py`` (``make report``) writes ``report/``."""
