@@ -18,13 +18,13 @@ import collections
 import time
 from typing import Sequence
 
-from geometry_msgs.msg import PoseStamped
 import numpy as np
 from rclpy.node import Node
 from sensor_msgs.msg import Image
 
+from haptic_contract.graph import PROBE_IMAGE, ROBOT_TCP_POSE
+from haptic_contract.streams import FRAME, POSE, POSE_ORIENTATION, POSE_POSITION, stamp_ns
 from haptic_util.callback_errors import log_callback_error
-from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
 from haptic_util.newest import NewestMessage
@@ -41,7 +41,6 @@ from ultrasound_sim.probe_imaging import ProbeImaging
 
 __all__ = ['ProbeImagerNode', 'main']
 
-POSE = MessageCodec(PoseStamped)
 RECENT_FRAMES = 300  # the report's frame times: about the last 10 s at 30 Hz
 
 
@@ -65,8 +64,8 @@ class ProbeImagerNode(Node):
         # (frame wall, frame CPU, pose stamp to publication) s, per frame
         self._times = collections.deque(maxlen=RECENT_FRAMES)
         self._clock = self.get_clock()
-        self._publisher = self.create_publisher(Image, 'probe/image', FRAME_QOS)
-        self._poses = NewestMessage(self, POSE, 'robot/tcp_pose', refused=self._refused)
+        self._publisher = self.create_publisher(Image, PROBE_IMAGE, FRAME_QOS)
+        self._poses = NewestMessage(self, POSE, ROBOT_TCP_POSE, refused=self._refused)
         # Frames are made in one thread, which yields the cores, and sent from another, which
         # does not: the EventsExecutor has no guard condition to wake its own thread with.
         self._sender = LatestWorker(self.publish_frame, on_error=log_callback_error,
@@ -99,20 +98,20 @@ class ProbeImagerNode(Node):
         The worker may be starved for the cores: it never holds the middleware's locks.
         """
         started, cpu = time.perf_counter(), time.thread_time()
-        imaged = self.imaging.image(pose[2], pose[3:6], pose[6:10])
+        imaged = self.imaging.image(pose[FRAME], pose[POSE_POSITION], pose[POSE_ORIENTATION])
         if imaged.reason:
             self._dark.add('dark frame', imaged.reason)
-        stamp_ns = pose[0] * 1_000_000_000 + pose[1]
-        frame = image_cdr(stamp_ns, self.params.probe_frame, imaged.image)
-        self._sender.offer((frame, stamp_ns, time.perf_counter() - started,
+        stamp = stamp_ns(pose)
+        frame = image_cdr(stamp, self.params.probe_frame, imaged.image)
+        self._sender.offer((frame, stamp, time.perf_counter() - started,
                             time.thread_time() - cpu))
 
     def publish_frame(self, made: tuple) -> None:
         """Publish a frame made (in the sender's thread)."""
-        frame, stamp_ns, wall, cpu = made
+        frame, stamp, wall, cpu = made
         self._publisher.publish(frame)
         self._published += 1
-        self._times.append((wall, cpu, 1e-9 * (clock_ns(self._clock) - stamp_ns)))
+        self._times.append((wall, cpu, 1e-9 * (clock_ns(self._clock) - stamp)))
 
     def report(self) -> Report:
         self._dark.log_new(self.get_logger().warn)
