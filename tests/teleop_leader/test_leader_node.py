@@ -1,19 +1,26 @@
 """The leader node answers each wand pose once, when its twist (same stamp) is in, in either order.
 
 Within one process the driver's twist reaches the leader before its pose (``intra_process``
-delivers in publishing order); over DDS the two may arrive either way round.
+delivers in publishing order); over DDS the two may arrive either way round. No pose is answered
+before the robot is found, so the driver's probe of the loop waits for it.
 """
+import numpy as np
 import pytest
 import rclpy
 from rclpy.context import Context
 
+from haptic_contract.teleop import Feedback
+from haptic_contract.teleop_fields import feedback_fields
 from teleop_leader.leader_node import LeaderNode
 
 STAMP = (100, 500)
+WAND = (0.01, 0.02, 0.03)  # [m] the pose's position
+TCP = np.array([0.3, -0.1, 0.2])  # [m] the robot's, in its first feedback
+PROBE = (99, 0)  # the stamp of the driver's probe before the robot is found
 
 
 def pose(stamp=STAMP, frame='world'):
-    return (*stamp, frame, 0.01, 0.02, 0.03, 0.0, 0.0, 0.0, 1.0)
+    return (*stamp, frame, *WAND, 0.0, 0.0, 0.0, 1.0)
 
 
 def twist(stamp=STAMP):
@@ -28,6 +35,15 @@ class Sent:
 
     def publish(self, values):
         self.messages.append(values)
+
+
+def robot_found(node):
+    """Probe ``node`` with the wand at ``WAND``, then give it the first feedback: the robot at
+    ``TCP``, touching nothing."""
+    node.on_twist(twist(PROBE))
+    node.on_pose(pose(PROBE))
+    node.on_feedback(feedback_fields(Feedback(node._now(), 0.0, 0.0, np.zeros(3), TCP, 0.0, None,
+                                              session=7, sequence=1), 'base_link'))
 
 
 @pytest.fixture
@@ -45,6 +61,7 @@ def leader():
 
 @pytest.mark.parametrize('order', ['pose first', 'twist first'])
 def test_a_pose_is_answered_once_its_twist_is_in_whichever_comes_first(leader, order):
+    robot_found(leader)
     if order == 'pose first':
         leader.on_pose(pose())
         assert leader._answer_pub.messages == []  # waits for the twist
@@ -55,14 +72,29 @@ def test_a_pose_is_answered_once_its_twist_is_in_whichever_comes_first(leader, o
         leader.on_pose(pose())
     [answer] = leader._answer_pub.messages
     assert answer[:3] == (*STAMP, 'world')
-    assert answer[3:] == (0.0,) * 6  # no robot yet: zero force
+    assert len(answer) == 9 and np.all(np.isfinite(answer[3:]))  # the coupling's wrench
     leader.on_twist(twist())  # the same twist again answers nothing more
     assert len(leader._answer_pub.messages) == 1
 
 
 def test_a_twist_of_another_stamp_answers_nothing(leader):
+    robot_found(leader)
     leader.on_twist(twist((100, 400)))
     leader.on_pose(pose())
     assert leader._answer_pub.messages == []
     leader.on_twist(twist())
     assert len(leader._answer_pub.messages) == 1
+
+
+def test_no_pose_is_answered_before_the_robot_is_found_and_the_session_anchors_the_wand_there(
+        leader):
+    leader.on_twist(twist(PROBE))
+    leader.on_pose(pose(PROBE))  # the driver's probe, the wand at rest
+    assert leader._answer_pub.messages == [] and leader._command_pub.messages == []
+    robot_found(leader)
+    leader.on_twist(twist())
+    leader.on_pose(pose())  # the same place: the robot's target is where the robot is
+    [answer] = leader._answer_pub.messages
+    assert answer[:3] == (*STAMP, 'world')
+    [command] = leader._command_pub.messages
+    assert np.allclose(command[5:8], TCP)

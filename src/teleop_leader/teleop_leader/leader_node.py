@@ -5,8 +5,12 @@ answers the driver at once from the newest ``teleop/feedback`` (``Leader``): ``w
 ``direct`` and ``tdpa`` (the driver applies it), ``wand/contact_model`` for ``model`` (the driver
 renders it at its servo rate). Each answer carries the pose's stamp and a short lifetime, so a
 leader that dies leaves no force behind. The session starts at the first feedback, whose TCP is
-the robot's anchor. ``teleop/clutch`` (Bool, true: engaged) re-centres the wand without moving
-the robot.
+the robot's anchor, and the wand's latest pose is the wand's. No pose is answered before it: the
+driver starts its experiment at the first answer to its probe, and a scripted hand that set off
+before the robot was found pressed from an anchor it had already left (the first feedback came
+2.2-2.4 s after the scan began over the gateways, the wand 18-20 mm down: the probe tracked that
+far above it, and the patient was pressed 5.1 N instead of 7.2). ``teleop/clutch`` (Bool, true:
+engaged) re-centres the wand without moving the robot.
 """
 import math
 from typing import Sequence
@@ -128,8 +132,8 @@ class LeaderNode(Node):
             self._refused.add('wand pose or twist not finite')
             self._answer(stamp_ns, None)
             return
-        if self.leader is None:
-            self._answer(stamp_ns, None)
+        if self.leader is None:  # unanswered: the driver's probe of the loop waits for the robot
+            self._unknown += 1
             return
         period = (stamp_ns - self._last_stamp_ns) * 1e-9 if self._last_stamp_ns else 1e-3
         self._last_stamp_ns = stamp_ns
