@@ -30,12 +30,7 @@ from haptic_util.qos import HAPTIC_STREAM_QOS
 
 MAX_PATIENT_FORCE = 20.0  # [N] the follower's and the robot's default
 POSE = MessageCodec(PoseStamped)
-# [N] the patient's force once the scan presses: the attacks start then. The scripted hand
-# presses 7 N, or 5 N when the first contact's model came back with the wand already deep and the
-# leader showed it moved out (the price of passivity, teleop_leader.leader; 5.1-5.3 N in four runs
-# at 100 ms here): a CI run at load 7 never saw 5 N and never started. 1 N above the 3 N every
-# attack's window must keep.
-PRESSING = 4.0
+PRESSING = 5.0  # [N] the patient's force once the scan presses: the attacks start then
 
 
 class Stranger:
