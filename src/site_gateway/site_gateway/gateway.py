@@ -35,7 +35,6 @@ from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.validate_full_topic_name import validate_full_topic_name
 import zenoh
 
-from haptic_contract.graph import FRAME_TOPICS, RELIABLE_CROSSINGS, TO_OPERATOR, TO_REMOTE
 from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
@@ -68,6 +67,8 @@ INSECURE_WARNING = ('INSECURE: plaintext, no authentication and no access contro
                     'only on a network you control end to end; mutual TLS is the default.')
 RELIABLE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                           reliability=ReliabilityPolicy.RELIABLE)
+TELEOP_TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
+TELEOP_TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
 
 
 @dataclass(frozen=True)
@@ -88,13 +89,13 @@ class GatewayParams(LinkStageParams):
     verify_name: bool = parameter(True, "check that the listening site's certificate names "
                                   'the host dialled')
     to_remote: tuple[str, ...] = parameter(
-        TO_REMOTE, "topics the operator site sends, 'topic:pkg/msg/Type'; [''] for none")
+        TELEOP_TO_REMOTE, "topics the operator site sends, 'topic:pkg/msg/Type'; [''] for none")
     to_operator: tuple[str, ...] = parameter(
-        TO_OPERATOR, "topics the remote site sends, 'topic:pkg/msg/Type'; [''] for none")
-    reliable: tuple[str, ...] = parameter(RELIABLE_CROSSINGS, 'topics (of the above) that must '
-                                          "arrive: reliable, blocking; [''] for none")
-    frames: tuple[str, ...] = parameter(FRAME_TOPICS, 'topics (of the above) that are images: '
-                                        "after the streams, dropped when congested; [''] for none")
+        TELEOP_TO_OPERATOR, "topics the remote site sends, 'topic:pkg/msg/Type'; [''] for none")
+    reliable: tuple[str, ...] = parameter(('',), 'topics (of the above) that must arrive: '
+                                          "reliable, blocking; [''] for none")
+    frames: tuple[str, ...] = parameter(('',), 'topics (of the above) that are images: after '
+                                        "the streams, dropped when congested; [''] for none")
     key_prefix: str = parameter('haptic', 'the Zenoh keys of this session start with it')
     lease: float = parameter(LEASE, 'a connection silent this long is closed and opened anew',
                              unit='s', low=0.1, high=60.0)
