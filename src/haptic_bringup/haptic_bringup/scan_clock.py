@@ -6,7 +6,7 @@ force-hold request, a test's link stall) counts from its first pose, not from th
 """
 from contextlib import contextmanager
 import time
-from typing import Callable, Iterator
+from typing import Callable, Iterator, NamedTuple
 
 from geometry_msgs.msg import PoseStamped
 import rclpy
@@ -20,16 +20,11 @@ from haptic_util.qos import HAPTIC_STREAM_QOS
 __all__ = ['FirstPose', 'first_pose', 'site_node', 'wait_for_first_pose']
 
 
-class FirstPose(tuple):
-    """When the first pose came: ``(monotonic, wall)`` clocks (wall as a bag's receive times)."""
+class FirstPose(NamedTuple):
+    """When the first pose came, on both clocks (wall as a bag's receive times)."""
 
-    @property
-    def monotonic(self) -> float:
-        return self[0]
-
-    @property
-    def wall(self) -> float:
-        return self[1]
+    monotonic: float
+    wall: float
 
 
 @contextmanager
@@ -53,7 +48,7 @@ def first_pose(node: Node, executor: SingleThreadedExecutor, timeout: float,
     came = []
     poses = node.create_subscription(
         PoseStamped, WAND_POSE,
-        lambda _: came or came.append(FirstPose((time.monotonic(), time.time()))),
+        lambda _: came or came.append(FirstPose(time.monotonic(), time.time())),
         HAPTIC_STREAM_QOS)
     deadline = time.monotonic() + timeout
     while not (came and also()) and time.monotonic() < deadline:
