@@ -148,6 +148,7 @@ def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dic
     operating = np.ones(count + 1, dtype=bool) if options.ticks is None else np.isin(
         np.arange(count + 1), options.ticks)
     operator_rows, remote_rows, held = [], [], np.nan
+    wrench = ZERO
     state, remote = device.read(0.0), robot.read(0.0)
     for k in range(1, count):
         now = k * TICK
@@ -176,15 +177,21 @@ def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dic
             leader.receive(now, delivery.payload)
         if renderer is not None:
             known, plane = leader.model(now, state.position)
-            if known:
-                answers.taken(now, MODEL_LIFETIME)  # answered as it went out, as in the site
-                renderer.take(_model(now, plane, state.position), answers.deadline)
+            answer = (now, _model(now, plane, state.position)) if known else None
         else:
-            answers.taken(now, MODEL_LIFETIME)
-            force = leader.force(now, state.position, state.linear_velocity, TICK)
-            device.apply(port.control(force, state.position, state.linear_velocity, TICK),
-                         ZERO, until=answers.deadline)
-        answers.sent(now, now)
+            answer = (now, leader.force(now, state.position, state.linear_velocity, TICK))
+        if answer is not None:  # taken as it comes, as in the site
+            answers.taken(answer[0], MODEL_LIFETIME)
+            if renderer is not None:
+                renderer.take(answer[1], answers.deadline, now)
+            else:
+                wrench = port.control(answer[1], state.position, state.linear_velocity, TICK)
+                device.apply(wrench, ZERO, until=answers.deadline)
+        if answers.sent(now, now):  # out and not answered yet: what is held stops holding
+            if renderer is not None:
+                renderer.expire(answers.deadline)
+            else:
+                device.apply(wrench, ZERO, until=answers.deadline)
     operator, remote_table = np.array(operator_rows), np.array(remote_rows)
     return {'time': operator[:, 0], 'wand': operator[:, 1:4], 'felt': operator[:, 4:7],
             'remote_time': remote_table[:, 0], 'patient': remote_table[:, 1:4],

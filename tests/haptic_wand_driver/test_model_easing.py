@@ -78,6 +78,43 @@ def test_a_model_met_after_nothing_was_felt_ramps_in_from_zero():
     assert forces[-1] == 0.0  # nothing was put in: nothing to push back with
 
 
+def lapsed(depth: float, model: ContactModel) -> list:
+    """Press 2 mm in (2 N), let the law lapse while the hand goes to ``depth``, take ``model``.
+
+    Returns the force of each period after, the tip held at ``depth``.
+    """
+    renderer = law(RATE)
+    renderer.take(wall(1000.0), deadline=0.0)
+    for z in np.linspace(0.0005, -0.002, 26):
+        renderer.wrench(-1.0, *at(z), PERIOD)
+    for k, z in enumerate(np.linspace(-0.002, depth, 120)):  # 30 ms of nothing rendered
+        assert renderer.wrench(k * PERIOD, *at(z), PERIOD)[0] == (0.0, 0.0, 0.0)
+    renderer.take(model, math.inf)
+    return [renderer.wrench(0.03 + k * PERIOD, *at(depth), PERIOD)[0][2] for k in range(400)]
+
+
+def test_a_model_after_a_lapse_goes_on_from_the_force_felt_before_it():
+    """The hand sank 12 mm while it felt nothing: it finds the 2 N it left, not a ramp from 0.
+
+    A remote end that never saw the lapse keeps the patient pressed as before; the hand, ramped
+    from zero, sank further and the robot followed it in (ci13). What the planes store is what
+    they stored before the lapse, which the port had absorbed.
+    """
+    forces = lapsed(-0.014, wall(1000.0))
+    assert forces[0] == pytest.approx(2.0, abs=1e-9)
+    assert np.abs(np.diff(forces)).max() <= RATE * PERIOD * (1.0 + 1e-9)
+
+
+def test_a_model_after_a_lapse_pushes_no_more_than_it_does_where_the_hand_now_is():
+    """The hand left the wall during the lapse: no wall follows it out, it ramps in from zero.
+
+    And one it is still 1 mm into, of the same stiffness, starts from its own 1 N.
+    """
+    left, into = lapsed(0.001, wall(1000.0)), lapsed(-0.001, wall(1000.0))
+    assert left[0] == 0.0
+    assert into[0] == pytest.approx(1.0, abs=1e-9)
+
+
 def test_a_model_without_damping_goes_on_from_the_damping_felt_and_eases_it_out():
     """An estimate's damping clamped to zero, met by a hand pressing in at 1 cm/s.
 

@@ -49,7 +49,9 @@ normal, stiffness, damping, tool point). ``bound`` is the planes' shift (m), the
 it was set for, the spring push the planes rendered in the last period (N; 0 when none), the
 factor on their stiffnesses and the sum of those scaled (N/m; 0 when none), the damping added to
 each plane's (N·s/m) and the sum of their dampings with it (N·s/m; 0 when none), then the count
-of planes rendered (0 when none) and their normals, 3 floats each (``BOUND_SIZE`` in all).
+of planes rendered (0 when none) and their normals, 3 floats each, then whether the planes held
+lapsed since they were last rendered (1.0) or not (``LAPSED``; ``BOUND_SIZE`` in all). A lapse
+leaves the rest as the last rendered period left it.
 """
 import math
 from typing import Sequence
@@ -64,7 +66,7 @@ from haptic_wand_driver.model_easing import eased_extra, eased_scale, eased_shif
     total_damping, total_stiffness, turned_normals
 from haptic_wand_driver.port_passivity import bounded_shift, PortPassivity
 
-__all__ = ['BOUND_SIZE', 'DEADLINE', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS',
+__all__ = ['BOUND_SIZE', 'DEADLINE', 'LAPSED', 'LAW_SIZE', 'LocalRenderer', 'MAX_DAMPING_PER_MASS',
            'MODE_NONE', 'MODE_PLANES', 'MODE_WRENCH', 'PLANE_SIZE', 'PLANES_AT', 'SERIAL', 'SINCE',
            'STEP_RATE']
 
@@ -73,7 +75,8 @@ MAX_DAMPING_PER_MASS = 0.5  # x m/T: an explicit damper is stable below 2 m/T
 MODE_NONE, MODE_WRENCH, MODE_PLANES = 0.0, 1.0, 2.0  # what ``packed`` holds
 DEADLINE, SINCE, SERIAL, STEP_RATE, PLANES_AT, PLANE_SIZE = 7, 21, 22, 23, 24, 15
 LAW_SIZE = PLANES_AT + MAX_PLANES * PLANE_SIZE
-BOUND_SIZE = 8 + 3 * MAX_PLANES
+BOUND_SIZE = 9 + 3 * MAX_PLANES
+LAPSED = BOUND_SIZE - 1
 _NOTHING = (None, None, -math.inf)  # (model, wrench, deadline) held
 
 
@@ -165,23 +168,30 @@ class LocalRenderer:
         limit = self.force_limit
         if wrench is not None and time + period <= deadline:
             force, torque = wrench
-            self.bound[2] = self.bound[4] = self.bound[6] = self.bound[7] = 0.0
+            self._forget()
         elif (model is not None and model.kind == Kind.PLANES and time + period <= deadline
                 and model.valid(position)):
             x, y, z = roll_axis(coordinates[4])
             spin = (rates[3] * x, rates[3] * y, rates[3] * z + rates[4])
             limit = min(self.force_limit, model.force_limit)
             shift, rendered = self._shift(model, take, coordinates, velocity, period)
+            self.bound[LAPSED] = 0.0
             force, torque = scaled_model(rendered, float(self.bound[3]),
                                          float(self.bound[5])).wrench(
                 position, velocity, coordinates[3], coordinates[4], spin,
                 self._contact_damping(period), limit, shift)
+        elif model is not None and model.kind == Kind.PLANES and time + period > deadline:
+            self.bound[LAPSED] = 1.0  # what the planes pushed waits for the next model
         else:
-            self.bound[2] = self.bound[4] = self.bound[6] = self.bound[7] = 0.0
+            self._forget()
         force = self.passivity.control(force, position, velocity, period,
                                        time + period > deadline)
         return (saturate_components(force, limit),
                 saturate_components(torque, self.torque_limit))
+
+    def _forget(self) -> None:
+        """Nothing renders planes now: the next model's start from no push."""
+        self.bound[2] = self.bound[4] = self.bound[6] = self.bound[7] = self.bound[LAPSED] = 0.0
 
     def _shift(self, model: ContactModel, take: int, coordinates: Sequence[float],
                velocity: Sequence[float], period: float) -> tuple[float, ContactModel]:
@@ -210,6 +220,8 @@ class LocalRenderer:
             scale = stiff / total if stiff > 0.0 and total > 0.0 else 1.0
             extra = matched_extra(rendered, damped)
             springs = [(d, scale * k) for d, k in springs]
+            if self.bound[LAPSED]:
+                push = min(push, spring_push(springs, 0.0))
             shift = matched_shift(springs, push)
         else:
             held = stored_energy([(d, scale * k) for d, k in rendered.springs(

@@ -28,9 +28,9 @@ import math
 import numpy as np
 
 from haptic_util.jit import jit
-from haptic_wand_driver.local_rendering import (BOUND_SIZE, DEADLINE, LAW_SIZE, MODE_PLANES,
-                                                MODE_WRENCH, PLANE_SIZE, PLANES_AT, SERIAL,
-                                                SINCE, STEP_RATE)
+from haptic_wand_driver.local_rendering import (BOUND_SIZE, DEADLINE, LAPSED, LAW_SIZE,
+                                                MODE_PLANES, MODE_WRENCH, PLANE_SIZE, PLANES_AT,
+                                                SERIAL, SINCE, STEP_RATE)
 from haptic_wand_driver.model_easing import COS_EASED_TURN, EASED_TURN
 from haptic_wand_driver.port_passivity import BOOKS_CLOSE_AFTER
 
@@ -176,6 +176,16 @@ def _matched_shift(depths, stiffnesses, count, push):
 
 
 @jit
+def _push(depths, stiffnesses, count, shift):
+    """Return the springs' push with the planes moved out by ``shift`` (``spring_push``)."""
+    push = 0.0
+    for k in range(count):
+        if depths[k] - shift > 0.0:
+            push += stiffnesses[k] * (depths[k] - shift)
+    return push
+
+
+@jit
 def _total_stiffness(stiffnesses, count):
     total = 0.0
     for k in range(count):
@@ -267,6 +277,8 @@ def _shift(law, coordinates, rates, books, bound, period):
         extra = (bound[6] - damping) / count if count > 0 else 0.0
         for k in range(count):
             stiffnesses[k] = scale * stiffnesses[k]
+        if bound[LAPSED] != 0.0:
+            push = min(push, _push(depths, stiffnesses, count, 0.0))
         shift = _matched_shift(depths, stiffnesses, count, push)
     else:
         held = 0.0
@@ -291,11 +303,7 @@ def _shift(law, coordinates, rates, books, bound, period):
             eased = max(shift - change, 0.0) if shift > 0.0 else min(shift + change, 0.0)
         floor = _least_shift(depths, stiffnesses, count, max(books[0], held), min(eased, 0.0))
         shift = floor if floor > eased else eased
-    push = 0.0
-    for k in range(count):
-        if depths[k] - shift > 0.0:
-            push += stiffnesses[k] * (depths[k] - shift)
-    bound[0], bound[1], bound[2] = shift, law[SERIAL], push
+    bound[0], bound[1], bound[2] = shift, law[SERIAL], _push(depths, stiffnesses, count, shift)
     bound[3], bound[4], bound[5] = scale, scale * total, extra
     bound[6], bound[7] = _total_damping(rendered, extra), count
     for k in range(count):
@@ -379,28 +387,33 @@ def _passive(books, fx, fy, fz, coordinates, rates, period, lapsed):
 
 
 @jit
+def _forget(bound):
+    """Nothing renders planes now (``LocalRenderer._forget``)."""
+    bound[2] = bound[4] = bound[6] = bound[7] = bound[LAPSED] = 0.0
+
+
+@jit
 def _law_wrench(packed, books, bound, time, coordinates, rates, period):
     """Return what ``LocalRenderer.wrench`` renders this period: force and torque, saturated."""
     law = packed[0] if time + period > packed[0, SINCE] else packed[1]
     fx = fy = fz = tx = ty = tz = 0.0
     limit = law[0]
     mode, live = law[6], time + period <= law[DEADLINE]
+    dx, dy, dz = coordinates[0] - law[10], coordinates[1] - law[11], coordinates[2] - law[12]
     if mode == MODE_WRENCH and live:
         fx, fy, fz, tx, ty, tz = law[13], law[14], law[15], law[16], law[17], law[18]
-        bound[2] = bound[4] = bound[6] = bound[7] = 0.0
-    elif mode == MODE_PLANES and live:
-        dx, dy, dz = coordinates[0] - law[10], coordinates[1] - law[11], coordinates[2] - law[12]
-        if dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
-            if law[8] < limit:
-                limit = law[8]
-            _shift(law, coordinates, rates, books, bound, period)
-            fx, fy, fz, tx, ty, tz = _planes(_scaled(_held_normals(law, bound), bound[3],
-                                                     bound[5]), coordinates, rates, limit,
-                                             period, bound[0])
-        else:
-            bound[2] = bound[4] = bound[6] = bound[7] = 0.0
+        _forget(bound)
+    elif mode == MODE_PLANES and live and dx * dx + dy * dy + dz * dz <= law[9] * law[9]:
+        if law[8] < limit:
+            limit = law[8]
+        _shift(law, coordinates, rates, books, bound, period)
+        bound[LAPSED] = 0.0
+        fx, fy, fz, tx, ty, tz = _planes(_scaled(_held_normals(law, bound), bound[3], bound[5]),
+                                         coordinates, rates, limit, period, bound[0])
+    elif mode == MODE_PLANES and not live:
+        bound[LAPSED] = 1.0
     else:
-        bound[2] = bound[4] = bound[6] = bound[7] = 0.0
+        _forget(bound)
     fx, fy, fz = _passive(books, fx, fy, fz, coordinates, rates, period, not live)
     fx, fy, fz = _saturate(fx, fy, fz, limit)
     tx, ty, tz = _saturate(tx, ty, tz, law[1])
