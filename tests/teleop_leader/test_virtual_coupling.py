@@ -2,14 +2,14 @@
 hand no energy of its own.
 
 What "no energy" can mean for a force held over a step: the coupling sees the wand's position and
-velocity at the step's start, and its force is held until the next. With the leader's gains it
-gives the wand no energy when the wand keeps that velocity over the step, whatever the velocities
-from step to step. A velocity that changes within the step is beyond any held force, fixed before
-the motion that decides the sign of its work, and no bound on the hand's motion removes that, it
-only shrinks it: a hand turning round as the coupling engages gets +4.9e-8 J at 1 g, +4.9e-12 J on
-a 5 Hz, 0.3 m/s motion. That energy of the hold is the device's to dissipate, by its own damping
-and its port's passivity controller (``haptic_wand_driver.port_passivity``; the sampled spring's
-K·T/2 in ``force_renderer.passivity`` is the same effect).
+velocity at the step's start, and its force is held until the next. With any gains its config
+admits, it gives the wand no energy when the wand keeps that velocity over the step, whatever the
+velocities from step to step. A velocity that changes within the step is beyond any held force,
+fixed before the motion that decides the sign of its work, and no bound on the hand's motion
+removes that, it only shrinks it: a hand turning round as the coupling engages gets +4.9e-8 J
+at 1 g, +4.9e-12 J on a 5 Hz, 0.3 m/s motion. That energy of the hold is the device's to
+dissipate, by its own damping and its port's passivity controller (``haptic_wand_driver.
+port_passivity``; the sampled spring's K·T/2 in ``force_renderer.passivity`` is the same effect).
 """
 from hypothesis import example, given, strategies as st, target
 import numpy as np
@@ -58,34 +58,60 @@ def test_it_gives_the_hand_no_energy_it_did_not_take_from_it(amplitudes, frequen
     assert most <= 0.0
 
 
-def _largest_work_per_square_velocity(config: CouplingConfig, ticks: int = 1000) -> float:
-    """Return max over every sequence u of ``ticks`` velocities of work / (|u|^2 DT), N·s/m.
+def _largest_work_per_square_velocity(config: CouplingConfig, step: float,
+                                      ticks: int = 1000) -> float:
+    """Return max over every sequence u of ``ticks`` velocities of work / (|u|^2 step), N·s/m.
 
     With no port force the coupling at rest is linear and time-invariant in the wand's velocity,
     so each step's force is the convolution of the velocities with one impulse response and the
     work a quadratic form in them, whose largest eigenvalue bounds the work of every sequence.
     """
     coupling = VirtualCoupling(config, np.zeros(3))
-    impulse = [coupling.step(np.zeros(3), np.zeros(3), [1.0, 0.0, 0.0], DT)[0]]
-    impulse += [coupling.step(np.zeros(3), [DT, 0.0, 0.0], np.zeros(3), DT)[0]
+    impulse = [coupling.step(np.zeros(3), np.zeros(3), [1.0, 0.0, 0.0], step)[0]]
+    impulse += [coupling.step(np.zeros(3), [step, 0.0, 0.0], np.zeros(3), step)[0]
                 for _ in range(ticks - 1)]
     forces = toeplitz(impulse, np.zeros(ticks))  # row k: the force of step k per velocity
     return float(np.linalg.eigvalsh((forces + forces.T) / 2.0)[-1])
 
 
-def test_no_sequence_of_velocities_draws_energy_from_it():
-    """Jumps included, over a second of ticks."""
-    assert _largest_work_per_square_velocity(CouplingConfig()) < 0.0
+EDGES = [{}, {'stiffness': 17_900.0}, {'damping': 99.4}, {'ground_damping': 0.0}]
 
 
-def test_the_check_sees_a_coupling_that_gives_energy():
-    """A spring without its damper, held over each step, gives energy (Colgate's K·T/2): the check
-    says so."""
-    assert _largest_work_per_square_velocity(CouplingConfig(damping=0.0)) > 0.0
+@pytest.mark.parametrize('gains', EDGES)
+def test_no_sequence_of_velocities_draws_energy_from_it(gains):
+    """The leader's gains and gains just inside each bound: jumps included, over 1000 steps."""
+    config = CouplingConfig(**gains)
+    assert _largest_work_per_square_velocity(config, config.max_step) <= 0.0
+
+
+@pytest.mark.parametrize('gains', EDGES)
+def test_stepped_past_its_bounds_the_same_coupling_gives_energy(gains):
+    """5 % past the longest step its gains are passive for, each gives energy: the bounds are
+    where the coupling's own numbers put them, and the check can fail."""
+    config = CouplingConfig(**gains)
+    longest = min(2.0 * config.damping / config.stiffness,
+                  config.mass / (config.damping + config.ground_damping / 2.0))
+    assert _largest_work_per_square_velocity(config, 1.05 * longest) > 0.0
+
+
+@st.composite
+def admitted_gains(draw) -> CouplingConfig:
+    """Gains the config admits for a 1 ms step, short of its bounds by 0.1 % at least."""
+    mass = draw(st.floats(0.01, 10.0))
+    fraction = st.floats(0.0, 0.999)
+    ground = draw(fraction) * 2.0 * mass / DT
+    damping = draw(fraction) * (mass / DT - ground / 2.0)
+    return CouplingConfig(mass, draw(fraction) * 2.0 * damping / DT, damping, ground, DT)
+
+
+@given(admitted_gains())
+def test_no_admitted_gains_draw_energy(config):
+    assert _largest_work_per_square_velocity(config, DT, ticks=300) <= 0.0
 
 
 @pytest.mark.parametrize('field, value', [('mass', 0.0), ('stiffness', -1.0),
-                                          ('damping', float('nan'))])
-def test_a_coupling_that_is_not_physical_is_refused(field, value):
+                                          ('damping', float('nan')), ('stiffness', 18_100.0),
+                                          ('damping', 99.6)])
+def test_a_coupling_that_is_not_physical_or_not_passive_sampled_is_refused(field, value):
     with pytest.raises(ValueError, match=field):
         CouplingConfig(**{field: value})
