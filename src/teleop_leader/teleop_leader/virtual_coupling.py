@@ -10,8 +10,16 @@ so the chain stays as passive as the link; the mass starts at rest, with no ener
 
 Integrated with the position first: over a step the port force does exactly ``force · velocity ·
 dt`` of work on the mass, the energy the controller books. Steps are at most ``max_step``: the
-leader's tick is the wand's pose period, which a busy machine stretches, and an explicit step of
-the damper is unstable beyond 2·mass/damping.
+leader's tick is the wand's pose period, which a busy machine stretches.
+
+Sampled, the elements stay passive for some gains only. The force on the wand is held over each
+step, and gives a wand that keeps the step's velocity no energy while ``stiffness · step / 2 <=
+damping`` (Colgate's bound for a sampled spring, with the coupling's damper for the device's) and
+``(damping + ground_damping / 2) · step < mass``: the impedance at the step's Nyquist frequency
+changes sign at each, and within both it is positive real (checked on the impedance for 200,000
+random gains, and on the coupling itself in tests/teleop_leader/test_virtual_coupling.py). Other
+gains are refused. A velocity that changes within a step is beyond any held force: that energy is
+the device's to absorb.
 """
 from dataclasses import dataclass
 import math
@@ -51,6 +59,15 @@ class CouplingConfig:
         finite_number(self.max_step, 'coupling max_step', minimum=0.0, strict=True)
         for name in ('stiffness', 'damping', 'ground_damping'):
             finite_number(getattr(self, name), f'coupling {name}', minimum=0.0)
+        if self.stiffness * self.max_step / 2.0 > self.damping:
+            raise ValueError(f'coupling stiffness {self.stiffness:g} N/m gives energy sampled '
+                             f'every {self.max_step:g} s with damping {self.damping:g} N*s/m: '
+                             'needs stiffness * max_step / 2 <= damping')
+        if (self.damping + self.ground_damping / 2.0) * self.max_step >= self.mass:
+            raise ValueError(f'coupling damping {self.damping:g} N*s/m (ground '
+                             f'{self.ground_damping:g}) gives energy sampled every '
+                             f'{self.max_step:g} s on mass {self.mass:g} kg: needs (damping + '
+                             'ground_damping / 2) * max_step < mass')
 
 
 class VirtualCoupling:
