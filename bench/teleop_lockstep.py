@@ -148,7 +148,7 @@ def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dic
     operating = np.ones(count + 1, dtype=bool) if options.ticks is None else np.isin(
         np.arange(count + 1), options.ticks)
     operator_rows, remote_rows, held = [], [], np.nan
-    wrench = ZERO
+    wrench, last = ZERO, 0.0
     state, remote = device.read(0.0), robot.read(0.0)
     for k in range(1, count):
         now = k * TICK
@@ -179,7 +179,9 @@ def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dic
             known, plane = leader.model(now, state.position)
             answer = (now, _model(now, plane, state.position)) if known else None
         else:
-            answer = (now, leader.force(now, state.position, state.linear_velocity, TICK))
+            answer = (now, leader.force(now, state.position, state.linear_velocity,
+                                        now - last))  # since its last pose, as the node has it
+        last = now
         if answer is not None:  # taken as it comes, as in the site
             answers.taken(answer[0], MODEL_LIFETIME)
             if renderer is not None:
