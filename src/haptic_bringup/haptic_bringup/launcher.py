@@ -472,12 +472,17 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='teleop: replay one-way delays from a CSV (time,delay in s)')
     parser.add_argument('--imaging', action='store_true',
                         help='teleop: the remote site images the probe\'s view (probe/image)')
+    add_run_arguments(parser, run_dir='build/launch')
+    return parser.parse_args(argv)
+
+
+def add_run_arguments(parser: argparse.ArgumentParser, run_dir: str) -> None:
+    """Add the options of where a run goes: its DDS domain, parameters file and folder."""
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', DEFAULT_DOMAIN_ID)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
-    parser.add_argument('--run-dir', default='build/launch',
+    parser.add_argument('--run-dir', default=run_dir,
                         help='where parameters and ROS logs of the run go')
-    return parser.parse_args(argv)
 
 
 def link_parameters(args: argparse.Namespace) -> dict:

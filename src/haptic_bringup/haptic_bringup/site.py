@@ -30,8 +30,8 @@ from typing import Optional
 
 import yaml
 
-from haptic_bringup.launcher import (link_parameters, Loop, LoopConfig, node_parameters,
-                                     site_nodes, teleop_endpoints)
+from haptic_bringup.launcher import (add_run_arguments, link_parameters, Loop, LoopConfig,
+                                     node_parameters, site_nodes, teleop_endpoints)
 from haptic_bringup.processes import run_until_stopped, start_child
 from haptic_contract.graph import FRAME_TOPICS, RELIABLE_CROSSINGS, TO_OPERATOR, TO_REMOTE
 from haptic_contract.teleop import Scheme, SCHEMES
@@ -181,11 +181,7 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='replay one-way delays from a CSV (time,delay in s)')
     parser.add_argument('--imaging', action='store_true',
                         help='remote: image the probe\'s view (operator: record it)')
-    parser.add_argument('--domain-id', type=int,
-                        default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
-    parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
-    parser.add_argument('--run-dir', default='build/site',
-                        help='where parameters and ROS logs of the run go')
+    add_run_arguments(parser, run_dir='build/site')
     args = parser.parse_args(argv)
     if not (args.listen or args.connect):
         parser.error('give --listen (the remote site) or --connect (the operator site)')
