@@ -141,13 +141,19 @@ def _object_distance(floats, ints, k, px, py, pz, gx, gy, gz, W, stack, stack_d2
             kind, floats, fo, ints, io, qx, qy, qz,
             floats[r + 12], floats[r + 13], floats[r + 14], floats[r + 18], lx, ly, lz,
             floats[1], floats[2], ints[1], ints[2], W, epa_floats, epa_ints)
-    wx = floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9]
-    wy = floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10]
-    wz = floats[r + 6] * x + floats[r + 7] * y + floats[r + 8] * z + floats[r + 11]
-    mx = floats[r] * nx + floats[r + 1] * ny + floats[r + 2] * nz
-    my = floats[r + 3] * nx + floats[r + 4] * ny + floats[r + 5] * nz
-    mz = floats[r + 6] * nx + floats[r + 7] * ny + floats[r + 8] * nz
+    wx, wy, wz, mx, my, mz = _to_world(floats, r, x, y, z, nx, ny, nz)
     return status, distance, lower, wx, wy, wz, mx, my, mz, iterations, triangle
+
+
+@jit
+def _to_world(floats, r, x, y, z, nx, ny, nz):
+    """Return the point (x, y, z) and the direction n of object record r's frame in the world's."""
+    return (floats[r] * x + floats[r + 1] * y + floats[r + 2] * z + floats[r + 9],
+            floats[r + 3] * x + floats[r + 4] * y + floats[r + 5] * z + floats[r + 10],
+            floats[r + 6] * x + floats[r + 7] * y + floats[r + 8] * z + floats[r + 11],
+            floats[r] * nx + floats[r + 1] * ny + floats[r + 2] * nz,
+            floats[r + 3] * nx + floats[r + 4] * ny + floats[r + 5] * nz,
+            floats[r + 6] * nx + floats[r + 7] * ny + floats[r + 8] * nz)
 
 
 @jit
@@ -338,11 +344,6 @@ def query_tool(floats, ints, tool_floats, tool_ints, out, px, py, pz, qx, qy, qz
         total += iterations
         if d < best:
             best, best_lower, best_status, best_k, best_t = d, lower, status, k, t
-            x = floats[r] * ox + floats[r + 1] * oy + floats[r + 2] * oz + floats[r + 9]
-            y = floats[r + 3] * ox + floats[r + 4] * oy + floats[r + 5] * oz + floats[r + 10]
-            z = floats[r + 6] * ox + floats[r + 7] * oy + floats[r + 8] * oz + floats[r + 11]
-            nx = floats[r] * mx + floats[r + 1] * my + floats[r + 2] * mz
-            ny = floats[r + 3] * mx + floats[r + 4] * my + floats[r + 5] * mz
-            nz = floats[r + 6] * mx + floats[r + 7] * my + floats[r + 8] * mz
+            x, y, z, nx, ny, nz = _to_world(floats, r, ox, oy, oz, mx, my, mz)
     _write(out, 0, best, x, y, z, nx, ny, nz, best_k, total, best_status,
            x + best * nx, y + best * ny, z + best * nz, best_t, best_lower)

@@ -7,7 +7,7 @@ tuples of leaf fields, in the order of each message's definition (``POSE.fields`
 import math
 
 from haptic_contract.collision_state import STATE, STATUS_INVALID_INPUT
-from haptic_contract.streams import POSE
+from haptic_contract.streams import FRAME, POSE, POSE_ORIENTATION, POSE_POSITION
 
 __all__ = ['InvalidPose', 'POSE', 'STATE', 'invalid_state', 'state', 'tip_pose',
            'tool_state']
@@ -35,7 +35,9 @@ def tip_pose(pose: list, frame_id: str) -> tuple:
     quaternion is normalised (its norm may be off by ``UNIT_QUATERNION_TOLERANCE``, not more).
     Raises InvalidPose for any other frame, a NaN or infinite value or a non-unit quaternion.
     """
-    _, _, frame, px, py, pz, qx, qy, qz, qw = pose
+    frame = pose[FRAME]
+    px, py, pz = pose[POSE_POSITION]
+    qx, qy, qz, qw = pose[POSE_ORIENTATION]
     if frame != frame_id:
         raise InvalidPose('pose in an unknown frame',
                           f'pose.header.frame_id is {frame!r}, not the scene frame '

@@ -294,13 +294,24 @@ class Loop:
         self.stop()
 
     def start(self) -> None:
-        config = self.config
+        """Start the children and wait until they are up (``startup_time``: how long it took)."""
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        env = loop_environment(config.domain_id, self.run_dir / 'log')
+        env = loop_environment(self.config.domain_id, self.run_dir / 'log')
         params = self.run_dir / 'params.yaml'
-        params.write_text(yaml.safe_dump(node_parameters(config), sort_keys=False))
-        ros_args = ['--ros-args', '--params-file', str(params)]
+        params.write_text(yaml.safe_dump(self._parameters(), sort_keys=False))
         started = time.monotonic()
+        self._start_children(env, params)
+        self._wait_until_up()
+        self.startup_time = time.monotonic() - started
+
+    def _parameters(self) -> dict:
+        """Return the parameters file's content: every node's parameters."""
+        return node_parameters(self.config)
+
+    def _start_children(self, env: dict, params: pathlib.Path) -> None:
+        """Start the loop's processes (or the session's) with the parameters file ``params``."""
+        config = self.config
+        ros_args = ['--ros-args', '--params-file', str(params)]
         if config.recorder_process:
             self.children.append(start_child(
                 'recorder', [config.python, '-m', RECORDER_MODULE, *ros_args], env))
@@ -314,8 +325,10 @@ class Loop:
             for name in config.nodes:
                 self.children.append(start_child(
                     name, [config.python, '-m', NODES[name].module, *ros_args], env))
-        self._wait_for_discovery(config.domain_id)
-        self.startup_time = time.monotonic() - started
+
+    def _wait_until_up(self) -> None:
+        """Wait until the loop is closed (a session: until the operator's domain is up too)."""
+        self._wait_for_discovery(self.config.domain_id)
 
     def _composed(self, nodes, ros_args: list) -> list:
         """Return the command line of one process running ``nodes``."""
@@ -459,12 +472,17 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='teleop: replay one-way delays from a CSV (time,delay in s)')
     parser.add_argument('--imaging', action='store_true',
                         help='teleop: the remote site images the probe\'s view (probe/image)')
+    add_run_arguments(parser, run_dir='build/launch')
+    return parser.parse_args(argv)
+
+
+def add_run_arguments(parser: argparse.ArgumentParser, run_dir: str) -> None:
+    """Add the options of where a run goes: its DDS domain, parameters file and folder."""
     parser.add_argument('--domain-id', type=int,
                         default=int(os.environ.get('ROS_DOMAIN_ID', DEFAULT_DOMAIN_ID)))
     parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
-    parser.add_argument('--run-dir', default='build/launch',
+    parser.add_argument('--run-dir', default=run_dir,
                         help='where parameters and ROS logs of the run go')
-    return parser.parse_args(argv)
 
 
 def link_parameters(args: argparse.Namespace) -> dict:

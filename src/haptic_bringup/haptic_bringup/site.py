@@ -26,12 +26,11 @@ import dataclasses
 import os
 import pathlib
 import socket
-import time
 from typing import Optional
 
 import yaml
 
-from haptic_bringup.launcher import (link_parameters, Loop, loop_environment, LoopConfig,
+from haptic_bringup.launcher import (add_run_arguments, link_parameters, Loop, LoopConfig,
                                      node_parameters, site_nodes, teleop_endpoints)
 from haptic_bringup.processes import run_until_stopped, start_child
 from haptic_contract.graph import FRAME_TOPICS, RELIABLE_CROSSINGS, TO_OPERATOR, TO_REMOTE
@@ -128,24 +127,22 @@ class Site(Loop):
         super().__init__(site.loop)
         self.site = site
 
-    def start(self) -> None:
+    def _parameters(self) -> dict:
+        """Return the parameters file's content: this site's nodes' and its gateway's."""
+        return site_parameters(self.site)
+
+    def _start_children(self, env: dict, params: pathlib.Path) -> None:
+        """Start this site's process, its imager if it images, and its gateway."""
         site, config = self.site, self.config
-        self.run_dir.mkdir(parents=True, exist_ok=True)
-        env = loop_environment(config.domain_id, self.run_dir / 'log')
-        params = self.run_dir / 'params.yaml'
-        params.write_text(yaml.safe_dump(site_parameters(site), sort_keys=False))
         ros_args = ['--ros-args', '--params-file', str(params)]
-        started = time.monotonic()
         self.children.append(start_child(
             site.role, self._composed(site_nodes(config, site.role), ros_args), env))
         if site.role == 'remote':
             self._start_imager(ros_args, env)
         self.children.append(start_child('gateway', gateway_argv(config.python, site.role, params),
                                          env))
-        self._wait_for_own_endpoints()
-        self.startup_time = time.monotonic() - started
 
-    def _wait_for_own_endpoints(self) -> None:
+    def _wait_until_up(self) -> None:
         """Wait for this site's own endpoints: the other site may not be there yet."""
         operator, remote = teleop_endpoints(self.config).values()
         self._wait_for({self.config.domain_id: operator if self.site.role == 'operator'
@@ -184,11 +181,7 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='replay one-way delays from a CSV (time,delay in s)')
     parser.add_argument('--imaging', action='store_true',
                         help='remote: image the probe\'s view (operator: record it)')
-    parser.add_argument('--domain-id', type=int,
-                        default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
-    parser.add_argument('--params-file', help='YAML with node parameters, as for ros2 run')
-    parser.add_argument('--run-dir', default='build/site',
-                        help='where parameters and ROS logs of the run go')
+    add_run_arguments(parser, run_dir='build/site')
     args = parser.parse_args(argv)
     if not (args.listen or args.connect):
         parser.error('give --listen (the remote site) or --connect (the operator site)')

@@ -13,71 +13,45 @@ __all__ = ['FRAME_QOS', 'HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_QOS', 'NEWEST_
 
 STREAM_DEPTH = 10
 
-HAPTIC_STREAM_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=STREAM_DEPTH,
-    reliability=ReliabilityPolicy.BEST_EFFORT,
-    durability=DurabilityPolicy.VOLATILE,
-)
+
+def _best_effort(depth: int) -> QoSProfile:
+    """Return the streams' policy: best effort, volatile, the last ``depth`` messages kept."""
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                      reliability=ReliabilityPolicy.BEST_EFFORT,
+                      durability=DurabilityPolicy.VOLATILE)
+
+
+def _reliable(depth: int, durability: DurabilityPolicy = DurabilityPolicy.VOLATILE) -> QoSProfile:
+    """Return the policy of what must arrive: reliable, the last ``depth`` messages kept."""
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                      reliability=ReliabilityPolicy.RELIABLE, durability=durability)
+
+
+HAPTIC_STREAM_QOS = _best_effort(STREAM_DEPTH)
+
+# A reader of a stream that wants its newest message only (the imager's pose, 30 times a
+# second): one kept, so that a reader that was descheduled wakes to it, not to a backlog.
+NEWEST_STREAM_QOS = _best_effort(1)
 
 # What comes from another site: the same policy, a history deep enough that a flood from any
 # publisher on the topic does not push the followed session's messages out before the node has
 # refused the flood's (it sheds them by content, at a few microseconds each): 100 is 5 ms of a
 # 20 kHz flood, and 100 ms of the link's own 1 kHz. Not deeper: a gateway reading the commands
 # 1000 deep stopped taking them a few seconds into an attacked session (cause not found).
-# A reader of a stream that wants its newest message only (the imager's pose, 30 times a
-# second): one kept, so that a reader that was descheduled wakes to it, not to a backlog.
-NEWEST_STREAM_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=1,
-    reliability=ReliabilityPolicy.BEST_EFFORT,
-    durability=DurabilityPolicy.VOLATILE,
-)
-
-LINK_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=100,
-    reliability=ReliabilityPolicy.BEST_EFFORT,
-    durability=DurabilityPolicy.VOLATILE,
-)
+LINK_QOS = _best_effort(100)
 
 # A recorder must not lose samples while it writes: same policy, a deep history.
-RECORDER_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=2000,
-    reliability=ReliabilityPolicy.BEST_EFFORT,
-    durability=DurabilityPolicy.VOLATILE,
-)
+RECORDER_QOS = _best_effort(2000)
 
 # For what is published reliably (reports): a best-effort reader may lose a node's last report
 # and never be told; a reliable one acknowledges it before the node goes.
-RELIABLE_RECORDER_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=RECORDER_QOS.depth,
-    reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.VOLATILE,
-)
+RELIABLE_RECORDER_QOS = _reliable(RECORDER_QOS.depth)
 
-LATCHED_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=1,
-    reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.TRANSIENT_LOCAL,
-)
+LATCHED_QOS = _reliable(1, DurabilityPolicy.TRANSIENT_LOCAL)
 
-MARKER_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=1,
-    reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.VOLATILE,
-)
+MARKER_QOS = _reliable(1)
 
 # Frames for people to look at (an ultrasound image): reliable, so that every viewer matches
 # (RViz's Image display subscribes reliably by default, rqt_image_view best effort), keep last
 # 2: a slow viewer gets the newest, and a publisher never waits for one.
-FRAME_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST,
-    depth=2,
-    reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.VOLATILE,
-)
+FRAME_QOS = _reliable(2)

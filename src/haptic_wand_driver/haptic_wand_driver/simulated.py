@@ -35,6 +35,7 @@ from haptic_contract.checks import finite_components, finite_number, finite_vect
 from haptic_contract.plane_law import saturate_components
 from haptic_contract.shared_defaults import DEVICE_DAMPING, FORCE_LIMIT
 from haptic_contract.wand import roll_axis
+from haptic_util.substeps import substeps_due
 from haptic_wand_driver.device import DeviceLimits, HapticDevice, WandState
 from haptic_wand_driver.hand_coupling import Hand, impedance
 from haptic_wand_driver.local_rendering import LocalRenderer
@@ -175,12 +176,8 @@ class SimulatedWand(HapticDevice):
         """
         self._raise_if_closed()
         now = finite_number(now, 'SimulatedWand.read now')
-        if self._start is None:
-            self._start = now
-        elif now < self._time():
-            raise ValueError(f'SimulatedWand.read: now {now!r} s is before the last state '
-                             f'({self._time()!r} s); the clock must not go back')
-        target_steps = math.floor((now - self._start) / self._step + 1e-9)
+        self._start, target_steps = substeps_due(now, self._start, self._steps_done, self._step,
+                                                 'SimulatedWand.read')
         if target_steps > self._steps_done:
             self._advance(target_steps)
         return WandState._from_checked(self._time(), self._coordinates, self._rates)

@@ -27,6 +27,7 @@ import numpy as np
 
 from haptic_contract.checks import (finite_components, finite_number, finite_vector,
                                     nonzero_components, unit_vector)
+from haptic_util.substeps import substeps_due
 
 __all__ = ['Environment', 'ImpedanceRobot', 'ImpedanceRobotConfig', 'RobotState']
 
@@ -187,12 +188,8 @@ class ImpedanceRobot:
         but not the state, whose arrays cost more than a tick's two substeps.
         """
         now = finite_number(now, 'ImpedanceRobot now')
-        if self._start is None:
-            self._start = now
-        elif now < self._time():
-            raise ValueError(f'ImpedanceRobot: now {now!r} s is before the last state '
-                             f'({self._time()!r} s); the clock must not go back')
-        target_steps = math.floor((now - self._start) / self._config.step + 1e-9)
+        self._start, target_steps = substeps_due(now, self._start, self._steps_done,
+                                                 self._config.step, 'ImpedanceRobot')
         if target_steps > self._steps_done:
             self._run_substeps(target_steps - self._steps_done)
             self._steps_done = target_steps

@@ -35,6 +35,7 @@ from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.validate_full_topic_name import validate_full_topic_name
 import zenoh
 
+from haptic_contract.graph import absolute, TELEOP_COMMAND, TELEOP_FEEDBACK, TOPIC_TYPES
 from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
@@ -67,8 +68,18 @@ INSECURE_WARNING = ('INSECURE: plaintext, no authentication and no access contro
                     'only on a network you control end to end; mutual TLS is the default.')
 RELIABLE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                           reliability=ReliabilityPolicy.RELIABLE)
-TELEOP_TO_REMOTE = ('/teleop/command:haptic_msgs/msg/TeleopCommand',)
-TELEOP_TO_OPERATOR = ('/teleop/feedback:haptic_msgs/msg/TeleopFeedback',)
+
+
+def _route(topic: str) -> str:
+    """Return the route ('topic:type') that carries the graph's ``topic``."""
+    return f'{absolute(topic)}:{TOPIC_TYPES[absolute(topic)]}'
+
+
+# The default routes: the command and the feedback alone. The graph's whole crossing set
+# (TO_REMOTE, TO_OPERATOR) would bring its reliable and image topics as defaults too, and a
+# gateway given only its own routes, which leave those out, would refuse to start.
+TELEOP_TO_REMOTE = (_route(TELEOP_COMMAND),)
+TELEOP_TO_OPERATOR = (_route(TELEOP_FEEDBACK),)
 
 
 @dataclass(frozen=True)
