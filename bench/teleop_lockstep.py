@@ -95,7 +95,9 @@ class ScanOptions:
     model at once, the baseline). ``link_timeout``: both ends' watchdogs (s); None waits out the
     jitter, as the launcher sets. ``force_hold``: (start, end) s, the remote site holding the
     force it measured at the start (``Follower.hold_force``) until the end. ``outage``: (start,
-    end) s, the link carries nothing either way.
+    end) s, the link carries nothing either way. ``answer_lag``: the driver takes each answer at
+    its next tick, as from a leader in another process or over DDS (one site's process, handing
+    its streams over in the process, answers at once).
     """
 
     jitter: float = 0.0
@@ -108,6 +110,7 @@ class ScanOptions:
     link_timeout: float | None = None
     force_hold: tuple | None = None
     outage: tuple | None = None
+    answer_lag: bool = False
 
 
 def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dict:
@@ -148,14 +151,16 @@ def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dic
     operating = np.ones(count + 1, dtype=bool) if options.ticks is None else np.isin(
         np.arange(count + 1), options.ticks)
     operator_rows, remote_rows, held = [], [], np.nan
-    wrench, last = ZERO, 0.0
+    wrench, last, pending = ZERO, 0.0, None
     state, remote = device.read(0.0), robot.read(0.0)
     for k in range(1, count):
         now = k * TICK
         if operating[k]:
             state = device.read(now)
             operator_rows.append((now, *state.position, *device.applied()[0]))
-            command = leader.command(now, state.position, state.linear_velocity)
+            shift = ZERO if renderer is None else renderer.planes_shift(
+                (*state.position, state.roll, state.yaw))
+            command = leader.command(now, state.position, state.linear_velocity, shift)
             if command is not None and not cut[k]:  # none until the feedback is heard
                 to_robot.send(now, command)
         for delivery in to_robot.deliver(now):
@@ -182,6 +187,8 @@ def scan(scheme: str, delay: float, options: ScanOptions = ScanOptions()) -> dic
             answer = (now, leader.force(now, state.position, state.linear_velocity,
                                         now - last))  # since its last pose, as the node has it
         last = now
+        if options.answer_lag:
+            answer, pending = pending, answer
         if answer is not None:  # taken as it comes, as in the site
             answers.taken(answer[0], MODEL_LIFETIME)
             if renderer is not None:

@@ -189,3 +189,20 @@ def test_scattered_estimates_eased_in_give_the_hand_no_energy_and_no_jolt(seed):
     step = np.abs(np.diff(eased[holding, 1])).max()
     assert jolt > 0.5  # N in one period
     assert step < jolt / 20.0
+
+
+def test_the_shift_said_over_a_lapse_is_the_one_the_next_model_starts_from():
+    """Pressed 2 mm (2 N), the law lapses and the hand sinks 12 mm: the planes are said to sit
+    12 mm out, over the lapse (the robot holds where the hand felt the wall) and after it."""
+    renderer = law(RATE)
+    renderer.take(wall(1000.0), deadline=0.0)
+    for z in np.linspace(0.0005, -0.002, 26):
+        renderer.wrench(-1.0, *at(z), PERIOD)
+    assert renderer.planes_shift(at(-0.002)[0]) == pytest.approx((0.0, 0.0, 0.0), abs=1e-12)
+    for k, z in enumerate(np.linspace(-0.002, -0.014, 120)):
+        renderer.wrench(k * PERIOD, *at(z), PERIOD)
+    lapsed = renderer.planes_shift(at(-0.014)[0])
+    renderer.take(wall(1000.0), math.inf)
+    renderer.wrench(0.03, *at(-0.014), PERIOD)
+    assert lapsed == pytest.approx((0.0, 0.0, 0.012))
+    assert renderer.planes_shift(at(-0.014)[0]) == pytest.approx(lapsed)

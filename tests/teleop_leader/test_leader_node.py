@@ -46,12 +46,12 @@ def robot_found(node):
                                               session=7, sequence=1), 'base_link'))
 
 
-@pytest.fixture
-def leader():
+@pytest.fixture(params=['tdpa'])
+def leader(request):
     context = Context()
     rclpy.init(context=context, domain_id=97)
     node = LeaderNode(context=context, parameter_overrides=[
-        rclpy.parameter.Parameter('scheme', value='tdpa')])
+        rclpy.parameter.Parameter('scheme', value=request.param)])
     node._answer_pub = Sent()
     node._command_pub = Sent()
     yield node
@@ -98,3 +98,18 @@ def test_no_pose_is_answered_before_the_robot_is_found_and_the_session_anchors_t
     assert answer[:3] == (*STAMP, 'world')
     [command] = leader._command_pub.messages
     assert np.allclose(command[5:8], TCP)
+
+
+@pytest.mark.parametrize('leader', ['model'], indirect=True)
+def test_the_robot_s_target_moves_out_as_far_as_the_device_renders_the_planes(leader):
+    """The device's shift of the planes it renders (``wand/model_shift``) is the robot's too; one
+    not finite or in another frame is refused and counted, and the last good one kept."""
+    robot_found(leader)
+    leader.on_model_shift((*STAMP, 'world', 0.0, 0.0, 0.012))
+    leader.on_model_shift((*STAMP, 'world', 0.0, 0.0, float('nan')))
+    leader.on_model_shift((*STAMP, 'base_link', 0.0, 0.0, 0.5))
+    leader.on_twist(twist())
+    leader.on_pose(pose())
+    [command] = leader._command_pub.messages
+    assert np.allclose(command[5:8], TCP + [0.0, 0.0, 0.012])
+    assert leader._refused.total() == 2

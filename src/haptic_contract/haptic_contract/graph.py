@@ -16,7 +16,8 @@ __all__ = ['COLLISION_MARKERS', 'COLLISION_NEARBY', 'COLLISION_STATE', 'DIAGNOST
            'SCENE_DESCRIPTION', 'SITE_PUBLISHERS', 'STREAMS', 'TELEOP_CLUTCH', 'TELEOP_COMMAND',
            'TELEOP_FEEDBACK', 'TELEOP_HOLD', 'TELEOP_NODES', 'TELEOP_RE_ENGAGE', 'TOPIC_TYPES',
            'TO_OPERATOR', 'TO_REMOTE', 'WAND_APPLIED_WRENCH', 'WAND_CONTACT_MODEL',
-           'WAND_FORCE_MARKER', 'WAND_POSE', 'WAND_TWIST', 'WAND_WRENCH', 'absolute']
+           'WAND_FORCE_MARKER', 'WAND_MODEL_SHIFT', 'WAND_POSE', 'WAND_TWIST', 'WAND_WRENCH',
+           'absolute']
 
 # The loop: the wand's state out, the engine's answer, the renderer's wrench or model back.
 WAND_POSE = 'wand/pose'
@@ -24,6 +25,7 @@ WAND_TWIST = 'wand/twist'
 WAND_WRENCH = 'wand/wrench'
 WAND_CONTACT_MODEL = 'wand/contact_model'
 WAND_APPLIED_WRENCH = 'wand/applied_wrench'  # what the device applied over each tick
+WAND_MODEL_SHIFT = 'wand/model_shift'  # how far out the device renders the model's planes
 WAND_FORCE_MARKER = 'wand/force_marker'
 COLLISION_STATE = 'collision/state'
 COLLISION_NEARBY = 'collision/nearby'
@@ -57,6 +59,7 @@ TOPIC_TYPES = {
     absolute(WAND_WRENCH): 'geometry_msgs/msg/WrenchStamped',
     absolute(WAND_CONTACT_MODEL): 'haptic_msgs/msg/ContactModel',
     absolute(WAND_APPLIED_WRENCH): 'geometry_msgs/msg/WrenchStamped',
+    absolute(WAND_MODEL_SHIFT): 'geometry_msgs/msg/Vector3Stamped',
     absolute(TELEOP_COMMAND): 'haptic_msgs/msg/TeleopCommand',
     absolute(TELEOP_FEEDBACK): 'haptic_msgs/msg/TeleopFeedback',
     absolute(ROBOT_TCP_POSE): 'geometry_msgs/msg/PoseStamped',

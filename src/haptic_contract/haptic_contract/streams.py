@@ -1,21 +1,23 @@
 """The wand's 1 kHz streams (pose, twist, wrench) as the codec's flat tuples, read by name.
 
 A wand sample is a stamped pose (``wand/pose``) and a stamped twist (``wand/twist``) of one
-stamp; the answer to it a stamped wrench (``wand/wrench``). Their readers take the stamp, the
-frame and the vectors through the slices here.
+stamp; the answer to it a stamped wrench (``wand/wrench``). A device rendering models itself also
+says how far out it renders their planes (``wand/model_shift``, a stamped vector). Their readers
+take the stamp, the frame and the vectors through the slices here.
 """
-from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
+from geometry_msgs.msg import PoseStamped, TwistStamped, Vector3Stamped, WrenchStamped
 
 from haptic_contract.fields import span, vector
 from haptic_util.cdr import MessageCodec
 
 __all__ = ['FRAME', 'POSE', 'POSE_ORIENTATION', 'POSE_POSITION', 'TWIST', 'TWIST_ANGULAR',
-           'TWIST_LINEAR', 'WRENCH', 'WRENCH_FORCE', 'WRENCH_TORQUE', 'frame', 'header',
-           'stamp_ns']
+           'TWIST_LINEAR', 'VECTOR', 'VECTOR_VALUE', 'WRENCH', 'WRENCH_FORCE', 'WRENCH_TORQUE',
+           'frame', 'header', 'stamp_ns']
 
 POSE = MessageCodec(PoseStamped)
 TWIST = MessageCodec(TwistStamped)
 WRENCH = MessageCodec(WrenchStamped)
+VECTOR = MessageCodec(Vector3Stamped)
 _SEC = POSE.index('header.stamp.sec')
 _NANOSEC = POSE.index('header.stamp.nanosec')
 FRAME = POSE.index('header.frame_id')
@@ -26,6 +28,7 @@ TWIST_LINEAR = vector(TWIST, 'twist.linear')
 TWIST_ANGULAR = vector(TWIST, 'twist.angular')
 WRENCH_FORCE = vector(WRENCH, 'wrench.force')
 WRENCH_TORQUE = vector(WRENCH, 'wrench.torque')
+VECTOR_VALUE = vector(VECTOR, 'vector')
 _SECOND = 1_000_000_000  # every stamped message begins with its header: these read them all
 
 

@@ -189,6 +189,28 @@ class LocalRenderer:
         return (saturate_components(force, limit),
                 saturate_components(torque, self.torque_limit))
 
+    def planes_shift(self, coordinates: Sequence[float]) -> tuple:
+        """Return how far (m, workspace frame) the planes are rendered out of the model held.
+
+        Along the first plane's normal: a telerobotic model has one plane, and the remote end
+        presses the patient as the hand feels it only if the robot's target is moved out as far.
+        Over a lapse, where the next model will start (the push before it, matched where the tool
+        now is): the hand sank while it felt nothing, and the robot must not follow it in. Zero
+        while no planes are held.
+        """
+        model = self._held[1][0]
+        if model is None or model.kind != Kind.PLANES or not model.planes:
+            return _ZERO
+        bound, normal = self.bound, model.planes[0].normal
+        shift = float(bound[0])
+        if bound[7] == len(model.planes):  # the normals rendered, eased toward the model's
+            normal = (float(bound[8]), float(bound[9]), float(bound[10]))
+        if bound[LAPSED] and self.model_step_rate > 0.0:
+            springs = [(d, bound[3] * k) for d, k in held_normals(model, bound[7:]).springs(
+                coordinates, coordinates[3], coordinates[4])]
+            shift = matched_shift(springs, min(float(bound[2]), spring_push(springs, 0.0)))
+        return (shift * normal[0], shift * normal[1], shift * normal[2])
+
     def _forget(self) -> None:
         """Nothing renders planes now: the next model's start from no push."""
         self.bound[2] = self.bound[4] = self.bound[6] = self.bound[7] = self.bound[LAPSED] = 0.0

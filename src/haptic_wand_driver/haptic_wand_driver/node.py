@@ -17,9 +17,9 @@ from rclpy.node import Node
 from std_msgs.msg import Bool
 
 from haptic_contract.contact_model import ContactModel, Kind, MODEL, ModelRefused
-from haptic_contract.graph import (WAND_APPLIED_WRENCH, WAND_CONTACT_MODEL, WAND_POSE, WAND_TWIST,
-                                   WAND_WRENCH)
-from haptic_contract.streams import (frame, POSE, stamp_ns, TWIST, WRENCH, WRENCH_FORCE,
+from haptic_contract.graph import (WAND_APPLIED_WRENCH, WAND_CONTACT_MODEL, WAND_MODEL_SHIFT,
+                                   WAND_POSE, WAND_TWIST, WAND_WRENCH)
+from haptic_contract.streams import (frame, POSE, stamp_ns, TWIST, VECTOR, WRENCH, WRENCH_FORCE,
                                      WRENCH_TORQUE)
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
@@ -97,6 +97,8 @@ class WandDriverNode(Node):
                    if self.renderer is not None else
                    (WRENCH, WAND_WRENCH, self.on_wrench))
         self._answer_sub = stream_subscription(self, *answers, refused=self._refused)
+        self._shift_pub = (None if self.renderer is None else
+                           stream_publisher(self, VECTOR, WAND_MODEL_SHIFT))
         if params.wait_for_recorder:
             self.create_subscription(Bool, 'recorder/ready', self.on_recorder_ready, LATCHED_QOS)
         self.create_timer(1.0 / params.rate, self.tick)
@@ -195,9 +197,9 @@ class WandDriverNode(Node):
     def _publish(self, state, now_ns: int) -> None:
         """Publish the state and what the device applied; its answer may come back inside.
 
-        The twist goes before the pose, and the pose is counted as sent before either: in one
-        process the pose's answer is computed (with this twist) and delivered inside the pose's
-        ``publish``.
+        The twist and the planes' shift go before the pose, and the pose is counted as sent
+        before any: in one process the pose's answer is computed (with this twist and shift) and
+        delivered inside the pose's ``publish``.
         """
         header = (*divmod(now_ns, 1_000_000_000), self.params.frame_id)
         force, torque = self.device.applied()  # what the hand felt since the last tick
@@ -205,6 +207,9 @@ class WandDriverNode(Node):
         self._last_probe_ns = now_ns
         self._twist_pub.publish((*header, *state.linear_velocity.tolist(),
                                  *state.angular_velocity.tolist()))
+        if self._shift_pub is not None:  # before the pose, whose answer may come inside
+            self._shift_pub.publish((*header, *self.renderer.planes_shift(
+                (*state.position.tolist(), state.roll, state.yaw))))
         self._pose_pub.publish((*header, *state.position.tolist(),
                                 *state.orientation.tolist()))
         self._applied_pub.publish((*header, *force.tolist(), *torque.tolist()))

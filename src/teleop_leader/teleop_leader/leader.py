@@ -31,6 +31,10 @@ the two agree; a give-back of the shift beyond that energy would move the robot 
 held the hand's force where it was (in lockstep, a 1 s outage mid-press then left 4.4 N felt,
 scaled, against 17 N at the patient). The clutch, or a free estimate, closes the books instead: the
 device renders those as free, and its port closes its own books after a moment of zero force.
+The device also moves the planes itself (its easing; after a lapse, the push the hand left,
+where the hand sank), and says how far (``device_shift``): the robot's target takes that too.
+Only the device knows of a lapse this end never saw, its tick stalled between a pose and its
+answer (in lockstep, the robot then pressed 11.2 N where the hand felt 6.2 N, scaled).
 
 Feedback older than ``link_timeout`` (on this site's clock: the sites share none) gives zero
 force and no model, and no command is sent while it lasts: the robot then holds, as it does when
@@ -57,6 +61,7 @@ from teleop_protocol.tdpa import OperatorPassivity
 __all__ = ['Leader', 'LeaderConfig']
 
 _STAMP_ROUNDING = 1e-6  # [s] a stamp through the message's integer seconds and nanoseconds
+_NO_SHIFT = np.zeros(3)
 
 
 @dataclass(frozen=True)
@@ -154,15 +159,17 @@ class Leader:
         """Whether feedback came within ``link_timeout`` before ``now``."""
         return now - self._heard <= self.config.link_timeout
 
-    def command(self, stamp: float, wand, wand_velocity) -> Command | None:
+    def command(self, stamp: float, wand, wand_velocity,
+                device_shift=_NO_SHIFT) -> Command | None:
         """Return the command for the wand's pose stamped ``stamp`` (s, this site's clock).
 
-        None while the feedback is silent: the robot holds rather than follow an operator who
-        feels nothing.
+        ``device_shift`` (3,) m: how far out of the planes sent the device renders them (its
+        easing, its port's bound after a lapse), which the robot's target takes too. None while
+        the feedback is silent: the robot holds rather than follow an operator who feels nothing.
         """
         if not self.live(stamp):
             return None
-        target = self.map.to_robot(wand) + self.map.position_scale * self._shift
+        target = self.map.to_robot(wand) + self.map.position_scale * (self._shift + device_shift)
         sequence = next(reversed(self._sent), 0) + 1
         self._sent[sequence] = stamp
         if len(self._sent) > self.SENT_KEPT:

@@ -10,7 +10,8 @@ driver starts its experiment at the first answer to its probe, and a scripted ha
 before the robot was found pressed from an anchor it had already left (the first feedback came
 2.2-2.4 s after the scan began over the gateways, the wand 18-20 mm down: the probe tracked that
 far above it, and the patient was pressed 5.1 N instead of 7.2). ``teleop/clutch`` (Bool, true:
-engaged) re-centres the wand without moving the robot.
+engaged) re-centres the wand without moving the robot. With ``model``, ``wand/model_shift`` (how
+far out the device renders the planes) moves the robot's target out as far.
 """
 import math
 from typing import Sequence
@@ -21,9 +22,10 @@ from std_msgs.msg import Bool
 
 from haptic_contract.contact_model import Kind, MODEL, model_fields
 from haptic_contract.graph import (TELEOP_CLUTCH, TELEOP_COMMAND, TELEOP_FEEDBACK,
-                                   WAND_CONTACT_MODEL, WAND_POSE, WAND_TWIST, WAND_WRENCH)
+                                   WAND_CONTACT_MODEL, WAND_MODEL_SHIFT, WAND_POSE, WAND_TWIST,
+                                   WAND_WRENCH)
 from haptic_contract.streams import (frame, POSE, POSE_POSITION, stamp_ns, TWIST, TWIST_LINEAR,
-                                     WRENCH)
+                                     VECTOR, VECTOR_VALUE, WRENCH)
 from haptic_contract.teleop import feedback_refusal, Scheme
 from haptic_contract.teleop_fields import COMMAND, command_fields, FEEDBACK, feedback_from_fields
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
@@ -64,6 +66,7 @@ class LeaderNode(Node):
         self.leader: Leader | None = None  # from the first feedback on
         self._pending = None  # (stamp ns, position) of the latest pose
         self._twist = None  # (stamp ns, velocity) of the latest twist
+        self._model_shift = np.zeros(3)  # [m] the device's, beyond the planes sent
         self._answered_ns = None  # the stamp of the pose answered last
         self._last_stamp_ns = None
         self._clutch = False
@@ -75,8 +78,10 @@ class LeaderNode(Node):
         answer = ((MODEL, WAND_CONTACT_MODEL) if params.scheme == Scheme.MODEL
                   else (WRENCH, WAND_WRENCH))
         self._answer_pub = stream_publisher(self, *answer)
-        for codec, topic, callback in ((POSE, WAND_POSE, self.on_pose),
-                                       (TWIST, WAND_TWIST, self.on_twist)):
+        streams = [(POSE, WAND_POSE, self.on_pose), (TWIST, WAND_TWIST, self.on_twist)]
+        if params.scheme == Scheme.MODEL:
+            streams.append((VECTOR, WAND_MODEL_SHIFT, self.on_model_shift))
+        for codec, topic, callback in streams:
             stream_subscription(self, codec, topic, callback, refused=self._refused)
         stream_subscription(self, FEEDBACK, TELEOP_FEEDBACK, self.on_feedback,
                             refused=self._refused, qos=LINK_QOS)
@@ -120,6 +125,13 @@ class LeaderNode(Node):
         self._twist = (stamp_ns(fields), fields[TWIST_LINEAR])
         self._answer_when_paired()
 
+    def on_model_shift(self, fields: Sequence) -> None:
+        shift = np.array(fields[VECTOR_VALUE], dtype=np.float64)
+        if frame(fields) != self.params.frame_id or not np.all(np.isfinite(shift)):
+            self._refused.add('model shift not finite or in another frame')
+            return
+        self._model_shift = shift
+
     def _answer_when_paired(self) -> None:
         """Answer the pose once the twist of its stamp is in too, whichever came first; once."""
         if (self._pending is None or self._twist is None or self._twist[0] != self._pending[0]
@@ -137,7 +149,7 @@ class LeaderNode(Node):
             return
         period = (stamp_ns - self._last_stamp_ns) * 1e-9 if self._last_stamp_ns else 1e-3
         self._last_stamp_ns = stamp_ns
-        command = self.leader.command(stamp_ns * 1e-9, position, velocity)
+        command = self.leader.command(stamp_ns * 1e-9, position, velocity, self._model_shift)
         if command is None:
             self._withheld += 1
         else:
