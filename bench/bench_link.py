@@ -185,16 +185,18 @@ def cpu_seconds(pid: int) -> float:
     return times.user + times.system
 
 
-def connect(end, pinger: Pinger) -> None:
-    """Ping until pongs come back, then for ``WARM_UP`` s more."""
+def connect(end, pinger: Pinger, first: int) -> int:
+    """Ping from ``first`` until pongs come back, then for ``WARM_UP`` s more; the next number.
+
+    Each path is pinged with numbers of its own: a pong of another path's is no sign of this one.
+    """
     deadline = time.monotonic() + CONNECT_LIMIT
-    first = -1_000_000
-    while not pinger.round_trips:
+    start = first
+    while not any(s in pinger.round_trips for s in range(start, first)):
         if time.monotonic() > deadline:
             raise RuntimeError('no pong came back: the path is not up')
-        pinger.run(end, 100.0, 0.1, first)
-        first += 10
-    pinger.run(end, 1000.0, WARM_UP, first)
+        first = pinger.run(end, 100.0, 0.1, first).stop
+    return pinger.run(end, 1000.0, WARM_UP, first).stop
 
 
 def measure(case: str, end, pinger: Pinger, args, pids: dict, first: int) -> dict:
@@ -245,8 +247,8 @@ def main(argv=None) -> int:
         dds, udp = DdsEnd(args.domain_id, pinger), UdpEnd(udp_port, pinger)
         pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
         try:
-            connect(udp, pinger)
-            connect(dds, pinger)
+            warmed = connect(udp, pinger, -2_000_000)
+            connect(dds, pinger, warmed)
             first = 0
             for _ in range(args.runs):
                 for case, end, watched in (('floor', udp, {'echo': echo.pid}),

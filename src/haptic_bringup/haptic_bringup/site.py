@@ -85,7 +85,8 @@ def loopback_gateway_parameters(folder: pathlib.Path, *, link: Optional[dict] = 
     The single-machine session takes the deployed path: a CA and both sites' certificates made
     for the run in ``folder/certs``, the remote gateway listening on a free loopback port, the
     operator's dialling it, each applying the emulated ``link`` to what it sends. ``routes``
-    (``to_remote``, ``to_operator``, and ``frames`` if any) replace the session's crossings.
+    (``to_remote``, ``to_operator``, and ``reliable`` and ``frames`` if any) replace the
+    session's crossings.
     """
     certs = folder / 'certs'
     init_ca(certs)
@@ -94,7 +95,7 @@ def loopback_gateway_parameters(folder: pathlib.Path, *, link: Optional[dict] = 
     with socket.socket() as probe:
         probe.bind(('127.0.0.1', 0))
         endpoint = [f'tls/127.0.0.1:{probe.getsockname()[1]}']
-    replaced = {'frames': [''], **routes} if routes else {}
+    replaced = {'reliable': [''], 'frames': [''], **routes} if routes else {}
     return {role: {**gateway_parameters(role, certs=str(certs), link=link, **{side: endpoint}),
                    **replaced}
             for role, side in (('remote', 'listen'), ('operator', 'connect'))}
