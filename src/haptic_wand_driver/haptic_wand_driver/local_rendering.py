@@ -212,7 +212,7 @@ class LocalRenderer:
         return (shift * normal[0], shift * normal[1], shift * normal[2])
 
     def _forget(self) -> None:
-        """Nothing renders planes now: the next model's start from no push."""
+        """Nothing renders planes now: the next model starts from no push."""
         self.bound[2] = self.bound[4] = self.bound[6] = self.bound[7] = self.bound[LAPSED] = 0.0
 
     def _shift(self, model: ContactModel, take: int, coordinates: Sequence[float],
