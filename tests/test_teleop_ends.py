@@ -264,6 +264,28 @@ def test_a_silence_keeps_the_books_the_hand_feels_what_it_left_and_the_robot_pre
     assert felt == pytest.approx(patient) == pytest.approx(4.0)
 
 
+def test_feedback_with_no_good_reading_is_a_silence_not_a_free_contact():
+    """Pressed 10 mm in, the robot's sensor reads nothing good for a while (a starved remote
+    site) and the hand sinks 30 mm. Meanwhile: no force, no command, no model. Then the first
+    plane stores what the spring held before, as after a silence; a free estimate would have
+    closed the books and shown it 40 mm out (ci18: the patient let go after a flood)."""
+    leader = Leader(LeaderConfig('model', force_scale=1.0, position_scale=1.0), np.zeros(3),
+                    np.zeros(3))
+    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
+    leader.receive(0.0, feedback(1.0, plane=skin))
+    assert leader.plane(0.001, np.array([0.0, 0.0, -0.01])) is not None
+    pressed = np.array([0.0, 0.0, -0.02])
+    before = stored(leader.plane(0.002, pressed), pressed)
+    unread = feedback(1.003, (0.0, 0.0, 0.0))._replace(measured=False)
+    assert leader.receive(0.003, unread) is None and leader.live(0.004)
+    assert leader.model(0.004, pressed) == (False, None)
+    assert leader.command(0.004, pressed, np.zeros(3)) is None
+    np.testing.assert_array_equal(leader.force(0.004, pressed, np.zeros(3), 1e-3), np.zeros(3))
+    deep = np.array([0.0, 0.0, -0.05])
+    leader.receive(0.005, feedback(1.005, plane=skin))
+    assert stored(leader.plane(0.006, deep), deep) == pytest.approx(before)
+
+
 def test_the_clutch_closes_the_books_as_the_device_does_for_a_free_model():
     """Pressed 10 mm in, the operator clutches (the device renders free and closes its books),
     moves the wand 30 mm deeper and lets go: nothing is stored at first, on either side."""

@@ -48,6 +48,19 @@ def test_feedback_crosses_whole_with_its_plane_or_without():
             assert (back.plane.stiffness, back.plane.damping) == (480.0, 3.0)
 
 
+def test_feedback_without_a_good_reading_crosses_as_unknown_not_as_free():
+    """A faulty or stale force reading says nothing of the contact: not "no contact"."""
+    sent = Feedback(7.25, 1_795_000_000.5, 0.002, np.zeros(3), np.array([0.0, 0.01, -0.04]),
+                    0.125, None, 0x5EED, 900, 77, measured=False)
+    data = FEEDBACK.encode(feedback_fields(sent, 'base_link'))
+    assert deserialize_message(data, TeleopFeedback).kind == TeleopFeedback.KIND_UNKNOWN
+    _, back = feedback_from_fields(FEEDBACK.decode(data))
+    assert not back.measured and back.plane is None
+    _, free = feedback_from_fields(FEEDBACK.decode(FEEDBACK.encode(
+        feedback_fields(sent._replace(measured=True), 'base_link'))))
+    assert free.measured and free.plane is None
+
+
 def test_what_a_robot_says_of_itself_is_read_back():
     message = impedance_message('base_link', stiffness=1500.0, max_speed=0.25,
                                 workspace_lower=(-0.4, -0.3, -0.2),

@@ -109,6 +109,7 @@ def follower(tmp_path):
 
 
 def test_a_nan_in_the_ft_wrench_feeds_back_zero_force_and_no_plane_until_a_good_one(follower):
+    """Said as unknown, not free: a bad reading says nothing of the contact."""
     follower.spin(1.0)
     good = follower.since(time.monotonic() - 0.5)
     assert good and all(force == PRESSED for force, _ in good)
@@ -120,7 +121,7 @@ def test_a_nan_in_the_ft_wrench_feeds_back_zero_force_and_no_plane_until_a_good_
     follower.spin(0.5)
     bad = follower.since(bad_start)
     assert len(bad) > 20
-    assert all(force == 0.0 and kind == TeleopFeedback.KIND_FREE for force, kind in bad), bad
+    assert all(force == 0.0 and kind == TeleopFeedback.KIND_UNKNOWN for force, kind in bad), bad
 
     follower.reading = PRESSED
     follower.spin(SETTLE)

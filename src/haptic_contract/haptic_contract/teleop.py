@@ -110,6 +110,9 @@ class Feedback(NamedTuple):
         The remote site's session, and the feedback's number in it (from 1).
     echo_sequence : int
         The echoed command's sequence; 0 before any.
+    measured : bool
+        Whether the sensor read the force well: if not, the force is zero and the plane None,
+        and neither says the contact ended (a stale or faulty reading in a starved site).
     """
 
     stamp: float
@@ -122,6 +125,7 @@ class Feedback(NamedTuple):
     session: int = 0
     sequence: int = 0
     echo_sequence: int = 0
+    measured: bool = True
 
 
 class CommandLimits(NamedTuple):

@@ -78,13 +78,15 @@ def feedback_from_fields(fields) -> tuple[str, Feedback]:
     echo = fields[_FEEDBACK_ECHO]
     return fields[_FRAME], Feedback(_stamp(fields), _stamp(echo), float(numbers[0]),
                                     numbers[1:4], numbers[4:7], float(numbers[7]), plane,
-                                    *fields[_FEEDBACK_IDS], echo[2])
+                                    *fields[_FEEDBACK_IDS], echo[2],
+                                    fields[_FEEDBACK_KIND] != TeleopFeedback.KIND_UNKNOWN)
 
 
 def feedback_fields(feedback: Feedback, frame: str) -> tuple:
     """Return the TeleopFeedback fields of ``feedback`` in ``frame``."""
     plane = feedback.plane
-    kind = TeleopFeedback.KIND_FREE if plane is None else TeleopFeedback.KIND_PLANE
+    kind = (TeleopFeedback.KIND_UNKNOWN if not feedback.measured else
+            TeleopFeedback.KIND_FREE if plane is None else TeleopFeedback.KIND_PLANE)
     plane_fields = _NO_PLANE if plane is None else (
         *plane.point.tolist(), *plane.normal.tolist(), *[plane.stiffness] * 3,
         *[plane.damping] * 3, 0.0, 0.0, 0.0)

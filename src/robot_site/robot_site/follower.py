@@ -205,4 +205,4 @@ class Follower:
         self._sent += 1
         return Feedback(now, echo, hold, force if good else np.zeros(3), self._tcp,
                         self.passivity.books.energy_in, self._plane if good else None,
-                        self.session, self._sent, echoed)
+                        self.session, self._sent, echoed, good)

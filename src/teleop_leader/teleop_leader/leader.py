@@ -159,6 +159,15 @@ class Leader:
         """Whether feedback came within ``link_timeout`` before ``now``."""
         return now - self._heard <= self.config.link_timeout
 
+    def heard(self, now: float) -> bool:
+        """Whether the feedback is live and says what the probe touches: its force was read.
+
+        Unread (a stale or faulty sensor in a starved remote site) it is a silence: zero force, no
+        command, no model, and the books kept. Taken for a free estimate, it closed them, and the
+        hand that sank meanwhile (60 mm through a flood) lost the patient for good.
+        """
+        return self.live(now) and self._feedback.measured
+
     def command(self, stamp: float, wand, wand_velocity,
                 device_shift=_NO_SHIFT) -> Command | None:
         """Return the command for the wand's pose stamped ``stamp`` (s, this site's clock).
@@ -167,7 +176,7 @@ class Leader:
         easing, its port's bound after a lapse), which the robot's target takes too. None while
         the feedback is silent: the robot holds rather than follow an operator who feels nothing.
         """
-        if not self.live(stamp):
+        if not self.heard(stamp):
             return None
         target = self.map.to_robot(wand) + self.map.position_scale * (self._shift + device_shift)
         sequence = next(reversed(self._sent), 0) + 1
@@ -183,7 +192,7 @@ class Leader:
         Not for ``model``. Zero while the link is silent or the clutch is engaged: for ``tdpa``
         the coupling is then let go, and starts again at rest where the wand is.
         """
-        if not self.live(now) or self.map.clutched:
+        if not self.heard(now) or self.map.clutched:
             self._coupling = None
             return np.zeros(3)
         patient = self._feedback.force
@@ -207,8 +216,8 @@ class Leader:
         In the wand's frame, with the felt gains, moved out as far as a passive update needs.
         None too while the link is silent or the clutch is engaged.
         """
-        if not self.live(now) or self.map.clutched or self._feedback.plane is None:
-            if not self.live(now):  # the spring lapses: its energy stays booked
+        if not self.heard(now) or self.map.clutched or self._feedback.plane is None:
+            if not self.heard(now):  # the spring lapses: its energy stays booked
                 self._reserve += 0.0 if self._shown is None else _stored(self._shown, wand)
             else:  # rendered free: the books close
                 self._reserve = 0.0
@@ -237,7 +246,7 @@ class Leader:
         interrupted, which a free model would close.
         """
         plane = self.plane(now, wand)
-        return plane is not None or self.live(now), plane
+        return plane is not None or self.heard(now), plane
 
 
 def _stored(plane: RemotePlane, wand) -> float:
