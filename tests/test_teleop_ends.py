@@ -240,18 +240,26 @@ def test_the_plane_sent_has_the_tissue_in_series_with_the_robots_spring():
     np.testing.assert_allclose(plane.normal, UP, atol=1e-3)
 
 
+def pressed_into_the_skin():
+    """A model leader, unscaled, shown the skin 10 mm under the start, the wand 10 mm into it.
+
+    Returns the leader, the skin, the wand and the energy the shown spring holds there (J).
+    """
+    leader = Leader(LeaderConfig('model', force_scale=1.0, position_scale=1.0), np.zeros(3),
+                    np.zeros(3))
+    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
+    leader.receive(0.0, feedback(1.0, plane=skin))
+    assert leader.plane(0.001, np.array([0.0, 0.0, -0.01])) is not None  # at the skin
+    pressed = np.array([0.0, 0.0, -0.02])
+    return leader, skin, pressed, stored(leader.plane(0.002, pressed), pressed)
+
+
 def test_a_silence_keeps_the_books_the_hand_feels_what_it_left_and_the_robot_presses_as_much():
     """Pressed 10 mm into the shown plane, the link fell silent and the hand sank 30 mm more.
     The first model after it stores what the spring held when the silence began, no more (no
     jolt, passive), and the robot's target, moved out by the same shift, presses the patient
     with the force the hand feels."""
-    config = LeaderConfig('model', force_scale=1.0, position_scale=1.0)
-    leader = Leader(config, np.zeros(3), np.zeros(3))
-    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
-    leader.receive(0.0, feedback(1.0, plane=skin))
-    assert leader.plane(0.001, np.array([0.0, 0.0, -0.01])) is not None  # at the skin
-    pressed = np.array([0.0, 0.0, -0.02])
-    before = stored(leader.plane(0.002, pressed), pressed)
+    leader, skin, pressed, before = pressed_into_the_skin()
     assert before == pytest.approx(0.5 * 400.0 * 0.01 ** 2)
     assert leader.model(0.5, pressed) == (False, None)  # silent: unknown, no model
     deep = np.array([0.0, 0.0, -0.05])
@@ -269,13 +277,7 @@ def test_feedback_with_no_good_reading_is_a_silence_not_a_free_contact():
     site) and the hand sinks 30 mm. Meanwhile: no force, no command, no model. Then the first
     plane stores what the spring held before, as after a silence; a free estimate would have
     closed the books and shown it 40 mm out (ci18: the patient let go after a flood)."""
-    leader = Leader(LeaderConfig('model', force_scale=1.0, position_scale=1.0), np.zeros(3),
-                    np.zeros(3))
-    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
-    leader.receive(0.0, feedback(1.0, plane=skin))
-    assert leader.plane(0.001, np.array([0.0, 0.0, -0.01])) is not None
-    pressed = np.array([0.0, 0.0, -0.02])
-    before = stored(leader.plane(0.002, pressed), pressed)
+    leader, skin, pressed, before = pressed_into_the_skin()
     unread = feedback(1.003, (0.0, 0.0, 0.0))._replace(measured=False)
     assert leader.receive(0.003, unread) is None and leader.live(0.004)
     assert leader.model(0.004, pressed) == (False, None)
@@ -289,13 +291,8 @@ def test_feedback_with_no_good_reading_is_a_silence_not_a_free_contact():
 def test_the_clutch_closes_the_books_as_the_device_does_for_a_free_model():
     """Pressed 10 mm in, the operator clutches (the device renders free and closes its books),
     moves the wand 30 mm deeper and lets go: nothing is stored at first, on either side."""
-    leader = Leader(LeaderConfig('model', force_scale=1.0, position_scale=1.0), np.zeros(3),
-                    np.zeros(3))
-    skin = RemotePlane(np.array([0.0, 0.0, -0.01]), UP, 400.0, 0.0)
-    leader.receive(0.0, feedback(1.0, plane=skin))
-    assert leader.plane(0.001, np.array([0.0, 0.0, -0.01])) is not None
-    pressed = np.array([0.0, 0.0, -0.02])
-    assert stored(leader.plane(0.002, pressed), pressed) > 0.0
+    leader, _, pressed, before = pressed_into_the_skin()
+    assert before > 0.0
     leader.map.engage(pressed)
     assert leader.model(0.003, pressed) == (True, None)  # known: free
     deep = np.array([0.0, 0.0, -0.05])

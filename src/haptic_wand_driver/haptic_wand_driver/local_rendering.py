@@ -208,8 +208,16 @@ class LocalRenderer:
         if bound[LAPSED] and self.model_step_rate > 0.0:
             springs = [(d, bound[3] * k) for d, k in held_normals(model, bound[7:]).springs(
                 coordinates, coordinates[3], coordinates[4])]
-            shift = matched_shift(springs, min(float(bound[2]), spring_push(springs, 0.0)))
+            shift = matched_shift(springs, self._push_to_match(springs))
         return (shift * normal[0], shift * normal[1], shift * normal[2])
+
+    def _push_to_match(self, springs) -> float:
+        """Return the push a model's first eased period starts from, on its ``springs``.
+
+        The last period's; after a lapse, no more than the model pushes where the tool now is.
+        """
+        push = float(self.bound[2])
+        return min(push, spring_push(springs, 0.0)) if self.bound[LAPSED] else push
 
     def _forget(self) -> None:
         """Nothing renders planes now: the next model starts from no push."""
@@ -242,9 +250,7 @@ class LocalRenderer:
             scale = stiff / total if stiff > 0.0 and total > 0.0 else 1.0
             extra = matched_extra(rendered, damped)
             springs = [(d, scale * k) for d, k in springs]
-            if self.bound[LAPSED]:
-                push = min(push, spring_push(springs, 0.0))
-            shift = matched_shift(springs, push)
+            shift = matched_shift(springs, self._push_to_match(springs))
         else:
             held = stored_energy([(d, scale * k) for d, k in rendered.springs(
                 coordinates, roll, yaw)], shift)
