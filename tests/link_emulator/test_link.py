@@ -109,3 +109,17 @@ def test_sending_back_in_time_is_refused():
     link.send(1.0, None)
     with pytest.raises(ValueError, match='must not go back'):
         link.send(0.5, None)
+
+
+def test_a_reliable_message_is_never_lost_and_each_loss_costs_it_a_round_trip():
+    count = 2000
+    link = EmulatedLink(LinkConfig(delay=0.05, loss=0.5, reorder=True, seed=4))
+    assert all(link.send(index * PERIOD, index, reliable=True) for index in range(count))
+    deliveries = link.deliver(math.inf)
+    assert sorted(d.payload for d in deliveries) == list(range(count)) and link.lost == 0
+    late = np.array([(d.arrived - d.sent - 0.05) / 0.1 for d in deliveries])
+    round_trips = np.round(late)
+    np.testing.assert_allclose(late, round_trips, atol=1e-9)
+    assert round_trips.sum() == link.retransmitted
+    # First time through for half of them, within 4 standard deviations of the binomial.
+    assert abs(np.mean(round_trips == 0) - 0.5) < 4 * math.sqrt(0.25 / count)

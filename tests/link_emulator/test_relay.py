@@ -65,6 +65,18 @@ def test_counts_say_what_was_lost_in_flight_and_how_late():
     assert 0.0 <= p50 <= p99 <= 0.0115 - 0.01 + 1e-12
 
 
+def test_the_routes_that_must_arrive_are_never_lost_where_the_others_are():
+    relay = Relay(EmulatedLink(LinkConfig(delay=0.01, loss=0.3, seed=2)), reliable={1})
+    for index in range(400):
+        relay.send(index * 1e-3, index % 2, bytes([index % 256]))
+    released = relay.release(math.inf)
+    assert sum(route == 1 for route, _ in released) == 200
+    assert 100 < sum(route == 0 for route, _ in released) < 180
+    counts = relay.counts()
+    assert counts['lost'] == 200 - sum(route == 0 for route, _ in released)
+    assert counts['retransmitted'] > 30
+
+
 def test_lateness_is_summarized_over_the_latest_releases_only():
     relay = Relay(EmulatedLink(LinkConfig(delay=0.0)))
     relay.send(0.0, 0, b'late')

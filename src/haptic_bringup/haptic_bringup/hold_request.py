@@ -37,5 +37,5 @@ def hold_during(domain_id: int, force: float, start: float, end: float | None,
             if at is not None:
                 time.sleep(max(0.0, came.monotonic + at - time.monotonic()))
                 publisher.publish(Float64(data=float(value)))
-        publisher.wait_for_all_acked(Duration(seconds=ACKED_WITHIN))  # the gateway has it
-        return came.wall
+        acked = publisher.wait_for_all_acked(Duration(seconds=ACKED_WITHIN))  # the gateway has it
+        return came.wall if acked else None

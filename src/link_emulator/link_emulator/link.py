@@ -7,8 +7,11 @@ the site gateway hands each message to ``EmulatedLink.send`` and relays what ``d
 returns. It is pure (times are arguments, no clock is read), so a run is reproducible.
 
 Each message is lost with probability ``loss``, else it arrives after the one-way delay plus
-Gaussian jitter, clipped at zero. The delay is ``delay``, or read from a ``DelayTrace`` (a CSV of
-measured delays) at the message's send time. Without ``reorder`` a message never overtakes an
+Gaussian jitter, clipped at zero. A message sent ``reliable`` (the hold, the re-engage: what
+the transport must deliver) is never lost: each loss drawn for it costs a retransmission, one
+round trip (twice the delay) later, as a reliable protocol over a lossy path recovers it.
+The delay is ``delay``, or read from a ``DelayTrace`` (a CSV of measured delays) at the
+message's send time. Without ``reorder`` a message never overtakes an
 earlier one (one ordered path: a late message holds back those behind it); with it, each arrives
 at its own time. One seed fixes every draw. The round trip over it is measured by the sites
 themselves (``teleop_protocol.round_trip``).
@@ -153,10 +156,13 @@ class EmulatedLink:
         self._first_sent: float | None = None
         self._last_arrival = -math.inf
         self._last_sent = -math.inf
-        self.sent = self.lost = 0
+        self.sent = self.lost = self.retransmitted = 0
 
-    def send(self, time: float, payload) -> bool:
-        """Put ``payload`` on the link at ``time`` (s); return False if it is lost."""
+    def send(self, time: float, payload, *, reliable: bool = False) -> bool:
+        """Put ``payload`` on the link at ``time`` (s); return False if it is lost.
+
+        ``reliable``: it is never lost; each loss drawn delays it by a retransmission.
+        """
         time = finite_number(time, 'EmulatedLink.send time')
         if time < self._last_sent:
             raise ValueError(f'EmulatedLink.send: time {time!r} s is before the last send '
@@ -166,10 +172,15 @@ class EmulatedLink:
             self._first_sent = time
         self.sent += 1
         lost, jitter = self._rng.random() < self.config.loss, self._rng.standard_normal()
+        delay, resent = self._delay(time), 0.0
+        while lost and reliable:
+            self.retransmitted += 1
+            resent += 2.0 * delay
+            lost = self._rng.random() < self.config.loss
         if lost:
             self.lost += 1
             return False
-        arrival = time + max(0.0, self._delay(time) + self.config.jitter * jitter)
+        arrival = time + resent + max(0.0, delay + self.config.jitter * jitter)
         if not self.config.reorder:
             arrival = self._last_arrival = max(arrival, self._last_arrival)
         heapq.heappush(self._queue, (arrival, next(self._order), time, payload))

@@ -107,16 +107,19 @@ class Relay:
     ----------
     link : EmulatedLink
         Shared by every route of this direction.
+    reliable : collection of int
+        The routes whose messages the transport must deliver: never lost on the link.
     """
 
-    def __init__(self, link: EmulatedLink) -> None:
+    def __init__(self, link: EmulatedLink, reliable=frozenset()) -> None:
         self.link = link
+        self._reliable = frozenset(reliable)
         self.relayed = 0
         self._lateness = deque(maxlen=LATENESS_WINDOW)  # [s] release time minus arrival
 
     def send(self, now: float, route: int, data: bytes) -> bool:
         """Put the bytes of ``route`` on the link at ``now`` (s); return False if lost."""
-        return self.link.send(now, Release(route, data))
+        return self.link.send(now, Release(route, data), reliable=route in self._reliable)
 
     def release(self, now: float) -> list:
         """Return the ``Release`` of each message due by ``now`` (s), in order of arrival."""
@@ -151,6 +154,7 @@ class Relay:
         """Return what a diagnostics report says of this direction."""
         p50, p99 = self.lateness()
         return {'received': self.link.sent, 'relayed': self.relayed, 'lost': self.link.lost,
+                'retransmitted': self.link.retransmitted,
                 'in_flight': self.in_flight,
                 'lateness_p50_ms': '-' if p50 is None else f'{p50 * 1e3:.3f}',
                 'lateness_p99_ms': '-' if p99 is None else f'{p99 * 1e3:.3f}'}

@@ -184,7 +184,9 @@ class GatewayNode(Node):
         if params.insecure:
             self.get_logger().warn(INSECURE_WARNING)
         direction = 'to_remote' if params.role == 'operator' else 'to_operator'
-        self._relay = Relay(emulated_link(params, direction, name))
+        self._relay = Relay(emulated_link(params, direction, name),
+                            reliable={index for index, crossing in enumerate(routes.outgoing)
+                                      if crossing.kind == RELIABLE})
         self._inbound = Inbound(routes.incoming, params.key_prefix, params.max_rate)
         self._peers, self._connections, self._closing = set(), 0, False
         self.session = _open(config, name)
