@@ -71,7 +71,7 @@ def test_two_sigints_to_the_group_stop_every_node_cleanly(tmp_path, trial):
         for process, name in zip(processes, NODES):
             stacks = _native_stacks_if_stuck(process)
             _, err = process.communicate(timeout=60)
-            assert process.returncode == 0, f'{name} exited {process.returncode}:\n{err}{stacks}'
+            assert process.returncode == 0, f'{name} exited {process.returncode}:{stacks}\n{err}'
             assert not any(crash in err for crash in CRASHES), f'{name}:\n{err}'
     finally:  # a failed trial leaves no loop in the domain to answer the next one's
         for process in processes:
@@ -94,9 +94,12 @@ def _native_stacks_if_stuck(process: subprocess.Popen, after: float = 5.0) -> st
     gdb = shutil.which('gdb')
     if gdb is None:
         return '\n(still running; no gdb here for its native stacks)'
-    dump = subprocess.run([gdb, '-p', str(process.pid), '-batch', '-ex', 'thread apply all bt'],
+    # The main thread whole first (where the teardown sits), then the top of every other.
+    dump = subprocess.run([gdb, '-p', str(process.pid), '-batch', '-ex', 'thread 1', '-ex', 'bt',
+                           '-ex', 'thread apply all bt 6'],
                           capture_output=True, text=True, timeout=60)
-    return f'\nnative stacks {after:g} s after the stop:\n{dump.stdout}{dump.stderr}'
+    frames = [line for line in dump.stdout.splitlines() if line.startswith(('#', 'Thread '))]
+    return f'\nnative stacks {after:g} s after the stop:\n' + '\n'.join(frames or [dump.stderr])
 
 
 @pytest.mark.parametrize('inherited', [signal.SIG_DFL, signal.SIG_IGN],
