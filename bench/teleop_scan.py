@@ -26,8 +26,10 @@ applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor
 - the patient's **force rise** (issue 28's envelope): the time from the first contact to 90 % of
   the mean contact force, and the peak rate of rise of the patient's force over 5 ms;
 - the **force error** through the sweep (from 0.5 s after it begins, ``SWEEP`` from the wand's
-  first pose): the patient's force against the held one in a hold run, else against its own
-  mean (what the operator's hand keeps by itself).
+  first pose): the patient's force against its own mean (what the operator's hand keeps by
+  itself); in a hold run, against the held one, from 0.5 s after the hold reached the remote
+  site to its release's arrival there (both read from the remote site's bag: the link's delay
+  is not the regulator's settling).
 
 The jitter is given as a fraction of the delay (20 %, and 5 % loss: issue 28's harsher link, to
 500 ms one way). ``--delay-trace`` runs each scheme once more over a measured link: a CSV of
@@ -47,6 +49,7 @@ site asks on ``teleop/hold`` as the sweep begins and releases as it ends, across
 import argparse
 import concurrent.futures
 import itertools
+import math
 import os
 import pathlib
 import shutil
@@ -62,7 +65,8 @@ from haptic_bringup.bag import typestore_with
 from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import read_vectors
+from haptic_bringup.session import read_numbers, read_vectors
+from haptic_contract.graph import absolute, REMOTE_PREFIX, TELEOP_HOLD
 from link_emulator.link import DelayTrace
 
 __all__ = ['figures', 'felt_steps', 'hold_error', 'read_scan', 'run', 'main']
@@ -80,11 +84,12 @@ SMOOTH_RATIO = 3.0  # the felt force's steps at most this many times the patient
 RISE_WINDOW = 5e-3  # [s] the patient's rate of rise, over the F/T sensor's noise
 CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the sweep
 SWEEP = (5.0, 16.0)  # [s] from the first pose: the scan's sweep along the patient (scan.yaml)
-HOLD_SETTLE = 0.5  # [s] after the sweep begins, before its force error counts
+HOLD_SETTLE = 0.5  # [s] after the sweep begins, or the hold arrives, before the error counts
 HOLD_FORCE = 8.0  # [N] held in a hold run: the scan's own press
 SITE_STREAMS = ('in-process', 'dds')
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
           '/remote/robot/ft_sensor/wrench': 'wrench', '/remote/robot/tcp_pose': 'pose'}
+REMOTE_HOLD = REMOTE_PREFIX + absolute(TELEOP_HOLD)
 
 
 def read_scan(path: pathlib.Path) -> dict:
@@ -146,6 +151,16 @@ def force_rise(patient: np.ndarray, mean_contact: float) -> dict:
     reached = np.flatnonzero(norm[touched[0]:] >= 0.9 * mean_contact)
     return {'time_to_force_s': float(reached[0]) * GRID if reached.size else np.nan,
             'peak_rise_n_per_s': rate}
+
+
+def held_window(path: pathlib.Path) -> tuple:
+    """Return when (s) the hold reached the remote site and its release did (inf: none)."""
+    times, forces = read_numbers(path, typestore_with(custom_definitions()), REMOTE_HOLD)
+    held = np.flatnonzero(forces > 0.0)
+    if not held.size:
+        raise RuntimeError(f'{path}: no hold reached the remote site ({REMOTE_HOLD} is empty)')
+    released = np.flatnonzero((forces == 0.0) & (times > times[held[0]]))
+    return float(times[held[0]]), float(times[released[0]]) if released.size else math.inf
 
 
 def hold_error(times: np.ndarray, patient: np.ndarray, held: float, start: float,
@@ -225,19 +240,19 @@ def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
                 cpu = process_cpu(loop)
                 if loop.wait(60.0) is None:
                     raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
-            zero = None if asked is None else asked.result()
-            if asked is not None and zero is None:
+            if asked is not None and asked.result() is None:
                 raise RuntimeError(f'{scheme} at {delay} s: the hold was never asked')
         streams = ', '.join([site_streams] + ([] if model_step_rate is None else
                                               [f'ease {model_step_rate:g}'])
                             + ([] if delay_trace is None else [f'trace {delay_trace.name}'])
                             + ([] if hold is None else [f'force held {hold:g} N']))
         scan = read_scan(folder / 'bag')
-        start = scan['/wand/pose'][0][0] if zero is None else zero  # the hold's own zero
+        start = scan['/wand/pose'][0][0]
+        window = (start + SWEEP[0], start + SWEEP[1]) if hold is None else \
+            held_window(folder / 'bag')
         return {'scheme': scheme, **figures(scan, delay), 'cpu': cpu, 'site_streams': streams,
                 **hold_error(*scan['/remote/robot/ft_sensor/wrench'],
-                             np.nan if hold is None else hold, start + SWEEP[0],
-                             start + SWEEP[1])}
+                             np.nan if hold is None else hold, *window)}
 
 
 def process_cpu(loop: Loop) -> dict:

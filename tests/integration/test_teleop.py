@@ -19,8 +19,9 @@ from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.scan_clock import wait_for_first_pose
-from haptic_bringup.session import (bags, published_counts, read_vectors, reported,
-                                    SITE_PUBLISHERS, topic_counts)
+from haptic_bringup.session import (bags, published_counts, read_numbers, read_vectors,
+                                    reported, SITE_PUBLISHERS, topic_counts)
+from haptic_contract.graph import absolute, REMOTE_PREFIX, TELEOP_HOLD
 from link_emulator.link import silence_timeout
 
 DELAY = 0.05  # [s] one way
@@ -138,6 +139,9 @@ def test_a_force_hold_asked_at_the_operator_s_site_crosses_and_the_remote_site_h
     held = reports(folder, 'teleop_follower', 'force_hold')
     assert held and held[0] == 'None'  # not holding as the scan began
     assert float(held[-1]) == HELD
+    _, arrived = read_numbers(folder / 'bag', typestore_with(custom_definitions()),
+                              REMOTE_PREFIX + absolute(TELEOP_HOLD))
+    assert arrived.tolist() == [HELD]  # in the remote site's bag, once
 
 
 def wait_for_the_first_pose(domain_id: int, timeout: float) -> float:

@@ -19,7 +19,8 @@ from haptic_contract.graph import (absolute, COLLISION_STATE, PUBLISHERS, SCENE_
                                    SITE_PUBLISHERS, WAND_APPLIED_WRENCH, WAND_WRENCH)
 from haptic_util.stamps import to_nanoseconds
 
-__all__ = ['Frames', 'Session', 'bags', 'read_frames', 'read_session', 'read_vectors',
+__all__ = ['Frames', 'Session', 'bags', 'read_frames', 'read_numbers', 'read_session',
+           'read_vectors',
            'reported', 'topic_counts', 'published_counts', 'applied_work', 'PUBLISHERS',
            'SITE_PUBLISHERS']
 
@@ -178,6 +179,17 @@ def read_vectors(path: pathlib.Path, typestore, topics: dict, stamped: bool = Fa
             series[connection.topic][1].append(_xyz(vector))
     return {topic: (np.array(times), np.array(vectors).reshape(-1, 3))
             for topic, (times, vectors) in series.items()}
+
+
+def read_numbers(path: pathlib.Path, typestore, topic: str) -> tuple:
+    """Return (receive times s, values) of a ``std_msgs/Float64`` topic; empty if absent."""
+    times, values = [], []
+    with AnyReader(bags(path), default_typestore=typestore) as reader:
+        connections = [c for c in reader.connections if c.topic == topic]
+        for connection, stamp, raw in reader.messages(connections=connections):
+            times.append(stamp * 1e-9)
+            values.append(reader.deserialize(raw, connection.msgtype).data)
+    return np.array(times, dtype=np.float64), np.array(values, dtype=np.float64)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

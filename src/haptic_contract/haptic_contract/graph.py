@@ -129,16 +129,17 @@ TO_OPERATOR = (f'{absolute(TELEOP_FEEDBACK)}:haptic_msgs/msg/TeleopFeedback',
 # The operator's requests, rare and each one meant: they must arrive (reliable, in order).
 RELIABLE_CROSSINGS = (absolute(TELEOP_HOLD), absolute(TELEOP_RE_ENGAGE))
 # A session's bag holds what each site measured and what crossed the link, recorded where it
-# arrives (its sent copy is the same message, earlier). Left out, each one step from those and
-# read by no analysis: the wand's twist (the pose's rate), the leader's answer to its driver (the
-# feedback through the leader) and the robot's target (the command through the patient-safety
-# filter). Each 1 kHz stream recorded costs its writer and the recorder about 5 % of a core
-# (docs/cpu_budget.md), on two cores that hold both sites. The probe's image is recorded where
-# the operator sees it, once: its stamp is the pose's, so the bag gives pose to image there.
+# arrives (its sent copy is the same message, earlier; a hold's error counts from its arrival).
+# Left out, each one step from those and read by no analysis: the wand's twist (the pose's
+# rate), the leader's answer to its driver (the feedback through the leader) and the robot's
+# target (the command through the patient-safety filter). Each 1 kHz stream recorded costs its
+# writer and the recorder about 5 % of a core (docs/cpu_budget.md), on two cores that hold both
+# sites. The probe's image is recorded where the operator sees it, once: its stamp is the
+# pose's, so the bag gives pose to image there.
 OPERATOR_RECORDED = tuple(absolute(topic) for topic in (
     WAND_POSE, WAND_APPLIED_WRENCH, TELEOP_FEEDBACK, DIAGNOSTICS))
 REMOTE_RECORDED = tuple(absolute(topic) for topic in (
-    ROBOT_TCP_POSE, ROBOT_FT_WRENCH, TELEOP_COMMAND, DIAGNOSTICS))
+    ROBOT_TCP_POSE, ROBOT_FT_WRENCH, TELEOP_COMMAND, TELEOP_HOLD, TELEOP_RE_ENGAGE, DIAGNOSTICS))
 # Which node publishes each stream, by its name in /diagnostics reports (a node publishes each
 # of its streams once per count): the loop's, and a telerobotic site's own measurements.
 PUBLISHERS = {absolute(WAND_POSE): 'wand_driver', absolute(WAND_TWIST): 'wand_driver',
