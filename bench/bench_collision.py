@@ -162,23 +162,50 @@ def _ours_kernel(scene_object):
     return signed_distance, (lambda points: [tuple(p) for p in points])
 
 
+def fcl_geometry(shape):
+    """Return python-fcl's geometry for one of our shapes: its primitive, else a mesh."""
+    import fcl
+
+    if isinstance(shape, Box):
+        return fcl.Box(*shape.size)
+    if isinstance(shape, Cylinder):
+        return fcl.Cylinder(shape.radius, shape.height)
+    if isinstance(shape, ConvexMesh):
+        faces = np.column_stack((np.full(len(shape.faces), 3), shape.faces)).ravel()
+        return fcl.Convex(shape.vertices, len(shape.faces), faces)
+    geometry = fcl.BVHModel()
+    geometry.beginModel(len(shape.vertices), len(shape.faces))
+    geometry.addSubModel(shape.vertices, shape.faces)
+    geometry.endModel()
+    return geometry
+
+
+def coal_geometry(shape):
+    """Return coal's geometry for one of our shapes: its primitive, else a mesh."""
+    import coal
+
+    if isinstance(shape, Box):
+        return coal.Box(*shape.size)
+    if isinstance(shape, Cylinder):
+        return coal.Cylinder(shape.radius, shape.height)
+    if isinstance(shape, ConvexMesh):
+        points = coal.StdVec_Vec3s()
+        points.extend(list(shape.vertices))
+        return coal.Convex.convexHull(points, False, None)
+    geometry = coal.BVHModelOBBRSS()
+    geometry.beginModel(len(shape.faces), len(shape.vertices))
+    geometry.addVertices(shape.vertices)
+    geometry.addTriangles(shape.faces)
+    geometry.endModel()
+    return geometry
+
+
 def _fcl(scene_object):
     import fcl
 
     shape, pose = scene_object.shape, scene_object.pose
-    if isinstance(shape, Box):
-        geometry = fcl.Box(*shape.size)
-    elif isinstance(shape, Cylinder):
-        geometry = fcl.Cylinder(shape.radius, shape.height)
-    elif isinstance(shape, ConvexMesh):
-        faces = np.column_stack((np.full(len(shape.faces), 3), shape.faces)).ravel()
-        geometry = fcl.Convex(shape.vertices, len(shape.faces), faces)
-    else:
-        geometry = fcl.BVHModel()
-        geometry.beginModel(len(shape.vertices), len(shape.faces))
-        geometry.addSubModel(shape.vertices, shape.faces)
-        geometry.endModel()
-    target = fcl.CollisionObject(geometry, fcl.Transform(pose.rotation, pose.translation))
+    target = fcl.CollisionObject(fcl_geometry(shape),
+                                 fcl.Transform(pose.rotation, pose.translation))
     probe = fcl.CollisionObject(fcl.Sphere(PROBE_RADIUS), fcl.Transform())
     request = fcl.DistanceRequest(enable_nearest_points=True, enable_signed_distance=True)
 
@@ -193,20 +220,7 @@ def _coal(scene_object):
     import coal
 
     shape, pose = scene_object.shape, scene_object.pose
-    if isinstance(shape, Box):
-        geometry = coal.Box(*shape.size)
-    elif isinstance(shape, Cylinder):
-        geometry = coal.Cylinder(shape.radius, shape.height)
-    elif isinstance(shape, ConvexMesh):
-        points = coal.StdVec_Vec3s()
-        points.extend(list(shape.vertices))
-        geometry = coal.Convex.convexHull(points, False, None)
-    else:
-        geometry = coal.BVHModelOBBRSS()
-        geometry.beginModel(len(shape.faces), len(shape.vertices))
-        geometry.addVertices(shape.vertices)
-        geometry.addTriangles(shape.faces)
-        geometry.endModel()
+    geometry = coal_geometry(shape)
     probe = coal.Sphere(PROBE_RADIUS)
     compute = coal.ComputeDistance(geometry, probe)
     placed = coal.Transform3s(pose.rotation, pose.translation)

@@ -23,7 +23,7 @@ import tempfile
 import threading
 import time
 
-from bench import machine, result_files
+from bench import machine, result_files, ros_domain
 from geometry_msgs.msg import PoseStamped
 import numpy as np
 import psutil
@@ -34,7 +34,7 @@ from rclpy.node import Node
 from rclpy.serialization import serialize_message
 from rclpy.task import Future
 
-from haptic_bringup.launcher import add_venv_prefix, loop_environment
+from haptic_bringup.launcher import loop_environment
 from haptic_bringup.processes import start_child, stop_children
 from haptic_bringup.site import loopback_gateways
 from haptic_util.executor import run_nodes
@@ -222,12 +222,10 @@ def main(argv=None) -> int:
     parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
     parser.add_argument('--runs', type=int, default=1, help='alternated rounds of both cases')
     parser.add_argument('--rate', type=float, default=1000.0, help='[Hz] pings')
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)),
-                        help="the operator's side; the echo's is the next")
+    ros_domain.add_option(parser, help="the operator's side; the echo's is the next")
     result_files.add_option(parser)
     args = parser.parse_args(argv[1:])
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy", "eclipse-zenoh")}; load average '
           f'{os.getloadavg()[0]:.2f}')
     print(f'{args.rate:g} Hz pings for {args.seconds:g} s per case, {args.runs} alternated '

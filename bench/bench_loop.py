@@ -28,18 +28,17 @@ on a worker thread, so it must not show in the round trip.
 """
 import argparse
 import math
-import os
 import pathlib
 import sys
 import tempfile
 import time
 
-from bench import machine, result_files
+from bench import machine, result_files, ros_domain
 import numpy as np
 import psutil
 import yaml
 
-from haptic_bringup.launcher import add_venv_prefix, Loop, loop_environment, LoopConfig
+from haptic_bringup.launcher import Loop, loop_environment, LoopConfig
 from haptic_bringup.processes import start_child, stop_children
 from haptic_util.paths import package_file
 
@@ -242,11 +241,10 @@ def main(argv=None) -> int:
                         help="the loop on the hand with the scene's FCL cross-check on and off")
     parser.add_argument('--rates', nargs='+', type=float, default=[1000.0])
     parser.add_argument('--duration', type=float, default=10.0, help='per --sweep run')
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    ros_domain.add_option(parser)
     result_files.add_option(parser)
     args = parser.parse_args(argv)
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy", "numba")}')
     if args.sweep:
         return sweep(args)

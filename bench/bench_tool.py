@@ -164,14 +164,8 @@ def _fcl(scene, probe):
 
     scene_object = scene.objects[0]
     shape, pose = scene_object.shape, scene_object.pose
-    if isinstance(shape, Box):
-        geometry = fcl.Box(*shape.size)
-    else:
-        geometry = fcl.BVHModel()
-        geometry.beginModel(len(shape.vertices), len(shape.faces))
-        geometry.addSubModel(shape.vertices, shape.faces)
-        geometry.endModel()
-    target = fcl.CollisionObject(geometry, fcl.Transform(pose.rotation, pose.translation))
+    target = fcl.CollisionObject(bench_collision.fcl_geometry(shape),
+                                 fcl.Transform(pose.rotation, pose.translation))
     tool = fcl.CollisionObject(fcl.Box(*probe.size), fcl.Transform())
     request = fcl.DistanceRequest(enable_signed_distance=True)
 
@@ -188,14 +182,7 @@ def _coal(scene, probe):
 
     scene_object = scene.objects[0]
     shape, pose = scene_object.shape, scene_object.pose
-    if isinstance(shape, Box):
-        geometry = coal.Box(*shape.size)
-    else:
-        geometry = coal.BVHModelOBBRSS()
-        geometry.beginModel(len(shape.faces), len(shape.vertices))
-        geometry.addVertices(shape.vertices)
-        geometry.addTriangles(shape.faces)
-        geometry.endModel()
+    geometry = bench_collision.coal_geometry(shape)
     tool = coal.Box(*probe.size)
     compute = coal.ComputeDistance(geometry, tool)
     placed = coal.Transform3s(pose.rotation, pose.translation)

@@ -32,13 +32,13 @@ import pathlib
 import sys
 import tempfile
 
-from bench import machine, result_files
+from bench import machine, result_files, ros_domain
 from bench.teleop_scan import process_cpu
 import numpy as np
 from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import typestore_with
-from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import bags, read_frames, read_vectors, reported
 
@@ -193,11 +193,10 @@ def main(argv=None) -> int:
     parser.add_argument('--imager', nargs='+', default=['5'], metavar='HOW',
                         help="how the imager's frame thread yields: a niceness (0-19; the "
                         "node's default, 5) or idle (SCHED_IDLE); the first is the summary's")
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    ros_domain.add_option(parser)
     result_files.add_option(parser)
     args = parser.parse_args(argv)
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     for variant in args.imager:
         imager_parameters(variant)  # a bad one stops here, not after the first runs

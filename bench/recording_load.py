@@ -30,12 +30,12 @@ import sys
 import tempfile
 import time
 
-from bench import machine
+from bench import machine, ros_domain
 import numpy as np
 import psutil
 
 from haptic_bringup.bag import typestore_with
-from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import (published_counts, PUBLISHERS, read_vectors, reported,
                                     SITE_PUBLISHERS, topic_counts)
@@ -140,10 +140,9 @@ def main(argv=None) -> int:
     parser.add_argument('--hogs', nargs='+', type=int, default=[0, 1])
     parser.add_argument('--runs', type=int, default=1)
     parser.add_argument('--seconds', type=float, default=6.0)
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    ros_domain.add_option(parser)
     args = parser.parse_args(argv)
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     print(f'{"layout":<12} {"stop":<9} {"hogs":>4} {"published":>10} {"recorded":>10}')
     for _ in range(args.runs):

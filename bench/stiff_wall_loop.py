@@ -18,19 +18,18 @@ applied force. Both passivity controllers are on in both.
 import argparse
 from dataclasses import replace
 import math
-import os
 import pathlib
 import sys
 import tempfile
 
-from bench import machine, result_files
+from bench import machine, result_files, ros_domain
 import numpy as np
 
 from collision_engine import load_scene, surface_projection
 from force_renderer.params import ForceRendererParams
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.contacts import contact_intervals
-from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import applied_work, read_session
 from haptic_contract.contact_model import ContactModel, Kind, Plane
@@ -126,11 +125,10 @@ def main(argv=None) -> int:
     parser.add_argument('--rendering', nargs='+', default=['local', 'remote'],
                         choices=['local', 'remote'])
     parser.add_argument('--duration', type=float, default=6.0)
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    ros_domain.add_option(parser)
     result_files.add_option(parser)
     args = parser.parse_args(argv)
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy", "numba")}')
     print(f'{"K N/m":>8} {"rendering":>9} {"contacts/tap":>12} {"net work mJ":>11} '
           f'{"depth mm":>8} {"/ ideal":>7} {"peak N":>7} {"answered":>8}')

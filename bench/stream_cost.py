@@ -16,14 +16,14 @@ import sys
 import tempfile
 import time
 
-from bench import machine
+from bench import machine, ros_domain
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 import numpy as np
 import psutil
 from rclpy.node import Node
 from rclpy.serialization import serialize_message
 
-from haptic_bringup.launcher import add_venv_prefix, loop_environment
+from haptic_bringup.launcher import loop_environment
 from haptic_bringup.processes import start_child, stop_children
 from haptic_msgs.msg import CollisionState, ContactModel
 from haptic_util.cdr import MessageCodec
@@ -114,10 +114,9 @@ def main(argv=None) -> int:
     parser.add_argument('--seconds', type=float, default=5.0, help='measured window per pair')
     parser.add_argument('--rate', type=float, default=1000.0, help='[Hz]')
     parser.add_argument('--runs', type=int, default=2, help='median over this many pairs')
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    ros_domain.add_option(parser)
     args = parser.parse_args(argv[1:])
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     print(f'one publisher and one subscriber process at {args.rate:g} Hz, {args.seconds:g} s '
           f'windows, median of {args.runs}; CPU in % of one core')

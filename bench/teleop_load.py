@@ -28,12 +28,11 @@ import sys
 import tempfile
 import time
 
-from bench import machine, result_files, teleop_scan
+from bench import machine, result_files, ros_domain, teleop_scan
 import numpy as np
 from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import typestore_with
-from haptic_bringup.launcher import add_venv_prefix
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_vectors
 
@@ -140,14 +139,13 @@ def main(argv=None) -> int:
     parser.add_argument('--loads', nargs='+', default=list(LOADS), choices=list(LOADS))
     parser.add_argument('--rounds', type=int, default=1)
     parser.add_argument('--baseline', default=BASELINE, help='git ref of the code before')
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    ros_domain.add_option(parser)
     parser.add_argument('--duration', type=float, default=DURATION,
                         help="the session's length, s (the issue's: 20)")
     result_files.add_option(parser)
     parser.add_argument('--keep', type=pathlib.Path, help='keep each case\'s bag under here')
     args = parser.parse_args(argv)
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     started = machine.line('ros-jazzy-rclpy')
     print(f'machine: {started}; load average {os.getloadavg()[0]:.1f} at the start')
     rows = []

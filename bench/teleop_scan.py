@@ -50,20 +50,19 @@ import argparse
 import concurrent.futures
 import itertools
 import math
-import os
 import pathlib
 import shutil
 import sys
 import tempfile
 import time
 
-from bench import machine, result_files
+from bench import machine, result_files, ros_domain
 import numpy as np
 import psutil
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.hold_request import hold_during
-from haptic_bringup.launcher import add_venv_prefix, Loop, LoopConfig
+from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_numbers, read_vectors
 from haptic_contract.graph import absolute, REMOTE_PREFIX, TELEOP_HOLD
@@ -312,11 +311,10 @@ def main(argv=None) -> int:
                         help="model: the driver's easing of new models, N/s (0: at once)")
     parser.add_argument('--force-hold', action='store_true',
                         help=f'model once more per delay, {HOLD_FORCE:g} N held through the sweep')
-    parser.add_argument('--domain-id', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 42)))
+    ros_domain.add_option(parser)
     result_files.add_option(parser)
     args = parser.parse_args(argv)
-    add_venv_prefix()
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     print_header()
     rows, traces = [], {}

@@ -2,31 +2,27 @@
 
 The demo's ``probe-flat`` and ``probe-phantom`` runs (``simulated_operator.scripts.probe_sweep``:
 pressed, rolled +-20 degrees, slid and yawed) are read from their bags. On the flat slab the
-torque about the wand's roll axis has an analytic value: for a face of length L along its roll
-lever, rolled by theta with the tip a depth d under the plane of stiffness k, every point y of
-the face sits d - y sin(theta) deep, and
-
-    F = k/L ∫ (d - y sin θ) dy,    tau = k cos θ / L ∫ y (d - y sin θ) dy
-
-over the pressed part of [-L/2, L/2]. The face's width along the roll axis does not enter. The
-renderer sums the face at its grid's cell centres instead; that sum is computed here too, from
-the scene's tool section, so that the figure separates the grid's share of the difference from
-the loop's (the damper's, on a moving wand). Samples whose force the renderer did not render
-by the law (zeroed by its watchdog, or saturated to its force limit, which scales the torque
-too) are left out of the comparison. Nothing here imports the renderer.
+torque about the wand's roll axis has an analytic value, that of a continuous face
+(``ground_truth.probe_face``). The renderer sums the face at its grid's cell centres instead;
+that sum is computed here too, from the scene's tool section, so that the figure separates the
+grid's share of the difference from the loop's (the damper's, on a moving wand). Samples whose
+force the renderer did not render by the law (zeroed by its watchdog, or saturated to its force
+limit, which scales the torque too) are left out of the comparison. Nothing here imports the
+renderer.
 """
 
 from dataclasses import dataclass
 import math
 from pathlib import Path
 
+from ground_truth.probe_face import continuous_face
 import numpy as np
 from report_generator.report_format import format_number, markdown_table
 
 from collision_engine import read_scene
 from haptic_bringup.session import read_session
 
-__all__ = ['FLAT', 'PHANTOM', 'ProbeFindings', 'continuous_face', 'probe_figure',
+__all__ = ['FLAT', 'PHANTOM', 'ProbeFindings', 'probe_figure',
            'probe_section', 'read_probe_runs']
 
 FLAT, PHANTOM = 'probe-flat', 'probe-phantom'
@@ -54,29 +50,6 @@ class ProbeFindings:
     rendered: np.ndarray
     continuous: np.ndarray
     points: np.ndarray
-
-
-def continuous_face(depth: float, roll: float, length: float,
-                    stiffness: float) -> tuple[float, float]:
-    """Force (N) and roll torque (N·m) of a continuous face (module docstring)."""
-    s, c = math.sin(roll), math.cos(roll)
-    lower, upper = -0.5 * length, 0.5 * length
-    if s > 0.0:
-        upper = min(upper, depth / s)
-    elif s < 0.0:
-        lower = max(lower, depth / s)
-    elif depth <= 0.0:
-        return 0.0, 0.0
-    if upper <= lower:
-        return 0.0, 0.0
-
-    def force(y):
-        return depth * y - 0.5 * s * y * y
-
-    def moment(y):
-        return 0.5 * depth * y * y - s * y ** 3 / 3.0
-    return (stiffness / length * (force(upper) - force(lower)),
-            stiffness * c / length * (moment(upper) - moment(lower)))
 
 
 def _grid_face(depth: float, roll: float, rows: np.ndarray, stiffness: float) -> float:

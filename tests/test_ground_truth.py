@@ -1,6 +1,7 @@
 """The ground truth itself, checked against closed forms and hand-worked points."""
 
 import ast
+import math
 from pathlib import Path
 
 from fuzzing import examples
@@ -16,6 +17,7 @@ from ground_truth.distances import (
     sphere_signed_distance,
     winding_number,
 )
+from ground_truth.probe_face import continuous_face
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -281,6 +283,35 @@ def test_shipped_files_are_found():
 def test_unknown_scene_names_the_shipped_ones():
     with pytest.raises(FileNotFoundError, match='cuboid'):
         scene_path('no_such_scene')
+
+
+def midpoint_sum(depth: float, roll: float, length: float, stiffness: float, cells=200_000):
+    """Force and roll torque of the face cut in ``cells`` strips, each pushing at its middle."""
+    y = (np.arange(cells) + 0.5) * length / cells - 0.5 * length
+    pressed = np.maximum(depth - y * math.sin(roll), 0.0) * stiffness / cells
+    return pressed.sum(), math.cos(roll) * (y * pressed).sum()
+
+
+@pytest.mark.parametrize(('depth', 'roll'), [
+    (0.01, 0.2),     # fully pressed
+    (0.002, 0.35),   # one edge lifted
+    (0.002, -0.35),  # the other edge lifted
+    (0.003, 0.0),    # flush
+    (-0.001, 0.0),   # above the plane
+    (-0.001, 0.3),   # a corner still above
+    (-0.002, 0.3),   # rolled, one edge pressed while the tip is above
+])
+def test_the_probe_face_closed_form_is_the_integral(depth, roll):
+    force, torque = continuous_face(depth, roll, 0.04, 1000.0)
+    expected_force, expected_torque = midpoint_sum(depth, roll, 0.04, 1000.0)
+    assert force == pytest.approx(expected_force, rel=1e-6, abs=1e-12)
+    assert torque == pytest.approx(expected_torque, rel=1e-6, abs=1e-12)
+
+
+def test_a_fully_pressed_probe_face_torque_is_minus_k_l2_over_12_sin_cos():
+    _, torque = continuous_face(0.01, 0.2, 0.04, 1000.0)
+    assert torque == pytest.approx(-1000.0 * 0.04 ** 2 / 12 * math.sin(0.2) * math.cos(0.2),
+                                   rel=1e-12)
 
 
 # The toolkit's own packages: what the references must not compute their answers with.

@@ -42,6 +42,14 @@ def hull_distance(cloud: np.ndarray, points) -> np.ndarray:
     return mesh_signed_distance(np.asarray(points, dtype=np.float64), cloud, faces)[0]
 
 
+def hull_or_skip(cloud: np.ndarray, points) -> tuple[ConvexMesh, np.ndarray]:
+    """The hull of ``cloud`` and each point's brute-force distance; a degenerate cloud skips."""
+    try:
+        return ConvexMesh(cloud), hull_distance(cloud, points)
+    except (ValueError, QhullError):
+        assume(False)
+
+
 def grid_clouds():
     """Point clouds on a 1/64 grid: exact duplicates, collinear and coplanar points abound,
     but no feature is thinner than the grid allows (slivers are tested apart)."""
@@ -75,11 +83,7 @@ def check_outside(shape, cloud, point, truth, scale):
        st.floats(1e-3, 1e3))
 def test_gjk_matches_brute_force_on_random_polytopes(cloud, points, scale):
     cloud, points = cloud * scale, points * scale
-    try:
-        shape = ConvexMesh(cloud)
-        reference = hull_distance(cloud, points)
-    except (ValueError, QhullError):
-        assume(False)
+    shape, reference = hull_or_skip(cloud, points)
     for point, truth in zip(points, reference):
         if truth > 1e-9 * scale:
             check_outside(shape, cloud, point, truth, scale)
@@ -93,11 +97,7 @@ def test_gjk_stays_within_1e_6_on_slivers(cloud, points):
     # With corners 1e-9 apart the search direction, known to rounding over the distance,
     # cannot tell such features apart: GJK may stop early or miss a contact by about that
     # much (2e-10 seen). No NaN, no exception, and the error is far below 1e-6 of the size.
-    try:
-        shape = ConvexMesh(cloud)
-        reference = hull_distance(cloud, points)
-    except (ValueError, QhullError):
-        assume(False)
+    shape, reference = hull_or_skip(cloud, points)
     for point, truth in zip(points, reference):
         _, contact, v, _, _ = run_gjk(shape, point, point - shape.vertices.mean(axis=0))
         distance = 0.0 if contact else np.linalg.norm(v)

@@ -2,12 +2,14 @@
 
 The ground truth here builds its own face grid and measures its own plane: it shares no code with
 the collision engine's face shell or the law. The discrete sums are written as sums over the
-points; the continuous face's values are the closed-form integrals over the pressed part.
+points; the continuous face's values are the closed-form integrals over the pressed part
+(``ground_truth.probe_face``).
 """
 
 import math
 
 from fuzzing import examples
+from ground_truth.probe_face import continuous_face
 from hypothesis import given, settings
 from hypothesis import strategies as st
 import numpy as np
@@ -61,25 +63,6 @@ def point_sum(face: np.ndarray, rotation: np.ndarray, tip, height: float = 0.0):
     return force, torque
 
 
-def continuous(depth: float, theta: float, length: float = LENGTH) -> tuple[float, float]:
-    """Force (N) and roll torque (N·m) of a continuous face rolled by theta, tip ``depth`` in.
-
-    Points at y along the face sit at depth(y) = depth - y sin(theta); the pressed part runs from
-    -L/2 to y1 = min(L/2, depth / sin(theta)) (theta > 0); F = k/L ∫ depth(y) dy and
-    tau = k cos(theta)/L ∫ y depth(y) dy.
-    """
-    s, c = math.sin(theta), math.cos(theta)
-    lower, upper = -0.5 * length, min(0.5 * length, depth / s) if s > 0 else 0.5 * length
-
-    def force(y):
-        return depth * y - 0.5 * s * y * y
-
-    def moment(y):
-        return 0.5 * depth * y * y - s * y ** 3 / 3.0
-    return (K / length * (force(upper) - force(lower)),
-            K * c / length * (moment(upper) - moment(lower)))
-
-
 @pytest.mark.parametrize('cells', [(1, 1), (2, 8), (4, 16), (10, 40)])
 def test_a_flush_face_pushes_k_depth_and_no_torque_at_any_point_count(cells):
     law = ProbeSpringDamper(K, C)
@@ -121,7 +104,7 @@ def test_a_fine_face_converges_to_the_continuous_integral(theta, depth):
     face = grid(1, 2000)
     law = ProbeSpringDamper(K, C)
     force = law.force(on_plane(face, roll_yaw(theta), (0.0, 0.0, -depth)), (0.0, 0.0, 0.0))
-    expected_force, expected_torque = continuous(depth, theta)
+    expected_force, expected_torque = continuous_face(depth, theta, LENGTH, K)
     assert force[2] == pytest.approx(expected_force, rel=1e-3)
     assert law.torque(None)[0] == pytest.approx(expected_torque, rel=1e-3)
     assert law.torque(None)[0] < 0.0  # restoring: the pressed low side turns the face back

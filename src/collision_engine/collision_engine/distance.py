@@ -8,7 +8,6 @@ and reused between calls.
 """
 
 from dataclasses import dataclass
-import math
 import weakref
 
 import numpy as np
@@ -16,6 +15,7 @@ import numpy as np
 from collision_engine import _kernels
 from collision_engine.gjk import STATUS_INVALID_INPUT
 from collision_engine.transforms import Pose
+from haptic_contract.checks import finite_components, finite_number, whole_number
 
 __all__ = ['DistanceRequest', 'DistanceResult', 'distance']
 
@@ -50,21 +50,14 @@ class DistanceRequest:
 
     def __post_init__(self) -> None:
         for name in ('rel_tol', 'abs_tol'):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
-                raise ValueError(f'DistanceRequest.{name} must be a finite number >= 0, '
-                                 f'got {value!r}')
+            object.__setattr__(self, name, finite_number(getattr(self, name),
+                                                         f'DistanceRequest.{name}', minimum=0.0))
         for name in ('max_iterations', 'max_epa_iterations'):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f'DistanceRequest.{name} must be an integer >= 1, '
-                                 f'got {value!r}')
+            object.__setattr__(self, name, whole_number(getattr(self, name),
+                                                        f'DistanceRequest.{name}'))
         if self.guess is not None:
-            guess = tuple(float(g) for g in self.guess)
-            if len(guess) != 3 or not all(math.isfinite(g) for g in guess):
-                raise ValueError(f'DistanceRequest.guess must be 3 finite numbers, '
-                                 f'got {self.guess!r}')
-            object.__setattr__(self, 'guess', guess)
+            object.__setattr__(self, 'guess', finite_components(self.guess, 3,
+                                                                'DistanceRequest.guess'))
 
 
 @dataclass(frozen=True, eq=False)

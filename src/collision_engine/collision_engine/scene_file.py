@@ -62,6 +62,7 @@ import yaml
 
 from collision_engine.errors import SceneError
 from collision_engine.transforms import Pose
+from haptic_contract.checks import whole_number
 
 __all__ = ['AnatomySpec', 'BoxSpec', 'CapsuleSpec', 'CrossValidationSpec', 'CylinderSpec',
            'MaterialSpec', 'MediumSpec', 'MeshSpec', 'ObjectSpec', 'SceneSpec', 'SphereSpec',
@@ -241,6 +242,9 @@ class _Reader:
             self.fail(where, f'must be a finite number{bound}, got {value!r}')
         return number
 
+    def count(self, value, where: str) -> int:
+        return whole_number(value, f'{self.path}: {where}:', error=SceneError)
+
     def vector(self, value, where: str, length: int, *, minimum: float = -math.inf,
                strict: bool = False) -> np.ndarray:
         if not isinstance(value, list) or len(value) != length:
@@ -386,12 +390,9 @@ def _tool(reader: _Reader, value) -> ToolSpec:
 def _cross_validation(reader: _Reader, value) -> CrossValidationSpec:
     where = 'cross_validation'
     fields = reader.mapping(value, where, (), ('fcl', 'every', 'tolerance'))
-    every = fields.get('every', 1)
-    if isinstance(every, bool) or not isinstance(every, int) or every < 1:
-        reader.fail(f'{where}.every', f'must be an integer >= 1, got {every!r}')
     return CrossValidationSpec(
         fcl=reader.boolean(fields.get('fcl', False), f'{where}.fcl'),
-        every=every,
+        every=reader.count(fields.get('every', 1), f'{where}.every'),
         tolerance=reader.number(fields.get('tolerance', 1e-6), f'{where}.tolerance',
                                 minimum=0.0, strict=True))
 

@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from haptic_contract.checks import finite_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector, whole_number
 
 __all__ = ['FirstOrderLowPass', 'ForceTorqueSensor', 'ForceTorqueSensorConfig', 'Wrench']
 
@@ -99,9 +99,7 @@ class ForceTorqueSensorConfig:
             finite_number(getattr(self, name), f'ForceTorqueSensorConfig.{name}', minimum=0.0)
         finite_number(self.bandwidth, 'ForceTorqueSensorConfig.bandwidth',
                       minimum=0.0, strict=True)
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise ValueError(f'ForceTorqueSensorConfig.seed must be an integer >= 0, '
-                             f'got {self.seed!r}')
+        whole_number(self.seed, 'ForceTorqueSensorConfig.seed', minimum=0)
 
 
 class ForceTorqueSensor:

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from haptic_contract.checks import whole_number
+
 __all__ = ['DEFAULT_OUTPUT', 'main', 'phantom_mesh', 'TORSO_SIZE']
 
 TORSO_SIZE = (0.30, 0.20, 0.15)
@@ -46,9 +48,8 @@ def phantom_mesh(size=TORSO_SIZE, *, exponent: float = 3.0, subdivisions: int = 
         raise ValueError(f'phantom size must be 3 finite lengths > 0 m, got {size!r}')
     if not (np.isfinite(exponent) and exponent >= 2.0):
         raise ValueError(f'phantom exponent must be finite and >= 2, got {exponent!r}')
-    if isinstance(subdivisions, bool) or not isinstance(subdivisions, int) or subdivisions < 1:
-        raise ValueError(f'phantom subdivisions must be an integer >= 1, got {subdivisions!r}')
-    sphere = trimesh.creation.icosphere(subdivisions=subdivisions)
+    sphere = trimesh.creation.icosphere(
+        subdivisions=whole_number(subdivisions, 'phantom subdivisions'))
     rays = sphere.vertices
     # The ray u meets the surface at t·u where t^p · Σ|u_i / half_i|^p = 1.
     reach = np.sum(np.abs(rays / half) ** exponent, axis=1) ** (-1.0 / exponent)

@@ -20,7 +20,7 @@ from typing import Callable, NamedTuple, Protocol, Sequence
 
 import numpy as np
 
-from haptic_contract.checks import finite_number, finite_vector
+from haptic_contract.checks import finite_number, finite_vector, whole_number
 from haptic_wand_driver.device import Workspace
 from haptic_wand_driver.pose_table import PoseFileError, PoseTable, read_pose_csv
 
@@ -417,10 +417,8 @@ def _tapping_from_aims(project: Projection, aim_points, taps: int, heading: floa
     aims = np.asarray(aim_points, dtype=np.float64)
     if aims.ndim != 2 or aims.shape[1] != 3 or len(aims) == 0:
         raise ScriptError(f'aim_points must be (n, 3), n >= 1, got shape {aims.shape}')
-    if not (isinstance(taps, int) and taps >= 1):
-        raise ScriptError(f'taps must be a positive integer, got {taps!r}')
     sites = []
-    for index in range(taps):
+    for index in range(whole_number(taps, 'taps', error=ScriptError)):
         aim = aims[index % len(aims)]
         point, normal = project(aim)
         try:

@@ -32,7 +32,7 @@ import bisect
 from collections import deque
 from dataclasses import dataclass
 
-from haptic_contract.checks import finite_number
+from haptic_contract.checks import finite_number, whole_number
 from haptic_contract.teleop import Refusal
 
 __all__ = ['Admission', 'AdmissionConfig', 'Refusal']
@@ -76,10 +76,7 @@ class AdmissionConfig:
         for name in ('max_age', 'max_lead', 'session_timeout', 'max_rate', 'burst', 'relearn'):
             finite_number(getattr(self, name), f'AdmissionConfig.{name}', minimum=0.0,
                           strict=True)
-        if isinstance(self.history, bool) or not isinstance(self.history, int) \
-                or self.history < 1:
-            raise ValueError(f'AdmissionConfig.history must be an integer >= 1, '
-                             f'got {self.history!r}')
+        whole_number(self.history, 'AdmissionConfig.history')
         finite_number(self.quantile, 'AdmissionConfig.quantile', minimum=0.0, maximum=1.0)
 
 

@@ -8,7 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from haptic_contract.checks import finite_number
+from haptic_contract.checks import finite_number, whole_number
 
 __all__ = ['EchoSample', 'RoundTripEstimator', 'echo_sample']
 
@@ -47,11 +47,8 @@ class RoundTripEstimator:
     """
 
     def __init__(self, window: int = 8) -> None:
-        if isinstance(window, bool) or not isinstance(window, int) or window < 1:
-            raise ValueError(f'RoundTripEstimator.window must be an integer >= 1, '
-                             f'got {window!r}')
+        self.window = whole_number(window, 'RoundTripEstimator.window')
         self._samples: list[EchoSample] = []
-        self.window = window
 
     def add(self, sent: float, received: float, replied: float, returned: float) -> EchoSample:
         """Take one echo's four stamps (see ``echo_sample``) and return its sample."""
