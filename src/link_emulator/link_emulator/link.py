@@ -27,7 +27,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from haptic_contract.checks import finite_number
+from haptic_contract.checks import finite_number, whole_number
 
 __all__ = ['DelayTrace', 'Delivery', 'EmulatedLink', 'LinkConfig', 'silence_timeout']
 
@@ -76,8 +76,7 @@ class LinkConfig:
             raise ValueError(f'LinkConfig.loss must be in [0, 1), got {self.loss!r}')
         if not isinstance(self.reorder, bool):
             raise ValueError(f'LinkConfig.reorder must be true or false, got {self.reorder!r}')
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise ValueError(f'LinkConfig.seed must be an integer >= 0, got {self.seed!r}')
+        whole_number(self.seed, 'LinkConfig.seed', minimum=0)
 
 
 class DelayTrace:
