@@ -34,8 +34,8 @@ until no discovery callback runs. The Fast DDS 2.14.5 wheel is built without
 running callback needs to end (Fast-DDS issue 6513). A peer that stops at the same moment runs
 such a callback, and the stop hung for good: one group stop in about 80 in the test suite, the
 main thread spinning in ``DomainParticipant::set_listener``, a receive thread blocked leaving
-``onWriterDiscovery``. Peers drop the participant when its lease runs out (20 s); its shared
-memory stays behind as a killed process's does (``haptic_bringup.processes.clean_stale_shm``).
+``onWriterDiscovery``. Peers drop the participant when its lease runs out (20 s); the process
+removes its shared-memory segments itself just before it ends (``shared_memory``).
 
 Once its nodes are destroyed and ROS is shut down (which flushes the logs), the process ends at
 once (``os._exit``). The interpreter's own teardown would only collect the objects of numba, scipy
@@ -66,7 +66,7 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
-from haptic_util import intra_process
+from haptic_util import intra_process, shared_memory
 from haptic_util.callback_errors import callback_errors, log_callback_error
 
 __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'end_process',
@@ -231,6 +231,7 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
             node.destroy_node()
         for context in contexts or [None]:
             rclpy.try_shutdown(context=context)
+        shared_memory.remove_segments_held_by(os.getpid())  # the participants' (kept alive)
         faulthandler.cancel_dump_traceback_later()
         # Should an error escape, Python's own exit follows, where it resets its handlers to the
         # default, and a late repeat would kill the process with SIGINT; an ignored signal it
