@@ -17,13 +17,14 @@ import sys
 import time
 from typing import Callable, Iterable, Optional
 
+from haptic_util import shared_memory
 from haptic_util.executor import hold_stop_signals
+from haptic_util.shared_memory import SHM_DIR
 
 __all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'run_until_stopped',
            'shm_segments', 'wait_any_exit']
 
 PR_SET_PDEATHSIG = 1
-SHM_DIR = pathlib.Path('/dev/shm')
 CREATION_GRACE = 2.0  # [s] a segment this young may still be being locked by its creator
 PORT_BASE, DOMAIN_GAIN = 7400, 250  # Fast DDS (RTPS) well-known port mapping
 
@@ -96,7 +97,7 @@ def stop_children(children: list, *, timeout: float = 5.0, gently: bool = True) 
 
 def shm_segments(directory: pathlib.Path = SHM_DIR) -> set:
     """Names of the Fast DDS segments now in ``directory`` (a snapshot for ``clean_stale_shm``)."""
-    return {path.name for path in directory.glob('fastrtps_*') if not path.name.endswith('_el')}
+    return shared_memory.segments(directory)
 
 
 def clean_stale_shm(directory: pathlib.Path = SHM_DIR, *, domains: Iterable[int],
@@ -125,7 +126,7 @@ def clean_stale_shm(directory: pathlib.Path = SHM_DIR, *, domains: Iterable[int]
             continue  # a live participant holds it
         except FileNotFoundError:
             pass  # no lock file: nobody can hold it
-        removed.append(_remove_segment(directory, name))
+        removed.append(shared_memory.remove_segment(name, directory))
     return removed
 
 
@@ -137,12 +138,6 @@ def _port(segment: str) -> Optional[int]:
 def _domain_of_port(port: int) -> int:
     """Fast DDS's default port mapping: 7400 + 250 x domain + offsets below 250."""
     return (port - PORT_BASE) // DOMAIN_GAIN
-
-
-def _remove_segment(directory: pathlib.Path, segment: str) -> str:
-    for name in (segment, f'{segment}_el', f'sem.{segment}_mutex'):
-        (directory / name).unlink(missing_ok=True)
-    return segment
 
 
 def wait_any_exit(children: list, timeout: float, poll: float = 0.05) -> Optional[Child]:

@@ -25,11 +25,23 @@ child before it runs Python), so one that comes while it still imports waits for
 before, it raised ``KeyboardInterrupt`` inside some import (a traceback), or, inherited as ignored
 from a shell without job control, was lost, and the node then spun forever.
 
-Once its nodes are destroyed (which deletes their DDS participants) and ROS is shut down (which
-flushes the logs), the process ends at once (``os._exit``). The interpreter's own teardown
-would only collect the objects of numba, scipy and trimesh: 0.7-3.8 s after the last word on
-this machine under load, past the 2 s a stopping session is allowed, and, at load 12, past the
-5 s ``ros2 launch`` waits before it escalates to SIGTERM.
+The nodes are destroyed, each telling its peers that its endpoints and its name are gone; the
+DDS participant under them is not deleted but left to the process's end, held by a hidden node
+without endpoints (``_keep_participants``). rmw_fastrtps deletes a context's participant with its
+last node, and first calls Fast DDS's ``set_listener(nullptr)`` with no time limit, which waits
+until no discovery callback runs. The Fast DDS 2.14.5 wheel is built without
+``pthread_cond_clockwait``: that wait's deadline overflows, and it spins holding the very mutex a
+running callback needs to end (Fast-DDS issue 6513). A peer that stops at the same moment runs
+such a callback, and the stop hung for good: one group stop in about 80 in the test suite, the
+main thread spinning in ``DomainParticipant::set_listener``, a receive thread blocked leaving
+``onWriterDiscovery``. Peers drop the participant when its lease runs out (20 s); the process
+removes its shared-memory segments itself just before it ends (``shared_memory``).
+
+Once its nodes are destroyed and ROS is shut down (which flushes the logs), the process ends at
+once (``os._exit``). The interpreter's own teardown would only collect the objects of numba, scipy
+and trimesh: 0.7-3.8 s after the last word on this machine under load, past the 2 s a stopping
+session is allowed, and, at load 12, past the 5 s ``ros2 launch`` waits before it escalates to
+SIGTERM.
 
 A callback that raises does not end its node: the spin logs the exception once, with its
 traceback, counts it, and goes on. Each node decides what a failed callback means for its output
@@ -50,10 +62,11 @@ from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedE
 from rclpy.experimental import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
-from haptic_util import intra_process
+from haptic_util import intra_process, shared_memory
 from haptic_util.callback_errors import callback_errors, log_callback_error
 
 __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'end_process',
@@ -79,6 +92,7 @@ _CONFIGURATION_ERRORS = (StartupError, ValueError, ParameterException, NameValid
 # main thread's handler to.
 _flags = {'stop': False, 'starting': False, 'interrupt': False}
 _slice = [Future()]  # the spin slice in progress ends when this completes
+_keepers: list = []  # nodes holding the DDS participants until the process ends (never destroyed)
 
 
 def request_stop(*_) -> None:
@@ -191,6 +205,7 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
     try:
         threading.Thread(target=_take_stop_signals, name='stop-signals', daemon=True).start()
         start(nodes, contexts)
+        _keep_participants(contexts)
         _flags['starting'] = False
         _freeze_what_start_made()
         spinner = make_executor(executor, contexts[0] if contexts else None)
@@ -216,6 +231,7 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
             node.destroy_node()
         for context in contexts or [None]:
             rclpy.try_shutdown(context=context)
+        shared_memory.remove_segments_held_by(os.getpid())  # the participants' (kept alive)
         faulthandler.cancel_dump_traceback_later()
         # Should an error escape, Python's own exit follows, where it resets its handlers to the
         # default, and a late repeat would kill the process with SIGINT; an ignored signal it
@@ -223,6 +239,23 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
         for signum in STOP_SIGNALS:
             signal.signal(signum, signal.SIG_IGN)
     return 0
+
+
+def _keep_participants(contexts: list) -> None:
+    """Hold each context's DDS participant with a hidden node that is never destroyed.
+
+    Destroying the nodes then never deletes the participant, which could hang (see above). The
+    node has no endpoint of its own, ignores the command line (no remapped name, no parameters
+    file), and lives in a module list: freed, it would delete the participant after all.
+    """
+    for context in contexts or [None]:
+        keeper = Node(f'_participant_of_{os.getpid()}', context=context, enable_rosout=False,
+                      start_parameter_services=False, use_global_arguments=False,
+                      parameter_overrides=[Parameter('start_type_description_service',
+                                                     value=False)])
+        for publisher in list(keeper.publishers):  # its parameter events: nothing to say
+            keeper.destroy_publisher(publisher)
+        _keepers.append(keeper)
 
 
 def _freeze_what_start_made() -> None:
