@@ -1,7 +1,12 @@
 """The scan's smoothness and force-rise figures on series whose answer is known by construction."""
+import math
+
 from bench import teleop_scan
 import numpy as np
 import pytest
+
+from haptic_bringup.bag import BagWriter, typestore_with
+from haptic_bringup.recorder import custom_definitions
 
 GRID = teleop_scan.GRID
 
@@ -41,3 +46,25 @@ def test_the_force_rise_is_read_from_the_patients_force():
     assert figures['peak_rise_n_per_s'] == pytest.approx(10.0)
     # From 1 N (contact) to 7.2 N (90 % of 8 N) at 10 N/s.
     assert figures['time_to_force_s'] == pytest.approx(0.62, abs=2 * GRID)
+
+
+def write_requests(folder, requests) -> None:
+    """The remote site's bag with ``requests``: (receive time s, force N) on its hold topic."""
+    typestore = typestore_with(custom_definitions())
+    writer = BagWriter(folder / 'remote', typestore)
+    writer.add_topic(teleop_scan.REMOTE_HOLD, 'std_msgs/msg/Float64')
+    for at, force in requests:
+        data = typestore.serialize_cdr(typestore.types['std_msgs/msg/Float64'](data=force),
+                                       'std_msgs/msg/Float64')
+        writer.write(teleop_scan.REMOTE_HOLD, round(at * 1e9), data)
+    writer.close()
+
+
+def test_a_hold_s_window_runs_from_its_arrival_at_the_remote_site_to_its_release_s(tmp_path):
+    write_requests(tmp_path, [(100.0, 0.0), (105.5, 8.0), (105.6, 8.0), (116.25, 0.0)])
+    assert teleop_scan.held_window(tmp_path) == pytest.approx((105.5, 116.25))
+    write_requests(tmp_path / 'never released', [(105.5, 8.0)])
+    assert teleop_scan.held_window(tmp_path / 'never released') == (pytest.approx(105.5), math.inf)
+    write_requests(tmp_path / 'none', [(100.0, 0.0)])
+    with pytest.raises(RuntimeError, match='no hold reached the remote site'):
+        teleop_scan.held_window(tmp_path / 'none')
