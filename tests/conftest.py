@@ -31,8 +31,8 @@ settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE')
 
 def pytest_sessionstart(session):
     """Note the Fast DDS segments there are before the tests start: only later ones are ours."""
-    from haptic_bringup.processes import shm_segments
-    session.config.stash[_SEGMENTS_BEFORE] = shm_segments()
+    from haptic_util.shared_memory import segments
+    session.config.stash[_SEGMENTS_BEFORE] = segments()
 
 
 def pytest_sessionfinish(session, exitstatus):

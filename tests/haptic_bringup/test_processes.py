@@ -7,7 +7,8 @@ import time
 
 import psutil
 
-from haptic_bringup.processes import clean_stale_shm, shm_segments, start_child, stop_children
+from haptic_bringup.processes import clean_stale_shm, start_child, stop_children
+from haptic_util.shared_memory import segments
 
 STUBBORN = """
 import signal, subprocess, sys, time
@@ -64,7 +65,7 @@ def test_only_our_own_dead_segments_are_removed(tmp_path):
         os.utime(tmp_path / name, (time.time() - age, time.time() - age))
 
     segment('fastrtps_someone_elses')  # dead, but there before us: not ours
-    before = shm_segments(tmp_path)
+    before = segments(tmp_path)
     segment('fastrtps_dead')
     segment('fastrtps_live')
     segment('fastrtps_young', age=0.0)  # its creator may not have locked it yet

@@ -39,8 +39,8 @@ from ament_index_python.packages import get_package_share_directory
 import yaml
 
 from haptic_bringup.discovery import GraphWatcher
-from haptic_bringup.processes import (clean_stale_shm, run_until_stopped, shm_segments,
-                                      start_child, stop_children, wait_any_exit)
+from haptic_bringup.processes import (clean_stale_shm, run_until_stopped, start_child,
+                                      stop_children, wait_any_exit)
 from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGER, LOOP_RECORDER,
                                    NODES, OPERATOR_RECORDED, OPERATOR_RECORDER, OPERATOR_SITE,
                                    PROBE_IMAGE, RECORDERS, REMOTE_PREFIX, REMOTE_RECORDED,
@@ -49,6 +49,7 @@ from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGE
                                    TELEOP_FEEDBACK, TELEOP_NODES, WAND_CONTACT_MODEL, WAND_POSE,
                                    WAND_WRENCH)
 from haptic_contract.teleop import Scheme, SCHEMES
+from haptic_util import shared_memory
 from haptic_util.executor import end_process
 from link_emulator.link import silence_timeout
 
@@ -284,7 +285,7 @@ class Loop:
         self.run_dir = pathlib.Path(config.run_dir).resolve() / f'{stamp}-{os.getpid()}'
         self.children = []
         self.startup_time = None
-        self._segments_before = shm_segments()
+        self._segments_before = shared_memory.segments()
 
     def __enter__(self) -> 'Loop':
         self.start()

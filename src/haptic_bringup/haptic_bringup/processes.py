@@ -22,7 +22,7 @@ from haptic_util.executor import hold_stop_signals
 from haptic_util.shared_memory import SHM_DIR
 
 __all__ = ['Child', 'start_child', 'stop_children', 'clean_stale_shm', 'run_until_stopped',
-           'shm_segments', 'wait_any_exit']
+           'wait_any_exit']
 
 PR_SET_PDEATHSIG = 1
 CREATION_GRACE = 2.0  # [s] a segment this young may still be being locked by its creator
@@ -95,11 +95,6 @@ def stop_children(children: list, *, timeout: float = 5.0, gently: bool = True) 
     return {child.name: child.process.wait() for child in children}
 
 
-def shm_segments(directory: pathlib.Path = SHM_DIR) -> set:
-    """Names of the Fast DDS segments now in ``directory`` (a snapshot for ``clean_stale_shm``)."""
-    return shared_memory.segments(directory)
-
-
 def clean_stale_shm(directory: pathlib.Path = SHM_DIR, *, domains: Iterable[int],
                     existing: set) -> list:
     """Remove Fast DDS segments our own processes left behind; return their names.
@@ -113,7 +108,7 @@ def clean_stale_shm(directory: pathlib.Path = SHM_DIR, *, domains: Iterable[int]
     domains = set(domains)
     removed = []
     now = time.time()
-    for name in sorted(shm_segments(directory) - set(existing)):
+    for name in sorted(shared_memory.segments(directory) - set(existing)):
         port = _port(name)
         if port is not None and _domain_of_port(port) not in domains:
             continue

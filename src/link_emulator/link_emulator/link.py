@@ -9,12 +9,12 @@ returns. It is pure (times are arguments, no clock is read), so a run is reprodu
 Each message is lost with probability ``loss``, else it arrives after the one-way delay plus
 Gaussian jitter, clipped at zero. A message sent ``reliable`` (the hold, the re-engage: what
 the transport must deliver) is never lost: each loss drawn for it costs a retransmission, one
-round trip (twice the delay) later, as a reliable protocol over a lossy path recovers it.
-The delay is ``delay``, or read from a ``DelayTrace`` (a CSV of measured delays) at the
-message's send time. Without ``reorder`` a message never overtakes an
-earlier one (one ordered path: a late message holds back those behind it); with it, each arrives
-at its own time. One seed fixes every draw. The round trip over it is measured by the sites
-themselves (``teleop_protocol.round_trip``).
+round trip (twice the delay) later, as a reliable protocol over a lossy path recovers it. The
+delay is ``delay``, or read from a ``DelayTrace`` (a CSV of measured delays) at the message's
+send time. Without ``reorder`` a message never overtakes an earlier one (one ordered path: a late
+message holds back those behind it); with it, each arrives at its own time. One seed fixes
+every draw. The round trip over it is measured by the sites themselves
+(``teleop_protocol.round_trip``).
 """
 
 import csv
