@@ -16,20 +16,20 @@ def imager(tmp_path_factory):
 
 
 @pytest.mark.parametrize('fields, message', [
-    ({'probe_type': 'phased'}, r'^probe_type: must be one of linear, convex'),
-    ({'depth': 0.0}, r'^depth: must be a finite number > 0'),
-    ({'depth': float('nan')}, r'^depth: must be a finite number > 0'),
-    ({'scanlines': 300}, r'^scanlines: must be at most image_width \(256\)'),
-    ({'scanlines': 1}, r'^scanlines: must be an integer >= 2'),
-    ({'samples': 512.0}, r'^samples: must be an integer >= 2'),
-    ({'centre_frequency': -5e6}, r'^centre_frequency: must be a finite number > 0'),
-    ({'bandwidth': 2.5}, r'^bandwidth: must be below 2'),
-    ({'angle': 4.0}, r'^angle: must be below pi'),
-    ({'gain': float('inf')}, r'^gain: must be a finite number'),
-    ({'tgc': (0.0, float('nan'))}, r'^tgc: must be a tuple'),
-    ({'tgc': [0.0, 1.0]}, r'^tgc: must be a tuple'),
-    ({'dynamic_range': 0}, r'^dynamic_range: must be a finite number > 0'),
-    ({'coupling_gap': -1e-3}, r'^coupling_gap: must be >= 0'),
+    ({'probe_type': 'phased'}, r'^probe_type must be one of linear, convex'),
+    ({'depth': 0.0}, r'^depth must be finite > 0'),
+    ({'depth': float('nan')}, r'^depth must be finite > 0'),
+    ({'scanlines': 300}, r'^scanlines must be at most image_width \(256\)'),
+    ({'scanlines': 1}, r'^scanlines must be an integer >= 2'),
+    ({'samples': 512.0}, r'^samples must be an integer >= 2'),
+    ({'centre_frequency': -5e6}, r'^centre_frequency must be finite > 0'),
+    ({'bandwidth': 2.5}, r'^bandwidth must be below 2'),
+    ({'angle': 4.0}, r'^angle must be below pi'),
+    ({'gain': float('inf')}, r'^gain must be finite'),
+    ({'tgc': (0.0, float('nan'))}, r'^tgc must be 2 finite numbers'),
+    ({'tgc': [0.0, 1.0]}, r'^tgc must be a tuple'),
+    ({'dynamic_range': 0}, r'^dynamic_range must be finite > 0'),
+    ({'coupling_gap': -1e-3}, r'^coupling_gap must be finite >= 0'),
 ])
 def test_bad_settings_name_the_field(fields, message):
     with pytest.raises(ValueError, match=message):

@@ -72,7 +72,7 @@ def test_every_probe_setting_is_a_parameter_and_checked():
     assert ProbeImagerParams().settings() == ProbeSettings()
     for bad, field in (({'probe_type': 'phased'}, 'probe_type'), ({'depth': 0.0}, 'depth'),
                        ({'scanlines': 300}, 'scanlines')):
-        with pytest.raises(ValueError, match=f'^{field}:'):
+        with pytest.raises(ValueError, match=f'^{field} '):
             ProbeImagerParams(**bad).settings()
 
 

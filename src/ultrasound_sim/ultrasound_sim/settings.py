@@ -13,6 +13,8 @@ at the tip, its long side along y: with no mount between them the two frames are
 from dataclasses import dataclass
 import math
 
+from haptic_contract.checks import finite_components, finite_number, whole_number
+
 __all__ = ['LINEAR', 'CONVEX', 'PROBE_TYPES', 'ProbeSettings']
 
 LINEAR = 'linear'
@@ -22,16 +24,7 @@ PROBE_TYPES = (LINEAR, CONVEX)
 
 def _require(condition: bool, field: str, message: str, value) -> None:
     if not condition:
-        raise ValueError(f'{field}: {message}, got {value!r}')
-
-
-def _finite(value) -> bool:
-    return (not isinstance(value, bool) and isinstance(value, (int, float))
-            and math.isfinite(value))
-
-
-def _count(value) -> bool:
-    return not isinstance(value, bool) and isinstance(value, int)
+        raise ValueError(f'{field} {message}, got {value!r}')
 
 
 @dataclass(frozen=True)
@@ -107,24 +100,20 @@ class ProbeSettings:
         positive = ('centre_frequency', 'bandwidth', 'cycles', 'depth', 'width', 'angle',
                     'radius', 'f_number', 'slice_thickness', 'dynamic_range', 'speed_of_sound')
         for name in positive:
-            value = getattr(self, name)
-            _require(_finite(value) and value > 0.0, name, 'must be a finite number > 0', value)
-        for name in ('gain', 'coupling_gap'):
-            value = getattr(self, name)
-            _require(_finite(value), name, 'must be a finite number', value)
-        _require(self.coupling_gap >= 0.0, 'coupling_gap', 'must be >= 0 m', self.coupling_gap)
+            finite_number(getattr(self, name), name, minimum=0.0, strict=True)
+        finite_number(self.gain, 'gain')
+        finite_number(self.coupling_gap, 'coupling_gap', minimum=0.0)
         _require(self.bandwidth < 2.0, 'bandwidth', 'must be below 2 (a fraction of the centre '
                  'frequency)', self.bandwidth)
         _require(self.angle < math.pi, 'angle', 'must be below pi rad', self.angle)
         for name in ('scanlines', 'samples', 'image_width', 'image_height'):
-            value = getattr(self, name)
-            _require(_count(value) and value >= 2, name, 'must be an integer >= 2', value)
+            whole_number(getattr(self, name), name, minimum=2)
         _require(self.scanlines <= self.image_width, 'scanlines',
                  f'must be at most image_width ({self.image_width}): more scanlines than '
                  'pixels across cannot be shown', self.scanlines)
-        _require(isinstance(self.tgc, tuple) and len(self.tgc) >= 1
-                 and all(_finite(g) for g in self.tgc), 'tgc',
-                 'must be a tuple of at least one finite gain (dB)', self.tgc)
+        _require(isinstance(self.tgc, tuple) and len(self.tgc) >= 1, 'tgc',
+                 'must be a tuple of at least one gain (dB)', self.tgc)
+        finite_components(self.tgc, len(self.tgc), 'tgc')
 
     @property
     def wavelength(self) -> float:
