@@ -72,7 +72,7 @@ def test_the_scene_material_is_the_abdomen_linearised_at_the_scan_force():
 @pytest.mark.parametrize('arguments, message', [
     (dict(size=(0.3, 0.0, 0.1)), 'size must be 3 finite lengths'),
     (dict(size=(0.3, 0.2)), 'size must be 3 finite lengths'),
-    (dict(exponent=1.5), 'exponent must be finite and >= 2'),
+    (dict(exponent=1.5), 'exponent must be finite >= 2'),
     (dict(subdivisions=0), 'subdivisions must be an integer >= 1'),
 ])
 def test_bad_arguments_are_refused(arguments, message):

@@ -28,6 +28,7 @@ from collision_engine.scene_file import (BoxSpec, CapsuleSpec, CrossValidationSp
 from collision_engine.shapes import Box, Capsule, ConvexMesh, Cylinder, Sphere, TriangleMesh
 from collision_engine.tool import DEFAULT_SHELL_SPACING, load_tool, mount_tool, pack_tool
 from collision_engine.transforms import Pose
+from haptic_contract.checks import finite_number
 
 __all__ = ['Scene', 'SceneObject', 'load_scene', 'surface_projection']
 
@@ -112,12 +113,9 @@ class Scene:
         self.objects = tuple(objects)
         self.tool = tool
         self.frame_id = frame_id
-        if not (tip_radius >= 0.0 and math.isfinite(tip_radius)):
-            raise ValueError(f'tip_radius must be a finite number >= 0 (m), got {tip_radius!r}')
-        self.tip_radius = float(tip_radius)
+        self.tip_radius = finite_number(tip_radius, 'tip_radius', minimum=0.0, unit='m')
         for name, value in (('workspace_size', workspace_size), ('shell_spacing', shell_spacing)):
-            if not (value > 0.0 and math.isfinite(value)):
-                raise ValueError(f'{name} must be a positive finite number (m), got {value!r}')
+            finite_number(value, name, minimum=0.0, strict=True, unit='m')
         self.workspace_size = float(workspace_size)
         self.shell_spacing = float(shell_spacing)
         self.request = request or DistanceRequest()

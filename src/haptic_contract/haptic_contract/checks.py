@@ -21,10 +21,12 @@ _FLOAT64 = np.dtype(np.float64)
 
 
 def finite_number(value, name: str, *, minimum: float | None = None, strict: bool = False,
-                  maximum: float | None = None, error: type[ValueError] = ValueError) -> float:
+                  maximum: float | None = None, unit: str = '',
+                  error: type[ValueError] = ValueError) -> float:
     """Return ``value`` as a float if it is finite and within the bounds, else raise ``error``.
 
-    ``minimum`` is exclusive when ``strict``; ``maximum`` is inclusive.
+    ``minimum`` is exclusive when ``strict``; ``maximum`` is inclusive. ``unit`` is named in the
+    error, so that a wrong order of magnitude reads as one.
     """
     try:
         number = float(value)
@@ -35,7 +37,7 @@ def finite_number(value, name: str, *, minimum: float | None = None, strict: boo
     if not math.isfinite(number) or below or above:
         bounds = ''.join([
             '' if minimum is None else f' {">" if strict else ">="} {minimum:g}',
-            '' if maximum is None else f' <= {maximum:g}'])
+            '' if maximum is None else f' <= {maximum:g}', f' ({unit})' if unit else ''])
         raise error(f'{name} must be finite{bounds}, got {value!r}')
     return number
 

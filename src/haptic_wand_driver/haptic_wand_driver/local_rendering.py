@@ -58,6 +58,7 @@ from typing import Sequence
 
 import numpy as np
 
+from haptic_contract.checks import finite_number
 from haptic_contract.contact_model import ContactModel, Kind, MAX_PLANES
 from haptic_contract.plane_law import saturate_components
 from haptic_contract.wand import roll_axis
@@ -100,9 +101,7 @@ class LocalRenderer:
     def __init__(self, *, force_limit: float, torque_limit: float, passivity: PortPassivity,
                  mass: Sequence[float] = (0.0, 0.0, 0.0), contact_damping_ratio: float = 0.0,
                  model_step_rate: float = 0.0) -> None:
-        if not (model_step_rate >= 0.0 and math.isfinite(model_step_rate)):
-            raise ValueError(f'model_step_rate must be a finite number >= 0 N/s, got '
-                             f'{model_step_rate!r}')
+        finite_number(model_step_rate, 'model_step_rate', minimum=0.0, unit='N/s')
         self.force_limit = force_limit
         self.torque_limit = torque_limit
         self.passivity = passivity

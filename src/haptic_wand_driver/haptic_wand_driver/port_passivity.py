@@ -33,6 +33,8 @@ import math
 
 import numpy as np
 
+from haptic_contract.checks import finite_number
+
 __all__ = ['BOOKS_CLOSE_AFTER', 'PortPassivity', 'bounded_shift']
 
 BOOKS_CLOSE_AFTER = 0.05  # [s] of zero force that ends a contact's books (a bounce is shorter)
@@ -51,9 +53,7 @@ class PortPassivity:
     """
 
     def __init__(self, max_damping: float) -> None:
-        if not (max_damping >= 0.0 and math.isfinite(max_damping)):
-            raise ValueError(f'max_damping must be a finite number >= 0, got {max_damping!r}')
-        self.max_damping = float(max_damping)
+        self.max_damping = finite_number(max_damping, 'max_damping', minimum=0.0, unit='N·s/m')
         self.energy = 0.0  # [J] absorbed by the environment in this contact
         self.net_work = 0.0  # [J] done on the tip by the applied force since the start
         self._force = (0.0, 0.0, 0.0)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from haptic_contract.checks import whole_number
+from haptic_contract.checks import finite_number, whole_number
 
 __all__ = ['DEFAULT_OUTPUT', 'main', 'phantom_mesh', 'TORSO_SIZE']
 
@@ -46,8 +46,7 @@ def phantom_mesh(size=TORSO_SIZE, *, exponent: float = 3.0, subdivisions: int = 
     half = np.asarray(size, dtype=np.float64) / 2.0
     if half.shape != (3,) or not np.all(np.isfinite(half)) or np.any(half <= 0.0):
         raise ValueError(f'phantom size must be 3 finite lengths > 0 m, got {size!r}')
-    if not (np.isfinite(exponent) and exponent >= 2.0):
-        raise ValueError(f'phantom exponent must be finite and >= 2, got {exponent!r}')
+    finite_number(exponent, 'phantom exponent', minimum=2.0)
     sphere = trimesh.creation.icosphere(
         subdivisions=whole_number(subdivisions, 'phantom subdivisions'))
     rays = sphere.vertices
