@@ -23,6 +23,7 @@ import time
 from domains import session_domain_id
 import numpy as np
 import pytest
+from rclpy.serialization import serialize_message
 from rosbags.highlevel import AnyReader
 from test_teleop import LINK_TIMEOUT, MAX_PATIENT_FORCE, MODEL_LIFETIME, reports, window, zeroed
 
@@ -30,7 +31,9 @@ from haptic_bringup.bag import typestore_with
 from haptic_bringup.launcher import loop_environment, REMOTE_PREFIX, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import bags, read_vectors
+from haptic_msgs.msg import TeleopCommand
 from site_gateway.certs import init_ca, issue
+from site_gateway.gateway import GatewayParams
 
 pytestmark = pytest.mark.skipif(
     os.geteuid() != 0 or shutil.which('ip') is None,
@@ -44,11 +47,12 @@ RESUME_LIMIT = 2.0  # [s] from the link's return to the session going on
 START_LIMIT = 180.0  # [s] both sites up and the loop closed, on a busy machine
 PRIVATE_SHM = 'mount -t tmpfs -o mode=1777 tmpfs /dev/shm && exec "$@"'
 FLOOD_AT = 10.5  # [s] after the experiment started: the scan sweeps, pressing
+FLOOD_RATE, FLOOD_DURATION = 20_000.0, 2.0  # [Hz], [s]
 FLOOD = """
-import json, sys, time, zenoh
-from rclpy.serialization import serialize_message
-from haptic_msgs.msg import TeleopCommand
-certs, endpoint = sys.argv[1:3]
+import json, os, sys, time, zenoh
+os.nice(19)  # another host's work: on this machine, it yields to the two sites
+certs, endpoint, data = sys.argv[1], sys.argv[2], bytes.fromhex(sys.argv[3])
+at, rate, duration = (float(a) for a in sys.argv[4:7])
 tls = {'root_ca_certificate': f'{certs}/ca.pem', 'enable_mtls': True}
 for side in ('listen', 'connect'):
     tls.update({f'{side}_certificate': f'{certs}/operator.pem',
@@ -56,14 +60,15 @@ for side in ('listen', 'connect'):
 config = {'mode': 'client', 'connect': {'endpoints': [endpoint]},
           'transport': {'link': {'tls': tls}}}
 session = zenoh.open(zenoh.Config.from_json5(json.dumps(config)))
-publisher = session.declare_publisher('haptic/operator/teleop/command', express=True)
-data = serialize_message(TeleopCommand(session=1, sequence=1))
-time.sleep(1.0)  # the remote gateway's subscription has reached this session
+# Batched, not express: a message per syscall would spend on this machine what another host's
+# flood costs another host, and the remote gateway still takes each message on its own.
+publisher = session.declare_publisher('haptic/operator/teleop/command')
+time.sleep(max(at - time.time(), 1.0))  # and the remote gateway's subscription has reached it
 start, sent = time.time(), 0
-while time.time() - start < 1.0:
+while time.time() - start < duration:
     publisher.put(data)
     sent += 1
-    lag = start + sent / 20_000 - time.time()
+    lag = start + sent / rate - time.time()
     if lag > 0:
         time.sleep(lag)
 print(json.dumps({'start': start, 'end': time.time(), 'sent': sent}))
@@ -155,7 +160,7 @@ def session(tmp_path_factory):
         hosts = Hosts()
     except subprocess.CalledProcessError as error:
         pytest.skip(f'network namespaces cannot be made here: {error.stderr.strip()}')
-    sites, probe = {}, None
+    sites, probe, flooder = {}, None, None
     try:
         sites['remote'] = start_site(hosts, 'remote', folder, domain, certs,
                                      '--listen', f'tls/{REMOTE_ADDRESS}:{PORT}')
@@ -174,16 +179,20 @@ def session(tmp_path_factory):
         time.sleep(CUT)
         hosts.link(up=True)
         restored = time.time()
-        time.sleep(max(0.0, started + FLOOD_AT - 1.0 - time.time()))
-        flood = subprocess.run(hosts.command('operator', sys.executable, '-c', FLOOD, str(certs),
-                                             f'tls/{REMOTE_ADDRESS}:{PORT}'),
-                               capture_output=True, text=True, timeout=60)
+        command = serialize_message(TeleopCommand(session=1, sequence=1)).hex()
+        flooder = subprocess.Popen(  # from now: a busy machine starts it slowly
+            hosts.command('operator', sys.executable, '-c', FLOOD, str(certs),
+                          f'tls/{REMOTE_ADDRESS}:{PORT}', command, str(started + FLOOD_AT),
+                          str(FLOOD_RATE), str(FLOOD_DURATION)),
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        flood = subprocess.CompletedProcess(flooder.args, flooder.wait(60), *flooder.communicate())
         codes = {role: process.wait(START_LIMIT) for role, process in sites.items()}
         graph = subprocess.CompletedProcess(probe.args, probe.wait(60), *probe.communicate())
     finally:
-        if probe is not None and probe.poll() is None:
-            probe.kill()
-            probe.wait()
+        for helper in (probe, flooder):
+            if helper is not None and helper.poll() is None:
+                helper.kill()
+                helper.wait()
         for process in sites.values():
             if process.poll() is None:
                 os.killpg(process.pid, signal.SIGINT)
@@ -287,19 +296,22 @@ def test_the_session_goes_on_within_2_s_of_the_link_s_return_with_no_node_restar
 
 def test_a_flood_with_the_operator_s_certificate_is_shed_and_the_remote_site_keeps_its_rate(
         session):
-    """A holder of the operator's certificate puts 20 kHz of commands of another session for 1 s.
+    """A holder of the operator's certificate puts commands of another session at up to 20 kHz
+    for 2 s.
 
-    The remote gateway hands on at most its 2 kHz; the robot goes on at its rate and the patient
-    stays within the limit. The flooder takes a core of the two the machine has, beside both
-    sites: the remote site may lose its share of the time to that, and not more. (The gateway's
-    bucket is per topic, not per publisher: the flood crowds the true operator's commands out
-    with it, and the robot may hold and draw back meanwhile, as on a silent link.)
+    The remote gateway hands on at most its ``max_rate``; the robot goes on at its rate and the
+    patient stays within the limit. The flooder stands for another host, so it runs at nice 19:
+    on this machine it takes mostly the time the two sites leave (with a core hogged, that makes
+    it a few kHz), and the remote site pays for what its gateway does with the flood. (The
+    gateway's bucket is per topic, not per publisher: the flood crowds the true operator's
+    commands out with it, and the robot may hold and draw back meanwhile, as on a silent link.)
     """
     folder, flood = session['folder'], session['flood']
     assert flood.returncode == 0, flood.stderr[-2000:]
     flooding = json.loads(flood.stdout.strip().splitlines()[-1])
-    assert flooding['sent'] > 10_000
     start, end = flooding['start'], flooding['end']
+    put_rate = flooding['sent'] / (end - start)
+    max_rate = GatewayParams().max_rate
     patient = series(folder, 'remote', {'/robot/tcp_pose': 'pose',
                                         '/robot/ft_sensor/wrench': 'wrench'})
     tcp_times = patient['/robot/tcp_pose'][0]
@@ -307,10 +319,16 @@ def test_a_flood_with_the_operator_s_certificate_is_shed_and_the_remote_site_kee
     def rate(first, last):
         return np.count_nonzero((tcp_times >= first) & (tcp_times < last)) / (last - first)
     quiet, flooded = rate(start - 1.5, start - 0.5), rate(start, end)
-    print(f'\nflood: {flooding["sent"]} put; the robot at {flooded:.0f} Hz against {quiet:.0f} Hz')
-    assert flooded >= 0.5 * quiet
+    shed = reports(folder / 'remote', 'remote_gateway', 'refused: teleop/command over max_rate')
+    handed = reports(folder / 'remote', 'teleop_follower', 'refused: command another session')
+    print(f'\nflood: {flooding["sent"]} put at {put_rate:.0f} Hz, {shed[-1] if shed else 0} shed '
+          f'(with the operator\'s own), {handed[-1] if handed else 0} handed on and refused; the '
+          f'robot at {flooded:.0f} Hz against {quiet:.0f} Hz')
+    assert quiet > 0.0, 'the flood came after the scan'
+    assert flooded >= 0.9 * quiet
     force_times, force = patient['/robot/ft_sensor/wrench']
     assert np.linalg.norm(force[window(force_times, start, end)], axis=1).max() <= (
         MAX_PATIENT_FORCE)
-    shed = reports(folder / 'remote', 'remote_gateway', 'refused: teleop/command over max_rate')
-    assert shed and int(shed[-1]) > 0
+    assert shed and int(shed[-1]) > 0  # the flood came faster than the gateway hands on
+    # At its rate over the flood, and the last arrivals after it: the bucket's burst and lag.
+    assert handed and int(handed[-1]) <= max_rate * (end - start + 0.5)
