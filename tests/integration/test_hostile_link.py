@@ -20,7 +20,8 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from test_teleop import DELAY, reports, streams, wait_for_the_first_pose
+from test_teleop import (DELAY, FORCE_SCALE, reports, streams, wait_for_the_first_pose,
+                         window)
 
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_contract.teleop_fields import COMMAND
@@ -184,7 +185,11 @@ def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
     A 20 kHz flood costs the remote site's one Python process about half a core to refuse,
     stranger by stranger: on a loaded machine it may fall behind the operator's commands, and
     then holds as on a silent link. That stays safe, and it follows again once the flood ends;
-    shedding a flood before the site is the authenticated gateway's part (issue 27).
+    shedding a flood before the site is the authenticated gateway's part (issue 27). Following
+    again, it presses as the hand feels, as after a stalled gateway (``test_teleop``): the
+    operator's feedback lapsed meanwhile, the hand sank feeling nothing, and passivity gives back
+    no push the device's port has not taken in. A hand that presses harder gets it back; the
+    scripted one is a fixed spring, so with a core hogged it may press on less than before.
     """
     _, series, windows = attacked
     times, patient = series['/remote/robot/ft_sensor/wrench']
@@ -193,8 +198,13 @@ def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
     for name, (start, end, _) in windows.items():
         if name not in ('quiet', 'flood', 'after the flood', 'deep target', 'tcp below'):
             assert force[(times >= start) & (times < end)].min() > 3.0, name
-    start, end, _ = windows['after the flood']
-    assert force[(times >= start) & (times < end)].max() > 3.0  # following and pressing again
+    _, end, _ = windows['after the flood']
+    felt_times, felt = series['/wand/applied_wrench']
+    felt_after = np.median(np.linalg.norm(felt[window(felt_times, end - 0.5, end)], axis=1))
+    pressed_after = np.median(force[window(times, end - 0.5, end)])
+    print(f'\nafter the flood: the patient {pressed_after:.2f} N, felt {felt_after:.2f} N')
+    assert pressed_after > 1.0  # following and pressing again, not let go
+    assert felt_after / FORCE_SCALE == pytest.approx(pressed_after, rel=0.2)  # as the hand feels
 
 
 def test_the_operator_s_site_keeps_its_rate_through_every_attack(attacked):
