@@ -36,6 +36,13 @@ def test_bad_settings_name_the_field(fields, message):
         ProbeSettings(**fields)
 
 
+def test_settings_keep_the_checked_numbers():
+    settings = ProbeSettings(depth=np.float32(0.05), scanlines=np.int64(64), tgc=(0, 1))
+    assert type(settings.depth) is float and settings.depth == pytest.approx(0.05)
+    assert type(settings.scanlines) is int and settings.scanlines == 64
+    assert settings.tgc == (0.0, 1.0) and all(type(g) is float for g in settings.tgc)
+
+
 @pytest.mark.parametrize('position, quaternion, message', [
     ([np.nan, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], r'^pose: position must be 3 finite'),
     ([0.0, 0.0], [0.0, 0.0, 0.0, 1.0], r'^pose: position must be 3 finite'),

@@ -27,6 +27,11 @@ def _require(condition: bool, field: str, message: str, value) -> None:
         raise ValueError(f'{field} {message}, got {value!r}')
 
 
+def _check(settings, name: str, check, **bounds) -> None:
+    """Check field ``name`` with a contract check, and keep what it returns (a float, an int)."""
+    object.__setattr__(settings, name, check(getattr(settings, name), name, **bounds))
+
+
 @dataclass(frozen=True)
 class ProbeSettings:
     """A probe and its scanner settings (SI units, but decibels where scanners use them).
@@ -100,20 +105,20 @@ class ProbeSettings:
         positive = ('centre_frequency', 'bandwidth', 'cycles', 'depth', 'width', 'angle',
                     'radius', 'f_number', 'slice_thickness', 'dynamic_range', 'speed_of_sound')
         for name in positive:
-            finite_number(getattr(self, name), name, minimum=0.0, strict=True)
-        finite_number(self.gain, 'gain')
-        finite_number(self.coupling_gap, 'coupling_gap', minimum=0.0)
+            _check(self, name, finite_number, minimum=0.0, strict=True)
+        _check(self, 'gain', finite_number)
+        _check(self, 'coupling_gap', finite_number, minimum=0.0)
         _require(self.bandwidth < 2.0, 'bandwidth', 'must be below 2 (a fraction of the centre '
                  'frequency)', self.bandwidth)
         _require(self.angle < math.pi, 'angle', 'must be below pi rad', self.angle)
         for name in ('scanlines', 'samples', 'image_width', 'image_height'):
-            whole_number(getattr(self, name), name, minimum=2)
+            _check(self, name, whole_number, minimum=2)
         _require(self.scanlines <= self.image_width, 'scanlines',
                  f'must be at most image_width ({self.image_width}): more scanlines than '
                  'pixels across cannot be shown', self.scanlines)
         _require(isinstance(self.tgc, tuple) and len(self.tgc) >= 1, 'tgc',
                  'must be a tuple of at least one gain (dB)', self.tgc)
-        finite_components(self.tgc, len(self.tgc), 'tgc')
+        _check(self, 'tgc', lambda gains, name: finite_components(gains, len(gains), name))
 
     @property
     def wavelength(self) -> float:
