@@ -3,7 +3,7 @@
     .venv/bin/python bench/teleop_scan.py [--schemes direct tdpa model]
         [--delays 0 0.01 0.025 0.05 0.1 0.25 0.5] [--jitter 0.2] [--loss 0.05]
         [--site-streams in-process dds] [--model-step-rates 5 0] [--delay-trace CSV]
-        [--force-hold] [--json PATH]
+        [--force-hold] [--keep DIR] [--json PATH]
 
 Both sites run as real processes in two DDS domains, joined by the two site gateways
 (``haptic_loop --teleop``): the scripted sonographer approaches the patient phantom, presses,
@@ -309,6 +309,7 @@ def main(argv=None) -> int:
                         choices=SITE_STREAMS, help="how each site's nodes pass their streams")
     parser.add_argument('--model-step-rates', nargs='+', type=float, default=[None],
                         help="model: the driver's easing of new models, N/s (0: at once)")
+    parser.add_argument('--keep', type=pathlib.Path, help="keep each case's bag under here")
     parser.add_argument('--force-hold', action='store_true',
                         help=f'model once more per delay, {HOLD_FORCE:g} N held through the sweep')
     ros_domain.add_option(parser)
@@ -318,31 +319,38 @@ def main(argv=None) -> int:
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     print_header()
     rows, traces = [], {}
-    with tempfile.TemporaryDirectory() as kept:
+    with tempfile.TemporaryDirectory() as tmp:
+        cases = args.keep or pathlib.Path(tmp)
+
+        def kept(name: str, drawn: bool = False) -> pathlib.Path | None:
+            return cases / name if drawn or args.keep else None
         for delay in args.delays:
             for scheme in args.schemes:
                 rates = args.model_step_rates if scheme == 'model' else [None]
                 for site_streams, rate in itertools.product(args.site_streams, rates):
-                    drawn = (args.json and delay in FIGURE_DELAYS
-                             and site_streams == 'in-process' and rate == rates[0])
-                    folder = pathlib.Path(kept) / f'{scheme}-{delay:g}' if drawn else None
+                    drawn = bool(args.json and delay in FIGURE_DELAYS
+                                 and site_streams == 'in-process' and rate == rates[0])
+                    eased = '' if rate is None else f'-ease{rate:g}'
+                    folder = kept(f'{scheme}-{delay:g}-{site_streams}{eased}', drawn)
                     rows.append(run(scheme, delay, jitter=args.jitter, loss=args.loss,
                                     domain_id=args.domain_id, site_streams=site_streams,
                                     keep=folder, model_step_rate=rate))
                     print_row(rows[-1])
-                    if folder:
+                    if drawn:
                         traces[f'{scheme}, {1e3 * delay:g} ms one way, over ROS 2'] = read_scan(
                             folder / 'bag')
             if args.force_hold:
                 rows.append(run('model', delay, jitter=args.jitter, loss=args.loss,
-                                domain_id=args.domain_id, hold=HOLD_FORCE))
+                                domain_id=args.domain_id, hold=HOLD_FORCE,
+                                keep=kept(f'model-{delay:g}-held')))
                 print_row(rows[-1])
-    if args.delay_trace:
-        longest = float(DelayTrace.from_csv(args.delay_trace).delays.max())
-        for scheme in args.schemes:
-            rows.append(run(scheme, longest, jitter=0.0, loss=args.loss,
-                            domain_id=args.domain_id, delay_trace=args.delay_trace))
-            print_row(rows[-1])
+        if args.delay_trace:
+            longest = float(DelayTrace.from_csv(args.delay_trace).delays.max())
+            for scheme in args.schemes:
+                rows.append(run(scheme, longest, jitter=0.0, loss=args.loss,
+                                domain_id=args.domain_id, delay_trace=args.delay_trace,
+                                keep=kept(f'{scheme}-trace')))
+                print_row(rows[-1])
     print_hold_errors(rows)
     print('\nCPU, % of one core, over the press and the sweep (the machine has '
           f'{psutil.cpu_count()} cores):')
