@@ -301,10 +301,11 @@ def test_a_flood_with_the_operator_s_certificate_is_shed_and_the_remote_site_kee
 
     The remote gateway hands on at most its ``max_rate``; the robot goes on at its rate and the
     patient stays within the limit. The flooder stands for another host, so it runs at nice 19:
-    on this machine it takes mostly the time the two sites leave (with a core hogged, that makes
-    it a few kHz), and the remote site pays for what its gateway does with the flood. (The
-    gateway's bucket is per topic, not per publisher: the flood crowds the true operator's
-    commands out with it, and the robot may hold and draw back meanwhile, as on a silent link.)
+    on this machine it takes mostly the time the two sites leave (about 19 kHz reached the
+    remote gateway, with a core hogged or not), and the remote site pays for what its gateway
+    does with the flood. (The gateway's bucket is per topic, not per publisher: the flood crowds
+    the true operator's commands out with it, and the robot may hold and draw back meanwhile, as
+    on a silent link.)
     """
     folder, flood = session['folder'], session['flood']
     assert flood.returncode == 0, flood.stderr[-2000:]
