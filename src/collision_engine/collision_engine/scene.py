@@ -114,10 +114,10 @@ class Scene:
         self.tool = tool
         self.frame_id = frame_id
         self.tip_radius = finite_number(tip_radius, 'tip_radius', minimum=0.0, unit='m')
-        for name, value in (('workspace_size', workspace_size), ('shell_spacing', shell_spacing)):
-            finite_number(value, name, minimum=0.0, strict=True, unit='m')
-        self.workspace_size = float(workspace_size)
-        self.shell_spacing = float(shell_spacing)
+        self.workspace_size = finite_number(workspace_size, 'workspace_size', minimum=0.0,
+                                            strict=True, unit='m')
+        self.shell_spacing = finite_number(shell_spacing, 'shell_spacing', minimum=0.0,
+                                           strict=True, unit='m')
         self.request = request or DistanceRequest()
         self._names = tuple(o.name for o in self.objects)
         shapes = [o.shape for o in self.objects]

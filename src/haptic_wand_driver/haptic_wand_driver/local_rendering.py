@@ -101,13 +101,13 @@ class LocalRenderer:
     def __init__(self, *, force_limit: float, torque_limit: float, passivity: PortPassivity,
                  mass: Sequence[float] = (0.0, 0.0, 0.0), contact_damping_ratio: float = 0.0,
                  model_step_rate: float = 0.0) -> None:
-        finite_number(model_step_rate, 'model_step_rate', minimum=0.0, unit='N/s')
         self.force_limit = force_limit
         self.torque_limit = torque_limit
         self.passivity = passivity
         self.mass = tuple(mass)
         self.contact_damping_ratio = contact_damping_ratio
-        self.model_step_rate = float(model_step_rate)
+        self.model_step_rate = finite_number(model_step_rate, 'model_step_rate', minimum=0.0,
+                                             unit='N/s')
         self.packed = np.zeros((2, LAW_SIZE))  # (servo_loop's layout)
         # shift, take, push, stiffness factor and sum, damping added and sum, planes, normals
         self.bound = np.zeros(BOUND_SIZE)
