@@ -7,8 +7,8 @@ When the force on the hand stopped is measured twice, from what the device appli
 the driver's intentions, from the signal (or, for a kill, from the killed node's last answer, if
 it answered after the signal was sent): the simulated device's own record of when its rendered
 force switched off (servo resolution, 0.25 ms), and ``wand/applied_wrench`` as this separate
-process received it (the mean force of each tick: the force stopped inside the last tick that
-held any).
+process received it (the mean force of the servo periods that ended in each tick: the force
+stopped inside the last report that held any).
 """
 import os
 import signal
@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from haptic_bringup.launcher import Loop, LoopConfig
+from haptic_wand_driver.params import WandDriverParams
 
 TRIALS = 20  # per kind of fault, alternating between the collision and the force node
 FAULTY = ('collision_engine', 'force_renderer')
@@ -195,20 +196,26 @@ def times_to_zero(record, faults) -> np.ndarray:
 def seen_from_outside(applied: list, faults) -> np.ndarray:
     """For each fault, when the force stopped as seen from outside: (from, to) after it [s].
 
-    Each wand/applied_wrench holds the mean force over the tick that ends at its stamp: the force
-    stopped inside the last tick that still held any, between its start (the previous stamp) and
-    its end. A driver slowed by a busy machine makes that tick, hence the bracket, longer.
+    Each wand/applied_wrench holds the mean force over the servo periods that ended since the
+    previous one (``SimulatedWand.applied``), and repeats the previous mean when none did: two
+    ticks less than a servo period apart, on a busy machine. So the force stopped inside the last
+    report that still held any, after its earliest period began: one servo period before the
+    previous report that had a period to end. A driver slowed by a busy machine makes that
+    bracket longer.
     """
-    applied = np.array(applied)
+    applied = np.array(sorted(applied))
     stamps, force = applied[:, 0], applied[:, 1]
+    servo_period = round(1e9 / WandDriverParams().servo_rate)  # [ns]
     brackets = []
     for before, back in faults:
         held = np.flatnonzero((stamps >= before) & (stamps < back) & (force > 0.0))
         if held.size == 0:
             brackets.append((0.0, 0.0))
             continue
-        last = held.max()
-        brackets.append((max(stamps[last - 1] - before, 0) * 1e-9,
+        last = first = held.max()
+        while first > 1 and stamps[first] - stamps[first - 1] < servo_period:
+            first -= 1  # perhaps no period ended in between: the report repeats the one before
+        brackets.append((max(stamps[first - 1] - servo_period - before, 0) * 1e-9,
                          (stamps[last] - before) * 1e-9))
     return np.array(brackets)
 
