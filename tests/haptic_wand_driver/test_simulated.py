@@ -352,6 +352,21 @@ def test_a_held_force_drops_to_zero_at_its_deadline_without_another_call():
     assert held.read(0.05).linear_velocity[0] > 0.0  # the force did act before the deadline
 
 
+def test_a_servo_period_that_would_end_after_the_deadline_renders_no_force():
+    """Nothing is rendered past ``until``: the period it falls inside is zero already."""
+    config = SimulatedWandConfig(step=5e-4)
+    held = SimulatedWand(config)
+    free = SimulatedWand(config)
+    for wand in (held, free):
+        wand.read(0.0)
+    held.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0], until=0.0033)
+    free.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    free.read(0.003)
+    free.apply([0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    assert held.read(0.01).position.tolist() == free.read(0.01).position.tolist()
+    assert held.force_edges == [(0.0, True), (0.003, False)]
+
+
 def test_a_deadline_already_past_renders_no_force():
     wand = SimulatedWand(SimulatedWandConfig())
     wand.read(1.0)

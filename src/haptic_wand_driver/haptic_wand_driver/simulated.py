@@ -185,7 +185,8 @@ class SimulatedWand(HapticDevice):
     def apply(self, force: np.ndarray, torque: np.ndarray, *, until: float = math.inf) -> None:
         """Hold this wrench (N, N·m, workspace frame), saturated, until the next or ``until``.
 
-        Substeps that start at or after ``until`` (s, the wand's clock) render zero.
+        A substep that would end after ``until`` (s, the wand's clock) renders zero: nothing is
+        rendered past the deadline, as in ``LocalRenderer``.
         """
         self._raise_if_closed()
         force = finite_components(force, 3, 'SimulatedWand.apply force')
@@ -231,12 +232,12 @@ class SimulatedWand(HapticDevice):
         return self._start + self._steps_done * self._step
 
     def _expiry_step(self) -> float:
-        """Return the first substep at or after the hold deadline (inf when there is none)."""
+        """Return the first substep that would end after the hold deadline (inf when none)."""
         if self._until == math.inf or self._start is None:
             return math.inf
         if self._until == -math.inf:
             return self._steps_done
-        return max(math.ceil((self._until - self._start) / self._step - 1e-9), self._steps_done)
+        return max(math.floor((self._until - self._start) / self._step + 1e-9), self._steps_done)
 
     def _advance(self, target_steps: int) -> None:
         """Substep semi-implicit Euler on every joint up to ``target_steps``; stops hold."""
