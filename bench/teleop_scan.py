@@ -25,11 +25,11 @@ applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor
   of a few tenths of a newton; a step the patient's force does not make is a jolt;
 - the patient's **force rise** (issue 28's envelope): the time from the first contact to 90 % of
   the mean contact force, and the peak rate of rise of the patient's force over 5 ms;
-- the **force error** through the sweep (from 0.5 s after it begins, ``SWEEP`` from the wand's
-  first pose): the patient's force against its own mean (what the operator's hand keeps by
-  itself); in a hold run, against the held one, from 0.5 s after the hold reached the remote
-  site to its release's arrival there (both read from the remote site's bag: the link's delay
-  is not the regulator's settling).
+- the **force error** through the sweep (from 0.5 s after it begins, ``SWEEP`` from the
+  session's start, the driver's ``wand/session_start``): the patient's force against its own
+  mean (what the operator's hand keeps by itself); in a hold run, against the held one, from
+  0.5 s after the hold reached the remote site to its release's arrival there (both read from
+  the remote site's bag: the link's delay is not the regulator's settling).
 
 The jitter is given as a fraction of the delay (20 %, and 5 % loss: issue 28's harsher link, to
 500 ms one way). ``--delay-trace`` runs each scheme once more over a measured link: a CSV of
@@ -64,7 +64,7 @@ from haptic_bringup.bag import typestore_with
 from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import read_numbers, read_vectors
+from haptic_bringup.session import read_numbers, read_session_start, read_vectors
 from haptic_contract.graph import absolute, REMOTE_PREFIX, TELEOP_HOLD
 from link_emulator.link import DelayTrace
 
@@ -82,7 +82,7 @@ JUMP = 1.0  # [N] a change of the felt force (scaled) between ticks that counts 
 SMOOTH_RATIO = 3.0  # the felt force's steps at most this many times the patient's
 RISE_WINDOW = 5e-3  # [s] the patient's rate of rise, over the F/T sensor's noise
 CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the sweep
-SWEEP = (5.0, 16.0)  # [s] from the first pose: the scan's sweep along the patient (scan.yaml)
+SWEEP = (5.0, 16.0)  # [s] from the session's start: the scan's sweep along the patient (scan.yaml)
 HOLD_SETTLE = 0.5  # [s] after the sweep begins, or the hold arrives, before the error counts
 HOLD_FORCE = 8.0  # [N] held in a hold run: the scan's own press
 SITE_STREAMS = ('in-process', 'dds')
@@ -246,7 +246,7 @@ def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
                             + ([] if delay_trace is None else [f'trace {delay_trace.name}'])
                             + ([] if hold is None else [f'force held {hold:g} N']))
         scan = read_scan(folder / 'bag')
-        start = scan['/wand/pose'][0][0]
+        start = read_session_start(folder / 'bag', typestore_with(custom_definitions()))
         window = (start + SWEEP[0], start + SWEEP[1]) if hold is None else \
             held_window(folder / 'bag')
         return {'scheme': scheme, **figures(scan, delay), 'cpu': cpu, 'site_streams': streams,

@@ -6,9 +6,13 @@ import pytest
 import rclpy
 from rclpy.clock import ROSClock
 from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.time import Time
+from std_msgs.msg import Header
 
 from haptic_contract.contact_model import Kind
+from haptic_util.qos import LATCHED_QOS
+from haptic_util.stamps import to_nanoseconds
 from haptic_wand_driver.local_rendering import DEADLINE
 from haptic_wand_driver.node import WandDriverNode
 
@@ -50,6 +54,25 @@ def test_rendering_locally_it_takes_the_model_alone_and_holds_the_wrench_of_a_la
                                            [0.0] * 5, 2.5e-4)
     assert force == pytest.approx((1.0, 0.0, -0.5)) and torque == (0.0, 0.0, 0.0)
     assert driver.stats.answers == 1
+
+
+def test_the_session_start_is_latched_with_the_instant_the_script_s_clock_started(driver):
+    """A subscriber that joins after the session began still hears when it began."""
+    before = time.time_ns()
+    driver.tick()  # open loop: the session starts at this tick
+    after = time.time_ns()
+    listener = rclpy.create_node('late_listener', context=driver.context)
+    heard = []
+    listener.create_subscription(Header, '/wand/session_start', heard.append, LATCHED_QOS)
+    executor = SingleThreadedExecutor(context=driver.context)
+    executor.add_node(listener)
+    deadline = time.monotonic() + 5.0
+    while not heard and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.05)
+    listener.destroy_node()
+    assert len(heard) == 1
+    assert before <= to_nanoseconds(heard[0].stamp) <= after
+    assert heard[0].frame_id == driver.params.frame_id
 
 
 def set_clocks(driver, monkeypatch, start_ns: int) -> tuple:

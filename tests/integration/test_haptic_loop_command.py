@@ -9,7 +9,7 @@ import time
 
 from domains import session_domain_id
 import pytest
-from test_teleop import wait_for_the_first_pose
+from test_teleop import wait_for_the_session_start
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.recorder import custom_definitions
@@ -50,7 +50,7 @@ def test_a_ctrl_c_stops_the_command_cleanly_and_the_bag_holds_everything_publish
             assert closed(output, command), output.read_text()[-3000:]
             # The loop closes at discovery; the wand moves once its recorder is ready, which on a
             # busy machine came more than RUNNING later (a CI run recorded no pose at all).
-            wait_for_the_first_pose(domain, START_TIMEOUT)
+            wait_for_the_session_start(domain, START_TIMEOUT)
             time.sleep(RUNNING)
             interrupted = time.time()
             os.killpg(command.pid, signal.SIGINT)

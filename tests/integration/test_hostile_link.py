@@ -20,7 +20,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from test_teleop import (DELAY, FORCE_SCALE, reports, streams, wait_for_the_first_pose,
+from test_teleop import (DELAY, FORCE_SCALE, reports, streams, wait_for_the_session_start,
                          window)
 
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
@@ -133,8 +133,8 @@ def attacked(tmp_path_factory):
                         intra_process=False, link={'delay': DELAY, 'jitter': 0.1 * DELAY})
     windows = {}
     with Loop(config) as loop:
-        # From the wand's first pose: a fresh clone's first session compiles its kernels first.
-        deadline = wait_for_the_first_pose(config.domain_id, 180.0) + 30.0
+        # From the session's start: a fresh clone's first session compiles its kernels first.
+        deadline = wait_for_the_session_start(config.domain_id, 180.0) + 30.0
         stranger = Stranger(config.remote_domain_id)
         try:
             # Both of the stranger's subscriptions must have matched: under load its command

@@ -18,9 +18,9 @@ from haptic_bringup.bag import recover, typestore_with
 from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.scan_clock import wait_for_first_pose
-from haptic_bringup.session import (bags, published_counts, read_numbers, read_vectors,
-                                    reported, SITE_PUBLISHERS, topic_counts)
+from haptic_bringup.scan_clock import wait_for_session_start
+from haptic_bringup.session import (bags, published_counts, read_numbers, read_session_start,
+                                    read_vectors, reported, SITE_PUBLISHERS, topic_counts)
 from haptic_contract.graph import absolute, REMOTE_PREFIX, TELEOP_HOLD
 from link_emulator.link import silence_timeout
 
@@ -30,7 +30,7 @@ MAX_PATIENT_FORCE = 20.0  # [N] the follower's default
 JITTER = 0.1 * DELAY  # [s]
 LINK_TIMEOUT = silence_timeout(0.1, JITTER)  # [s] both ends', as the launcher sets them
 MODEL_LIFETIME = 0.010  # [s] the leader's default
-PRESSING = (6.0, 8.0)  # [s] after the first pose: the scan holds its press, then sweeps
+PRESSING = (6.0, 8.0)  # [s] into the scan (its session start): pressed, sweeping
 HELD = 7.0  # [N] the force the operator asks the remote site to hold once PRESSING is over
 STREAMS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
            '/teleop/feedback': 'pose', '/remote/robot/ft_sensor/wrench': 'wrench',
@@ -96,8 +96,7 @@ def scan(tmp_path_factory):
 
 def test_the_patient_is_felt_scaled_across_the_delayed_link(scan):
     folder, series = scan
-    pose_times = series['/wand/pose'][0]
-    start = pose_times[0]
+    start = read_session_start(folder / 'bag', typestore_with(custom_definitions()))
     felt_times, felt = series['/wand/applied_wrench']
     patient_times, patient = series['/remote/robot/ft_sensor/wrench']
     held = window(felt_times - start, *PRESSING)
@@ -144,19 +143,19 @@ def test_a_force_hold_asked_at_the_operator_s_site_crosses_and_the_remote_site_h
     assert arrived.tolist() == [HELD]  # in the remote site's bag, once
 
 
-def wait_for_the_first_pose(domain_id: int, timeout: float) -> float:
-    """Return when (time.monotonic) the wand's first pose came: the scan's time zero."""
-    came = wait_for_first_pose(domain_id, timeout)
-    assert came is not None, 'the wand never moved'
-    return came.monotonic
+def wait_for_the_session_start(domain_id: int, timeout: float) -> float:
+    """Return when (time.monotonic) the wand's session began: the scan's time zero."""
+    began = wait_for_session_start(domain_id, timeout)
+    assert began is not None, 'the session never began'
+    return began.monotonic
 
 
 def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_meet_again(
         tmp_path):
     """The operator's gateway stops for 0.5 s while the scan presses, then sends what it held.
 
-    The stall comes 6.5 s into the scan by its first pose, in its held press, not 6.5 s after
-    the launcher returned: under load the scan started up to seconds later.
+    The stall comes 6.5 s into the scan, in its sweep, not 6.5 s after the launcher returned:
+    under load the scan started up to seconds later.
 
     The operator's force is zero within the link timeout; the robot holds its TCP (not the last
     target, which lay further in) and retracts: the patient's force never rises during the
@@ -164,7 +163,7 @@ def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_
     link is back the robot and the operator's model meet again: the patient is pressed and the
     hand feels, scaled, the force the patient gets."""
     with teleop(tmp_path, duration=SCAN_DURATION) as loop:
-        start = wait_for_the_first_pose(session_domain_id(), SCAN_DURATION)
+        start = wait_for_the_session_start(session_domain_id(), SCAN_DURATION)
         time.sleep(max(0.0, start + PRESSING[0] + 0.5 - time.monotonic()))
         gateway = loop.child('operator_gateway')
         dropped = time.time()
@@ -239,7 +238,7 @@ def test_reordered_messages_from_the_link_are_ignored_by_stamp(tmp_path):
     assert older and int(older[-1]) > 100
     assert int(reports(tmp_path, 'teleop_leader', 'refused')[-1]) > 10  # older feedback
     series = streams(tmp_path)
-    start = series['/wand/pose'][0][0]
+    start = read_session_start(tmp_path / 'bag', typestore_with(custom_definitions()))
     felt_times, felt = series['/wand/applied_wrench']
     patient_times, patient = series['/remote/robot/ft_sensor/wrench']
     felt_force = np.median(felt[window(felt_times - start, *PRESSING), 2]) / FORCE_SCALE

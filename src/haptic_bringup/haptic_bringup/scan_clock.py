@@ -1,27 +1,30 @@
-"""The scan's time zero: when the wand's first pose came, heard from the operator's site.
+"""The scan's time zero: when the wand's session began, heard from the operator's site.
 
 Why: a scripted scan starts once the loop is closed and the recorder ready, which on a busy
-machine comes seconds after the launcher returns; whatever acts on the scan at set times (a
-force-hold request, a test's link stall) counts from its first pose, not from the launch.
+machine comes seconds after the launcher returns, and in a telerobotic session a round trip
+and more after the wand's first pose (the loop is probed at rest until the remote site answers:
+1.5 to 2.5 s at 250 ms one way). Whatever acts on the scan at set times (a force-hold request, a
+test's link stall) counts from the driver's ``wand/session_start``, the instant its script's
+clock started. It is latched, and carries that instant: heard late, it still gives it.
 """
 from contextlib import contextmanager
 import time
 from typing import Callable, Iterator, NamedTuple
 
-from geometry_msgs.msg import PoseStamped
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from std_msgs.msg import Header
 
-from haptic_contract.graph import WAND_POSE
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_contract.graph import WAND_SESSION_START
+from haptic_util.qos import LATCHED_QOS
 
-__all__ = ['FirstPose', 'first_pose', 'site_node', 'wait_for_first_pose']
+__all__ = ['SessionStart', 'session_start', 'site_node', 'wait_for_session_start']
 
 
-class FirstPose(NamedTuple):
-    """When the first pose came, on both clocks (wall as a bag's receive times)."""
+class SessionStart(NamedTuple):
+    """When the session began, on both clocks (wall as a bag's receive times)."""
 
     monotonic: float
     wall: float
@@ -42,22 +45,23 @@ def site_node(domain_id: int, name: str) -> Iterator[tuple[Node, SingleThreadedE
         rclpy.try_shutdown(context=context)
 
 
-def first_pose(node: Node, executor: SingleThreadedExecutor, timeout: float,
-               also: Callable[[], bool] = lambda: True) -> FirstPose | None:
-    """Spin until the wand's first pose came and ``also()`` holds, or None after ``timeout`` s."""
-    came = []
-    poses = node.create_subscription(
-        PoseStamped, WAND_POSE,
-        lambda _: came or came.append(FirstPose(time.monotonic(), time.time())),
-        HAPTIC_STREAM_QOS)
+def session_start(node: Node, executor: SingleThreadedExecutor, timeout: float,
+                  also: Callable[[], bool] = lambda: True) -> SessionStart | None:
+    """Spin until the session began and ``also()`` holds, or None after ``timeout`` s."""
+    began = []
+
+    def heard(header: Header) -> None:
+        wall = header.stamp.sec + header.stamp.nanosec * 1e-9
+        began[:] = [SessionStart(time.monotonic() - (time.time() - wall), wall)]
+    starts = node.create_subscription(Header, WAND_SESSION_START, heard, LATCHED_QOS)
     deadline = time.monotonic() + timeout
-    while not (came and also()) and time.monotonic() < deadline:
+    while not (began and also()) and time.monotonic() < deadline:
         executor.spin_once(timeout_sec=0.01)
-    node.destroy_subscription(poses)
-    return came[0] if came and also() else None
+    node.destroy_subscription(starts)
+    return began[0] if began and also() else None
 
 
-def wait_for_first_pose(domain_id: int, timeout: float) -> FirstPose | None:
+def wait_for_session_start(domain_id: int, timeout: float) -> SessionStart | None:
     """Return the scan's time zero in the operator's domain, or None after ``timeout`` s."""
     with site_node(domain_id, 'scan_clock') as (node, executor):
-        return first_pose(node, executor, timeout)
+        return session_start(node, executor, timeout)

@@ -16,13 +16,13 @@ from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import killed_bags
 from haptic_contract.graph import (absolute, COLLISION_STATE, PUBLISHERS, SCENE_DESCRIPTION,
-                                   SITE_PUBLISHERS, WAND_APPLIED_WRENCH, WAND_WRENCH)
+                                   SITE_PUBLISHERS, WAND_APPLIED_WRENCH, WAND_SESSION_START,
+                                   WAND_WRENCH)
 from haptic_util.stamps import to_nanoseconds
 
 __all__ = ['Frames', 'Session', 'bags', 'read_frames', 'read_numbers', 'read_session',
-           'read_vectors',
-           'reported', 'topic_counts', 'published_counts', 'applied_work', 'PUBLISHERS',
-           'SITE_PUBLISHERS']
+           'read_session_start', 'read_vectors', 'reported', 'topic_counts', 'published_counts',
+           'applied_work', 'PUBLISHERS', 'SITE_PUBLISHERS']
 
 _STATE, _WRENCH = absolute(COLLISION_STATE), absolute(WAND_WRENCH)
 _APPLIED, _SCENE = absolute(WAND_APPLIED_WRENCH), absolute(SCENE_DESCRIPTION)
@@ -190,6 +190,19 @@ def read_numbers(path: pathlib.Path, typestore, topic: str) -> tuple:
             times.append(stamp * 1e-9)
             values.append(reader.deserialize(raw, connection.msgtype).data)
     return np.array(times, dtype=np.float64), np.array(values, dtype=np.float64)
+
+
+def read_session_start(path: pathlib.Path, typestore) -> float:
+    """Return when the wand's session began (s, its ``wand/session_start`` stamp).
+
+    The scan's time zero, on the clock of the bag's receive times.
+    """
+    with AnyReader(bags(path), default_typestore=typestore) as reader:
+        connections = [c for c in reader.connections if c.topic == absolute(WAND_SESSION_START)]
+        for connection, _, raw in reader.messages(connections=connections):
+            return to_nanoseconds(reader.deserialize(raw, connection.msgtype).stamp) * 1e-9
+    raise ValueError(f'{path}: no {absolute(WAND_SESSION_START)} recorded: the session never '
+                     'began, or the bag is older than that topic')
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

@@ -16,8 +16,8 @@ __all__ = ['COLLISION_MARKERS', 'COLLISION_NEARBY', 'COLLISION_STATE', 'DIAGNOST
            'SCENE_DESCRIPTION', 'SITE_PUBLISHERS', 'STREAMS', 'TELEOP_CLUTCH', 'TELEOP_COMMAND',
            'TELEOP_FEEDBACK', 'TELEOP_HOLD', 'TELEOP_NODES', 'TELEOP_RE_ENGAGE', 'TOPIC_TYPES',
            'TO_OPERATOR', 'TO_REMOTE', 'WAND_APPLIED_WRENCH', 'WAND_CONTACT_MODEL',
-           'WAND_FORCE_MARKER', 'WAND_MODEL_SHIFT', 'WAND_POSE', 'WAND_TWIST', 'WAND_WRENCH',
-           'absolute']
+           'WAND_FORCE_MARKER', 'WAND_MODEL_SHIFT', 'WAND_POSE', 'WAND_SESSION_START',
+           'WAND_TWIST', 'WAND_WRENCH', 'absolute']
 
 # The loop: the wand's state out, the engine's answer, the renderer's wrench or model back.
 WAND_POSE = 'wand/pose'
@@ -27,6 +27,7 @@ WAND_CONTACT_MODEL = 'wand/contact_model'
 WAND_APPLIED_WRENCH = 'wand/applied_wrench'  # what the device applied over each tick
 WAND_MODEL_SHIFT = 'wand/model_shift'  # how far out the device renders the model's planes
 WAND_FORCE_MARKER = 'wand/force_marker'
+WAND_SESSION_START = 'wand/session_start'  # when the session began: the experiment's time zero
 COLLISION_STATE = 'collision/state'
 COLLISION_NEARBY = 'collision/nearby'
 COLLISION_MARKERS = 'collision/markers'
@@ -66,10 +67,11 @@ TOPIC_TYPES = {
     absolute(ROBOT_FT_WRENCH): 'geometry_msgs/msg/WrenchStamped',
     absolute(ROBOT_TARGET_POSE): 'geometry_msgs/msg/PoseStamped',
     absolute(SCENE_DESCRIPTION): 'std_msgs/msg/String',
+    absolute(WAND_SESSION_START): 'std_msgs/msg/Header',
     absolute(PROBE_IMAGE): 'sensor_msgs/msg/Image',
     DIAGNOSTICS: 'diagnostic_msgs/msg/DiagnosticArray',
 }
-LATCHED_TOPICS = (absolute(SCENE_DESCRIPTION),)
+LATCHED_TOPICS = (absolute(SCENE_DESCRIPTION), absolute(WAND_SESSION_START))
 RELIABLE_TOPICS = (DIAGNOSTICS,)  # a node's last report, with its final counts, must arrive
 # Images for people to look at, tens of hertz: taken over DDS as their viewers take them; across
 # the link, after the streams, and dropped when it is congested.
@@ -82,7 +84,7 @@ STREAMS = tuple(t for t in TOPIC_TYPES
 # said about itself (its last report carries its final counts).
 LOOP_TOPICS = tuple(absolute(topic) for topic in (
     WAND_POSE, WAND_TWIST, COLLISION_STATE, WAND_WRENCH, WAND_CONTACT_MODEL,
-    WAND_APPLIED_WRENCH, SCENE_DESCRIPTION, DIAGNOSTICS))
+    WAND_APPLIED_WRENCH, SCENE_DESCRIPTION, WAND_SESSION_START, DIAGNOSTICS))
 
 
 class NodeEntry(NamedTuple):
@@ -137,7 +139,7 @@ RELIABLE_CROSSINGS = (absolute(TELEOP_HOLD), absolute(TELEOP_RE_ENGAGE))
 # sites. The probe's image is recorded where the operator sees it, once: its stamp is the
 # pose's, so the bag gives pose to image there.
 OPERATOR_RECORDED = tuple(absolute(topic) for topic in (
-    WAND_POSE, WAND_APPLIED_WRENCH, TELEOP_FEEDBACK, DIAGNOSTICS))
+    WAND_POSE, WAND_APPLIED_WRENCH, TELEOP_FEEDBACK, WAND_SESSION_START, DIAGNOSTICS))
 REMOTE_RECORDED = tuple(absolute(topic) for topic in (
     ROBOT_TCP_POSE, ROBOT_FT_WRENCH, TELEOP_COMMAND, TELEOP_HOLD, TELEOP_RE_ENGAGE, DIAGNOSTICS))
 # Which node publishes each stream, by its name in /diagnostics reports (a node publishes each

@@ -5,6 +5,8 @@ each ``wand/wrench`` (WrenchStamped) to the device when it arrives. A wrench old
 ``wrench_timeout``, or one with NaN, gives zero force; while the next pose is late, the answer to
 the newest one may hold longer (``hold_while_late``, ``answer_deadline``). The wrench's stamp is
 the stamp of the pose it answers, so the driver measures the loop's round trip (``stats_file``).
+Once the loop is closed it publishes ``wand/session_start`` (Header, latched): the instant its
+experiment's clock starts, which whatever acts on a scripted session at set times counts from.
 """
 import enum
 import math
@@ -14,11 +16,11 @@ from typing import Sequence
 
 import numpy as np
 from rclpy.node import Node
-from std_msgs.msg import Bool
+from std_msgs.msg import Bool, Header
 
 from haptic_contract.contact_model import ContactModel, Kind, MODEL, ModelRefused
 from haptic_contract.graph import (WAND_APPLIED_WRENCH, WAND_CONTACT_MODEL, WAND_MODEL_SHIFT,
-                                   WAND_POSE, WAND_TWIST, WAND_WRENCH)
+                                   WAND_POSE, WAND_SESSION_START, WAND_TWIST, WAND_WRENCH)
 from haptic_contract.streams import (frame, POSE, stamp_ns, TWIST, VECTOR, WRENCH, WRENCH_FORCE,
                                      WRENCH_TORQUE)
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
@@ -90,6 +92,7 @@ class WandDriverNode(Node):
         self._pose_pub = stream_publisher(self, POSE, WAND_POSE)
         self._twist_pub = stream_publisher(self, TWIST, WAND_TWIST)
         self._applied_pub = stream_publisher(self, WRENCH, WAND_APPLIED_WRENCH)
+        self._session_pub = self.create_publisher(Header, WAND_SESSION_START, LATCHED_QOS)
         # One answer per pose: the model when the device renders it (a model carries the wrench
         # of a law that has none), else the wrench. A stream it does not use costs a core's
         # percent or more at 1 kHz, for the publisher and for this node.
@@ -192,6 +195,8 @@ class WandDriverNode(Node):
         """Start the session: once an answer came back for a probe, or at once when open loop."""
         self._phase = Phase.RUNNING
         self._device_offset = time.monotonic() - self._probe_start
+        self._session_pub.publish(Header(stamp=self.get_clock().now().to_msg(),
+                                         frame_id=self.params.frame_id))
         self.get_logger().info('loop closed: experiment started')
 
     def _publish(self, state, now_ns: int) -> None:
