@@ -335,35 +335,31 @@ def test_states_are_read_only():
             vector[0] = 1.0
 
 
+def held_and_freed(until: float, freed_at: float) -> tuple:
+    """Two wands pushed alike from 0 s: one held ``until``, one given zero at ``freed_at``."""
+    config = SimulatedWandConfig(step=5e-4)
+    held, freed = SimulatedWand(config), SimulatedWand(config)
+    for wand in (held, freed):
+        wand.read(0.0)
+    held.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0], until=until)
+    freed.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    freed.read(freed_at)
+    freed.apply([0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    return held, freed
+
+
 def test_a_held_force_drops_to_zero_at_its_deadline_without_another_call():
     """The device-level watchdog: past ``until`` the wand moves as if no force were applied."""
-    config = SimulatedWandConfig(step=5e-4)
-    held = SimulatedWand(config)
-    free = SimulatedWand(config)
-    for wand in (held, free):
-        wand.read(0.0)
-    held.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0], until=0.0035)
-    free.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0])
-    assert held.read(0.002).position.tolist() == free.read(0.002).position.tolist()
-    free.read(0.0035)
-    free.apply([0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    held, freed = held_and_freed(until=0.0035, freed_at=0.0035)
     for t in (0.0035, 0.01, 0.05):
-        assert held.read(t).position.tolist() == free.read(t).position.tolist()
+        assert held.read(t).position.tolist() == freed.read(t).position.tolist()
     assert held.read(0.05).linear_velocity[0] > 0.0  # the force did act before the deadline
 
 
 def test_a_servo_period_that_would_end_after_the_deadline_renders_no_force():
     """Nothing is rendered past ``until``: the period it falls inside is zero already."""
-    config = SimulatedWandConfig(step=5e-4)
-    held = SimulatedWand(config)
-    free = SimulatedWand(config)
-    for wand in (held, free):
-        wand.read(0.0)
-    held.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0], until=0.0033)
-    free.apply([2.0, 0.0, 0.0], [0.0, 0.0, 0.0])
-    free.read(0.003)
-    free.apply([0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
-    assert held.read(0.01).position.tolist() == free.read(0.01).position.tolist()
+    held, freed = held_and_freed(until=0.0033, freed_at=0.003)
+    assert held.read(0.01).position.tolist() == freed.read(0.01).position.tolist()
     assert held.force_edges == [(0.0, True), (0.003, False)]
 
 
