@@ -196,15 +196,21 @@ def test_point_spread(imager):
     rng = np.random.default_rng(3)
     shape = (imager.settings.scanlines, imager.settings.samples)
     field = rng.normal(size=shape) + 1j * rng.normal(size=shape)
+    coupled = np.ones(shape[0], dtype=bool)
+    coupled[7] = False
     envelope = np.empty(shape, dtype=np.float32)
-    _kernels.point_spread(field, imager.psf.axial, np.ascontiguousarray(imager.psf.lateral.T),
-                          np.empty_like(field), envelope)
-    axial = np.array([np.convolve(row, imager.psf.axial, mode='same') for row in field])
+    _kernels.point_spread(field, coupled, imager.psf.axial,
+                          np.ascontiguousarray(imager.psf.lateral.T), np.empty((2, *shape)),
+                          envelope)
+    heard = np.where(coupled[:, None], field, 0.0)
+    axial = np.array([np.convolve(row, imager.psf.axial, mode='same') for row in heard])
     kl = imager.psf.lateral.shape[1] // 2
     padded = np.pad(axial, ((kl, kl), (0, 0)))
     expected = np.zeros(shape, dtype=complex)
     for k in range(-kl, kl + 1):
         expected += imager.psf.lateral[:, k + kl][None, :] * padded[kl - k: kl - k + shape[0]]
+    expected[~coupled] = 0.0
+    assert np.abs(expected[6]).min() > 0  # line 7's neighbours are heard without it
     np.testing.assert_allclose(envelope, np.abs(expected), rtol=1e-5)
 
 

@@ -116,7 +116,7 @@ class Imager:
         self._hit_owner = np.empty(_HIT_CAPACITY, dtype=np.int64)
         self._inside = np.empty(len(anatomy.names), dtype=np.int64)
         self._field = np.empty(shape, dtype=np.complex128)
-        self._work = np.empty(shape, dtype=np.complex128)
+        self._work = np.empty((2, *shape))
         self._levels = np.empty(shape)
 
     @staticmethod
@@ -171,8 +171,8 @@ class Imager:
             settings.centre_frequency, rotation, p, self._voxel, self._noise, self._keys,
             self._scatter_gain, self._field, self._hit_t, self._hit_owner, self._inside)
         envelope = np.empty((settings.scanlines, settings.samples), dtype=np.float32)
-        _kernels.point_spread(self._field, self.psf.axial, self._lateral, self._work, envelope)
-        envelope[~mask] = 0.0
+        _kernels.point_spread(self._field, mask, self.psf.axial, self._lateral, self._work,
+                              envelope)
         geometry = self.conversion.geometry
         image = np.empty((geometry.height, geometry.width), dtype=np.uint8)
         conversion = self.conversion
