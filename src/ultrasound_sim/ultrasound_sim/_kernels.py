@@ -227,7 +227,7 @@ def point_spread(field, coupled, axial, lateral, work, envelope):
     across lines, one column per depth (the beam widens where the aperture stops growing). An
     uncoupled line's field counts as zero and its envelope is zero. ``work`` (2, lines, samples)
     holds the axial pass, real and imaginary apart: in real arithmetic, tap by tap over whole
-    rows, the loops vectorise.
+    rows, the loops vectorise (numba's wrap-around of an index that may be negative does not).
     """
     n_lines, n_samples = field.shape
     ka = axial.shape[0] // 2
@@ -244,9 +244,12 @@ def point_spread(field, coupled, axial, lateral, work, envelope):
             field_real[j], field_imag[j] = field[line, j].real, field[line, j].imag
         for k in range(-ka, ka + 1):
             tap_real, tap_imag = axial[k + ka].real, axial[k + ka].imag
-            for j in range(max(0, k), min(n_samples, n_samples + k)):
-                row_real[j] += tap_real * field_real[j - k] - tap_imag * field_imag[j - k]
-                row_imag[j] += tap_real * field_imag[j - k] + tap_imag * field_real[j - k]
+            start, stop = max(0, k), min(n_samples, n_samples + k)
+            out_real, out_imag = row_real[start:stop], row_imag[start:stop]
+            in_real, in_imag = field_real[start - k:stop - k], field_imag[start - k:stop - k]
+            for j in range(stop - start):  # indices that cannot be negative: it vectorises
+                out_real[j] += tap_real * in_real[j] - tap_imag * in_imag[j]
+                out_imag[j] += tap_real * in_imag[j] + tap_imag * in_real[j]
     sum_real, sum_imag = np.empty(n_samples), np.empty(n_samples)
     for line in range(n_lines):
         if not coupled[line]:
