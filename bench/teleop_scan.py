@@ -3,7 +3,7 @@
     .venv/bin/python bench/teleop_scan.py [--schemes direct tdpa model]
         [--delays 0 0.01 0.025 0.05 0.1 0.25 0.5] [--jitter 0.2] [--loss 0.05]
         [--site-streams in-process dds] [--model-step-rates 5 0] [--delay-trace CSV]
-        [--force-hold] [--keep DIR] [--json PATH]
+        [--measured-link FROM ...] [--force-hold] [--keep DIR] [--json PATH]
 
 Both sites run as real processes in two DDS domains, joined by the two site gateways
 (``haptic_loop --teleop``): the scripted sonographer approaches the patient phantom, presses,
@@ -34,8 +34,9 @@ applied to the hand (``/wand/applied_wrench``) and what the remote site's sensor
 The jitter is given as a fraction of the delay (20 %, and 5 % loss: issue 28's harsher link, to
 500 ms one way). ``--delay-trace`` runs each scheme once more over a measured link: a CSV of
 one-way delays (``time,delay`` in s, ``link_emulator.link.DelayTrace``), with no jitter added
-(the trace has its own) and the same loss; no such trace of an intercontinental link ships with
-the project (none with its per-sample delays could be found in public reach). Each site is one
+(the trace has its own) and the same loss. ``--measured-link`` does so over the measured
+intercontinental link that ships with the project (``measured_link``: echo round trips between
+Argentina and Málaga), replayed from each FROM s into it. Each site is one
 process; its nodes hand their streams over in the process (``in-process``, the default) or
 through DDS (``dds``: the sites before intra-process delivery, their CPU's baseline). With both,
 each case runs once per way, one after the other. With ``--json`` the figure of the felt and
@@ -57,6 +58,7 @@ import tempfile
 import time
 
 from bench import machine, result_files, ros_domain
+from bench.measured_link import echo_delays
 import numpy as np
 import psutil
 
@@ -295,6 +297,16 @@ def print_hold_errors(rows: list) -> None:
                   f'  rms {r["hold_error_rms_n"]:5.2f} N')
 
 
+def measured_traces(delay_trace: pathlib.Path | None, starts: list,
+                    folder: pathlib.Path) -> list:
+    """Return the CSVs of delays to replay: the one given, then the shipped link from each."""
+    shipped = []
+    for start in starts:
+        shipped.append(folder / f'argentina_malaga_from_{start:g}s.csv')
+        echo_delays().after(start).to_csv(shipped[-1])
+    return ([delay_trace] if delay_trace else []) + shipped
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--schemes', nargs='+', default=['direct', 'tdpa', 'model'],
@@ -305,6 +317,8 @@ def main(argv=None) -> int:
     parser.add_argument('--loss', type=float, default=0.05)
     parser.add_argument('--delay-trace', type=pathlib.Path, metavar='CSV',
                         help='each scheme once more over these measured one-way delays')
+    parser.add_argument('--measured-link', nargs='+', type=float, default=[], metavar='FROM',
+                        help='each scheme once more over the Argentina-Malaga trace, from FROM s')
     parser.add_argument('--site-streams', nargs='+', default=['in-process'],
                         choices=SITE_STREAMS, help="how each site's nodes pass their streams")
     parser.add_argument('--model-step-rates', nargs='+', type=float, default=[None],
@@ -344,12 +358,12 @@ def main(argv=None) -> int:
                                 domain_id=args.domain_id, hold=HOLD_FORCE,
                                 keep=kept(f'model-{delay:g}-held')))
                 print_row(rows[-1])
-        if args.delay_trace:
-            longest = float(DelayTrace.from_csv(args.delay_trace).delays.max())
+        for trace in measured_traces(args.delay_trace, args.measured_link, cases):
+            longest = float(DelayTrace.from_csv(trace).delays.max())
             for scheme in args.schemes:
                 rows.append(run(scheme, longest, jitter=0.0, loss=args.loss,
-                                domain_id=args.domain_id, delay_trace=args.delay_trace,
-                                keep=kept(f'{scheme}-trace')))
+                                domain_id=args.domain_id, delay_trace=trace,
+                                keep=kept(f'{scheme}-{trace.stem}')))
                 print_row(rows[-1])
     print_hold_errors(rows)
     print('\nCPU, % of one core, over the press and the sweep (the machine has '

@@ -76,6 +76,23 @@ def test_a_delay_trace_is_replayed_from_csv(tmp_path):
     assert delays == pytest.approx({'start': 0.01, 'a': 0.01, 'b': 0.1, 'c': 0.05})
 
 
+def test_a_trace_after_a_time_is_what_a_run_begun_then_replays(tmp_path):
+    trace = DelayTrace([0.0, 1.0, 2.0, 3.0], [0.01, 0.1, 0.05, 0.2])
+    later = trace.after(1.5)
+    assert later.times.tolist() == [0.0, 0.5, 1.5]
+    assert [later.delay_at(t) for t in (0.0, 0.4, 0.5, 9.0)] == [0.1, 0.1, 0.05, 0.2]
+    assert trace.after(2.0).times.tolist() == [0.0, 1.0]
+    path = tmp_path / 'later.csv'
+    later.to_csv(path)
+    again = DelayTrace.from_csv(path)
+    assert again.times.tolist() == later.times.tolist()
+    assert again.delays.tolist() == later.delays.tolist()
+    with pytest.raises(ValueError, match='past the last sample'):
+        trace.after(3.5)
+    with pytest.raises(ValueError, match='start must be finite >= 0'):
+        trace.after(-1.0)
+
+
 @pytest.mark.parametrize('text, message', [
     ('t,d\n0,0.1\n', 'header "time,delay"'),
     ('time,delay\n0,abc\n', 'two numbers'),

@@ -121,6 +121,23 @@ class DelayTrace:
         except ValueError as error:
             raise ValueError(f'{path}: {error}') from None
 
+    def to_csv(self, path) -> None:
+        """Write the trace as ``from_csv`` reads it."""
+        with Path(path).open('w', newline='', encoding='utf-8') as file:
+            writer = csv.writer(file)
+            writer.writerow(['time', 'delay'])
+            writer.writerows(zip(self.times.tolist(), self.delays.tolist()))
+
+    def after(self, start: float) -> 'DelayTrace':
+        """Return the trace from ``start`` (s) on, its time 0 there: what a run begun then sees."""
+        start = finite_number(start, 'DelayTrace.after start', minimum=0.0)
+        if start > self.times[-1]:
+            raise ValueError(f'DelayTrace.after: {start!r} s is past the last sample '
+                             f'({self.times[-1]!r} s)')
+        first = max(int(np.searchsorted(self.times, start, side='right')) - 1, 0)
+        times = np.maximum(self.times[first:] - start, 0.0)
+        return DelayTrace(times, self.delays[first:])
+
     def delay_at(self, time: float) -> float:
         """Return the delay (s) of the latest sample at or before ``time`` (s), or the first."""
         index = max(int(np.searchsorted(self.times, time, side='right')) - 1, 0)
