@@ -81,8 +81,8 @@ def frame_times(settings: ProbeSettings, frames: int) -> dict:
         frame = imager.frame(*pose, coupling)
         end, end_cpu = time.perf_counter(), time.thread_time()
         _kernels.display(frame.envelope, coupling, gain, settings.dynamic_range, levels,
-                         conversion.line_at, conversion.sample_at, conversion.line_weight,
-                         conversion.sample_weight, image)
+                         conversion.read, conversion.line_at, conversion.sample_at,
+                         conversion.line_weight, conversion.sample_weight, image)
         floor_end_cpu = time.thread_time()
         if index >= 0:
             wall.append(end - start)

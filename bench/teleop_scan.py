@@ -87,6 +87,7 @@ CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the swee
 SWEEP = (5.0, 16.0)  # [s] from the session's start: the scan's sweep along the patient (scan.yaml)
 HOLD_SETTLE = 0.5  # [s] after the sweep begins, or the hold arrives, before the error counts
 HOLD_FORCE = 8.0  # [N] held in a hold run: the scan's own press
+SCAN_LIMIT = 60.0  # [s] a scan ends within this, or it failed: the span of a trace it replays
 SITE_STREAMS = ('in-process', 'dds')
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
           '/remote/robot/ft_sensor/wrench': 'wrench', '/remote/robot/tcp_pose': 'pose'}
@@ -239,7 +240,7 @@ def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
                                                               *SWEEP, 120.0)
             with Loop(config) as loop:
                 cpu = process_cpu(loop)
-                if loop.wait(60.0) is None:
+                if loop.wait(SCAN_LIMIT) is None:
                     raise RuntimeError(f'{scheme} at {delay} s: the scan did not end')
             if asked is not None and asked.result() is None:
                 raise RuntimeError(f'{scheme} at {delay} s: the hold was never asked')
@@ -303,7 +304,7 @@ def measured_traces(delay_trace: pathlib.Path | None, starts: list,
     shipped = []
     for start in starts:
         shipped.append(folder / f'argentina_malaga_from_{start:g}s.csv')
-        echo_delays().after(start).to_csv(shipped[-1])
+        echo_delays().after(start, SCAN_LIMIT).to_csv(shipped[-1])
     return ([delay_trace] if delay_trace else []) + shipped
 
 

@@ -82,6 +82,7 @@ def test_a_trace_after_a_time_is_what_a_run_begun_then_replays(tmp_path):
     assert later.times.tolist() == [0.0, 0.5, 1.5]
     assert [later.delay_at(t) for t in (0.0, 0.4, 0.5, 9.0)] == [0.1, 0.1, 0.05, 0.2]
     assert trace.after(2.0).times.tolist() == [0.0, 1.0]
+    assert trace.after(0.5, length=1.5).delays.tolist() == [0.01, 0.1]
     path = tmp_path / 'later.csv'
     later.to_csv(path)
     again = DelayTrace.from_csv(path)
@@ -91,6 +92,8 @@ def test_a_trace_after_a_time_is_what_a_run_begun_then_replays(tmp_path):
         trace.after(3.5)
     with pytest.raises(ValueError, match='start must be finite >= 0'):
         trace.after(-1.0)
+    with pytest.raises(ValueError, match='length must be > 0 s'):
+        trace.after(1.0, length=0.0)
 
 
 @pytest.mark.parametrize('text, message', [

@@ -225,9 +225,12 @@ def test_display(imager):
     gain = np.linspace(0.0, 12.0, settings.samples)
     geometry = conversion.geometry
     image = np.empty((geometry.height, geometry.width), dtype=np.uint8)
-    _kernels.display(envelope, coupled, gain, settings.dynamic_range, np.empty(shape),
+    unread = np.full(shape, np.nan)  # a level the kernel used without making it shows
+    _kernels.display(envelope, coupled, gain, settings.dynamic_range, unread, conversion.read,
                      conversion.line_at, conversion.sample_at, conversion.line_weight,
                      conversion.sample_weight, image)
+    assert 0 < conversion.read.sum() < conversion.read.size
+    assert np.isnan(unread[~conversion.read]).all()
     with np.errstate(divide='ignore'):
         levels = (20 * np.log10(envelope) + gain + settings.dynamic_range) * 255 \
             / settings.dynamic_range

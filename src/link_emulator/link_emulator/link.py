@@ -128,15 +128,19 @@ class DelayTrace:
             writer.writerow(['time', 'delay'])
             writer.writerows(zip(self.times.tolist(), self.delays.tolist()))
 
-    def after(self, start: float) -> 'DelayTrace':
-        """Return the trace from ``start`` (s) on, its time 0 there: what a run begun then sees."""
+    def after(self, start: float, length: float = math.inf) -> 'DelayTrace':
+        """Return ``length`` s of the trace from ``start`` (s), its time 0 there: what a run
+        begun then sees."""
         start = finite_number(start, 'DelayTrace.after start', minimum=0.0)
         if start > self.times[-1]:
             raise ValueError(f'DelayTrace.after: {start!r} s is past the last sample '
                              f'({self.times[-1]!r} s)')
+        if not length > 0.0:
+            raise ValueError(f'DelayTrace.after: length must be > 0 s, got {length!r}')
         first = max(int(np.searchsorted(self.times, start, side='right')) - 1, 0)
-        times = np.maximum(self.times[first:] - start, 0.0)
-        return DelayTrace(times, self.delays[first:])
+        stop = int(np.searchsorted(self.times, start + length, side='left'))
+        times = np.maximum(self.times[first:stop] - start, 0.0)
+        return DelayTrace(times, self.delays[first:stop])
 
     def delay_at(self, time: float) -> float:
         """Return the delay (s) of the latest sample at or before ``time`` (s), or the first."""

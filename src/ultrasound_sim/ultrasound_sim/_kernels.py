@@ -27,35 +27,41 @@ _AXIS_MASK = 0xFFF  # each axis's key table too: the field repeats every 2**12 v
 
 
 @jit
+def _local(vertices, v, rotation, position, axis):
+    """Return coordinate ``axis`` of vertex ``v`` in the probe frame (rotation transposed)."""
+    return (rotation[0, axis] * (vertices[v, 0] - position[0])
+            + rotation[1, axis] * (vertices[v, 1] - position[1])
+            + rotation[2, axis] * (vertices[v, 2] - position[2]))
+
+
+@jit
 def section(vertices, triangles, owner, rotation, position, segments, segment_owner):
     """Cut the anatomy's triangles by the probe's scan plane (x = 0 in the probe frame).
 
     A vertex is on the plane's positive side when its x > 0, else on the other, the same rule
     for every triangle that shares it, so the cut of a closed mesh is closed polygons. Writes
     each cut as (y0, z0, y1, z1) into ``segments`` and its structure into ``segment_owner``;
-    returns how many.
+    returns how many. Only x is found for every vertex; y and z only for the few triangles cut.
     """
     n_vertices = vertices.shape[0]
-    local = np.empty((n_vertices, 3))
+    x = np.empty(n_vertices)
     for v in range(n_vertices):
-        dx = vertices[v, 0] - position[0]
-        dy = vertices[v, 1] - position[1]
-        dz = vertices[v, 2] - position[2]
-        for a in range(3):  # the probe frame: rotation transposed
-            local[v, a] = rotation[0, a] * dx + rotation[1, a] * dy + rotation[2, a] * dz
+        x[v] = _local(vertices, v, rotation, position, 0)
     count = 0
     for t in range(triangles.shape[0]):
         a, b, c = triangles[t, 0], triangles[t, 1], triangles[t, 2]
-        pa, pb, pc = local[a, 0] > 0.0, local[b, 0] > 0.0, local[c, 0] > 0.0
+        pa, pb, pc = x[a] > 0.0, x[b] > 0.0, x[c] > 0.0
         if pa == pb and pb == pc:
             continue
         found = 0
         for edge in range(3):
             i, j = (a, b) if edge == 0 else ((b, c) if edge == 1 else (c, a))
-            if (local[i, 0] > 0.0) != (local[j, 0] > 0.0):
-                w = local[i, 0] / (local[i, 0] - local[j, 0])
-                segments[count, 2 * found] = local[i, 1] + w * (local[j, 1] - local[i, 1])
-                segments[count, 2 * found + 1] = local[i, 2] + w * (local[j, 2] - local[i, 2])
+            if (x[i] > 0.0) != (x[j] > 0.0):
+                w = x[i] / (x[i] - x[j])
+                for axis in (1, 2):
+                    start = _local(vertices, i, rotation, position, axis)
+                    end = _local(vertices, j, rotation, position, axis)
+                    segments[count, 2 * found + axis - 1] = start + w * (end - start)
                 found += 1
         segment_owner[count] = owner[t]
         count += 1
@@ -267,18 +273,21 @@ def point_spread(field, coupled, axial, lateral, work, envelope):
 
 
 @jit
-def display(envelope, coupled, gain, dynamic_range, levels, line_at, sample_at, line_weight,
-            sample_weight, image):
+def display(envelope, coupled, gain, dynamic_range, levels, read, line_at, sample_at,
+            line_weight, sample_weight, image):
     """Log-compress the envelope to grey levels, then scan-convert them into ``image``.
 
     Level 255 is 0 dB (a perfect reflector at the face, after ``gain`` (samples,) dB), level 0
-    is ``dynamic_range`` below; an uncoupled line is black. Each pixel interpolates the levels
-    of the four samples around it (``line_at`` < 0: outside the field, black).
+    is ``dynamic_range`` below; an uncoupled line is black. Only the samples ``read`` get a
+    level: the logarithm is most of this kernel's time. Each pixel interpolates the levels of
+    the four samples around it (``line_at`` < 0: outside the field, black).
     """
     n_lines, n_samples = envelope.shape
     scale = 255.0 / dynamic_range
     for line in range(n_lines):
         for j in range(n_samples):
+            if not read[line, j]:
+                continue
             value = envelope[line, j]
             level = 0.0
             if coupled[line] and value > 0.0:

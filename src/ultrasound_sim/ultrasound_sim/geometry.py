@@ -8,6 +8,7 @@ depth = -z, rows going deeper and columns toward +y.
 """
 
 from dataclasses import dataclass
+import itertools
 
 import numpy as np
 
@@ -64,7 +65,8 @@ class ScanConversion:
 
     ``line_at`` (pixels,) int64 is the lower line (-1: outside the field), ``sample_at`` the
     lower sample; ``line_weight`` and ``sample_weight`` (pixels,) float64 are the bilinear
-    weights of the upper ones.
+    weights of the upper ones. ``read`` (scanlines, samples) bool marks the samples some pixel
+    reads: a linear probe's image shows every other one of them, and the rest need no grey level.
     """
 
     geometry: ImageGeometry
@@ -72,6 +74,7 @@ class ScanConversion:
     sample_at: np.ndarray
     line_weight: np.ndarray
     sample_weight: np.ndarray
+    read: np.ndarray
 
 
 def _lateral_span(settings: ProbeSettings) -> float:
@@ -137,4 +140,8 @@ def scan_conversion(settings: ProbeSettings) -> ScanConversion:
     line_at, line_weight = _lower(line.ravel(), settings.scanlines)
     sample_at, sample_weight = _lower(sample.ravel(), settings.samples)
     line_at[~inside.ravel()] = -1
-    return ScanConversion(geometry, line_at, sample_at, line_weight, sample_weight)
+    read = np.zeros((settings.scanlines, settings.samples), dtype=bool)
+    shown = line_at >= 0
+    for lines, samples in itertools.product((0, 1), (0, 1)):
+        read[line_at[shown] + lines, sample_at[shown] + samples] = True
+    return ScanConversion(geometry, line_at, sample_at, line_weight, sample_weight, read)

@@ -177,6 +177,6 @@ class Imager:
         image = np.empty((geometry.height, geometry.width), dtype=np.uint8)
         conversion = self.conversion
         _kernels.display(envelope, mask, self._gain, settings.dynamic_range, self._levels,
-                         conversion.line_at, conversion.sample_at, conversion.line_weight,
-                         conversion.sample_weight, image)
+                         conversion.read, conversion.line_at, conversion.sample_at,
+                         conversion.line_weight, conversion.sample_weight, image)
         return BModeFrame(image, geometry, envelope, mask.copy())
