@@ -129,8 +129,10 @@ class DelayTrace:
             writer.writerows(zip(self.times.tolist(), self.delays.tolist()))
 
     def after(self, start: float, length: float = math.inf) -> 'DelayTrace':
-        """Return ``length`` s of the trace from ``start`` (s), its time 0 there: what a run
-        begun then sees."""
+        """Return ``length`` s of the trace from ``start`` (s), its time 0 there.
+
+        What a run begun ``start`` s into the measured link replays.
+        """
         start = finite_number(start, 'DelayTrace.after start', minimum=0.0)
         if start > self.times[-1]:
             raise ValueError(f'DelayTrace.after: {start!r} s is past the last sample '
