@@ -235,7 +235,20 @@ def _teleop_chapter(findings: Findings) -> list[str]:
         'robot\'s spring to 40 N/s in contact); the *sweep force error* the patient\'s force '
         'through the sweep (from 0.5 s into it) against the one held, in the runs marked '
         '*force held* (the remote site holding it, asked on `teleop/hold` across the '
-        'gateways over ROS 2), else against its own mean (what the operator\'s hand keeps).',
+        'gateways over ROS 2), else against its own mean (what the operator\'s hand keeps). '
+        'The runs marked *trace argentina_malaga_from_N s* replay a measured intercontinental '
+        'link from N s into it: the echo round trips of a networked telerobot between Argentina '
+        'and Málaga (Fernández-Madrigal et al., *Roundtrip Times in Networked Telerobots for '
+        'Sensory Data Transmissions*, Zenodo 2025, doi:10.5281/zenodo.14967644; '
+        '`bench/delay_traces/`), each way half a round trip, with the same loss and no jitter '
+        'added; their delay is the longest they replay. From 0 s: its first minute, 299–648 ms '
+        'round trips. From 365 s: its worst stretch, round trips up to 2.3 s, the delay '
+        'rising by up to 460 ms from one sample to the next. Over that stretch *model* and '
+        '*tdpa* never reach the patient: the follower\'s admission (a backlog after a silence '
+        'is refused, and so is a stamp ahead of the link) refuses the bunches that each rise '
+        'and fall of the delay releases, hundreds a second, and the robot holds off the '
+        'patient. Safe, not usable: a link this unsteady needs admission bounds that follow '
+        'its spread, which they do not yet.',
         '']
     parts += ['### In lockstep', '']
     parts += _stored(findings, 'teleop_lockstep', lambda rows: [
