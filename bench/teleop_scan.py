@@ -36,7 +36,9 @@ The jitter is given as a fraction of the delay (20 %, and 5 % loss: issue 28's h
 one-way delays (``time,delay`` in s, ``link_emulator.link.DelayTrace``), with no jitter added
 (the trace has its own) and the same loss. ``--measured-link`` does so over the measured
 intercontinental link that ships with the project (``measured_link``: echo round trips between
-Argentina and Málaga), replayed from each FROM s into it. Each site is one
+Argentina and Málaga), replayed from each FROM s into it; over each trace ``model`` runs once
+more with both ends' watchdogs and admission bounds fixed at the nodes' defaults (``fixed bounds
+(before)``), not widened to the link's spread as the launcher now does. Each site is one
 process; its nodes hand their streams over in the process (``in-process``, the default) or
 through DDS (``dds``: the sites before intra-process delivery, their CPU's baseline). With both,
 each case runs once per way, one after the other. With ``--json`` the figure of the felt and
@@ -87,6 +89,9 @@ CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the swee
 SWEEP = (5.0, 16.0)  # [s] from the session's start: the scan's sweep along the patient (scan.yaml)
 HOLD_SETTLE = 0.5  # [s] after the sweep begins, or the hold arrives, before the error counts
 HOLD_FORCE = 8.0  # [N] held in a hold run: the scan's own press
+FIXED_BOUNDS = {  # the nodes' own defaults: the bounds before they followed the link's spread
+    'teleop_leader': {'link_timeout': 0.1, 'max_feedback_age': 0.1, 'max_stamp_lead': 0.05},
+    'teleop_follower': {'link_timeout': 0.1, 'max_command_age': 0.1, 'max_stamp_lead': 0.05}}
 SCAN_LIMIT = 60.0  # [s] a scan ends within this, or it failed: the span of a trace it replays
 SITE_STREAMS = ('in-process', 'dds')
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
@@ -218,12 +223,15 @@ def figures(scan: dict, delay: float, force_scale: float = FORCE_SCALE) -> dict:
 def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
         domain_id: int = 42, keep: pathlib.Path | None = None,
         site_streams: str = 'in-process', model_step_rate: float | None = None,
-        delay_trace: pathlib.Path | None = None, hold: float | None = None) -> dict:
+        delay_trace: pathlib.Path | None = None, hold: float | None = None,
+        fixed_bounds: bool = False) -> dict:
     """One scan with ``scheme`` over a link of one-way ``delay`` s; its figures.
 
     ``model_step_rate``: the driver's (N/s), None for the launcher's. ``delay_trace``: a CSV of
     one-way delays replayed instead of ``delay``, which is then the trace's longest. ``hold``:
-    the force (N) the remote site is asked to hold through the sweep.
+    the force (N) the remote site is asked to hold through the sweep. ``fixed_bounds``: both
+    ends' watchdogs and admission at their nodes' defaults, not widened to the link's spread
+    (the code before it).
     """
     with tempfile.TemporaryDirectory() as tmp:
         folder = keep or pathlib.Path(tmp)
@@ -233,8 +241,9 @@ def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
                             link={'delay': delay, 'jitter': jitter * delay, 'loss': loss,
                                   **({'delay_trace': str(delay_trace)} if delay_trace else {})},
                             intra_process=site_streams == 'in-process',
-                            overrides={} if model_step_rate is None else
-                            {'wand_driver': {'model_step_rate': model_step_rate}})
+                            overrides={**({} if model_step_rate is None else
+                                          {'wand_driver': {'model_step_rate': model_step_rate}}),
+                                       **(FIXED_BOUNDS if fixed_bounds else {})})
         with concurrent.futures.ThreadPoolExecutor(1) as requests:
             asked = None if hold is None else requests.submit(hold_during, domain_id, hold,
                                                               *SWEEP, 120.0)
@@ -247,7 +256,8 @@ def run(scheme: str, delay: float, *, jitter: float = 0.2, loss: float = 0.05,
         streams = ', '.join([site_streams] + ([] if model_step_rate is None else
                                               [f'ease {model_step_rate:g}'])
                             + ([] if delay_trace is None else [f'trace {delay_trace.name}'])
-                            + ([] if hold is None else [f'force held {hold:g} N']))
+                            + ([] if hold is None else [f'force held {hold:g} N'])
+                            + (['fixed bounds (before)'] if fixed_bounds else []))
         scan = read_scan(folder / 'bag')
         start = read_session_start(folder / 'bag', typestore_with(custom_definitions()))
         window = (start + SWEEP[0], start + SWEEP[1]) if hold is None else \
@@ -365,6 +375,11 @@ def main(argv=None) -> int:
                 rows.append(run(scheme, longest, jitter=0.0, loss=args.loss,
                                 domain_id=args.domain_id, delay_trace=trace,
                                 keep=kept(f'{scheme}-{trace.stem}')))
+                print_row(rows[-1])
+            if 'model' in args.schemes:  # the baseline: bounds that do not follow the link
+                rows.append(run('model', longest, jitter=0.0, loss=args.loss,
+                                domain_id=args.domain_id, delay_trace=trace, fixed_bounds=True,
+                                keep=kept(f'model-{trace.stem}-fixed')))
                 print_row(rows[-1])
     print_hold_errors(rows)
     print('\nCPU, % of one core, over the press and the sweep (the machine has '

@@ -3,6 +3,7 @@ import os
 import pathlib
 import sys
 
+import pytest
 import yaml
 
 from haptic_bringup.launcher import (expected_endpoints, imager_argv, loop_environment,
@@ -86,3 +87,21 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
                                     '--imaging']))
     assert remote.loop.imaging and parse_args(['--teleop', 'model', '--imaging']).imaging
     assert not parse_args(['--teleop', 'model']).imaging
+
+
+def test_both_ends_wait_out_the_link_s_spread_a_trace_s_included(tmp_path):
+    def bounds(link):
+        merged = node_parameters(LoopConfig(teleop='model', link=link))
+        leader = merged['teleop_leader']['ros__parameters']
+        follower = merged['teleop_follower']['ros__parameters']
+        assert leader['link_timeout'] == follower['link_timeout']
+        assert leader['max_feedback_age'] == follower['max_command_age']
+        assert leader['max_stamp_lead'] == follower['max_stamp_lead']
+        return leader['link_timeout'], leader['max_feedback_age'], leader['max_stamp_lead']
+    assert bounds({}) == (0.1, 0.1, 0.05)  # the nodes' own defaults on a steady link
+    assert bounds({'delay': 0.5, 'jitter': 0.1}) == pytest.approx((0.6, 0.6, 0.55))
+    trace = tmp_path / 'trace.csv'
+    trace.write_text('time,delay\n0.0,0.1\n1.0,0.3\n')  # one SD of 0.1 s
+    assert bounds({'delay_trace': str(trace)}) == pytest.approx((0.6, 0.6, 0.55))
+    assert bounds({'delay_trace': str(trace), 'jitter': 0.1}) == pytest.approx(
+        (0.1 + 5 * 0.1 * 2 ** 0.5,) * 2 + (0.05 + 5 * 0.1 * 2 ** 0.5,))

@@ -51,7 +51,8 @@ from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGE
 from haptic_contract.teleop import Scheme, SCHEMES
 from haptic_util import shared_memory
 from haptic_util.executor import end_process
-from link_emulator.link import silence_timeout
+from link_emulator.link import delay_spread, DelayTrace, silence_timeout
+from teleop_protocol.admission import AdmissionConfig
 
 __all__ = ['LoopConfig', 'Loop', 'imager_argv', 'main', 'loop_environment', 'NODES']
 
@@ -175,8 +176,12 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     it is sent, for at most ``LATE_POSE_HOLD``: an answer that expired inside a stretched tick let
     the hand fall in, and the next one threw it back out (``haptic_wand_driver.answer_deadline``).
     Each new model eases in at ``MODEL_STEP_RATE`` (``haptic_wand_driver.model_easing``): at
-    once, every estimate's move since the last jolted the hand (issue 28). Both ends' watchdogs
-    wait out the link's jitter (``link_emulator.link.silence_timeout``).
+    once, every estimate's move since the last jolted the hand (issue 28). Both ends' watchdogs,
+    and their admission's bounds on a message's age and lead, wait out the link's spread: its
+    jitter, and a delay trace's own rises and falls (``link_emulator.link.delay_spread``,
+    ``silence_timeout``). With fixed bounds, over the measured Argentina-Malaga link's worst
+    stretch, the follower refused each backlog a rise of the delay released and each early
+    bunch a fall brought, hundreds a second, and the robot never reached the patient.
     """
     scheme = config.teleop
     driver = options.setdefault('wand_driver', {})
@@ -188,9 +193,17 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     driver['passivity'] = scheme != Scheme.DIRECT
     driver['hold_while_late'] = LATE_POSE_HOLD
     driver['model_step_rate'] = MODEL_STEP_RATE
-    timeout = silence_timeout(LINK_TIMEOUT, float(config.link.get('jitter', 0.0)))
-    for node in ('teleop_leader', 'teleop_follower'):
-        options.setdefault(node, {}).update(scheme=scheme, link_timeout=timeout)
+    trace = config.link.get('delay_trace')
+    spread = delay_spread(float(config.link.get('jitter', 0.0)),
+                          DelayTrace.from_csv(trace) if trace else None)
+    timeout = silence_timeout(LINK_TIMEOUT, spread)
+    lead = silence_timeout(AdmissionConfig.max_lead, spread)
+    options.setdefault('teleop_leader', {}).update(
+        scheme=scheme, link_timeout=timeout, max_feedback_age=silence_timeout(
+            AdmissionConfig.max_age, spread), max_stamp_lead=lead)
+    options.setdefault('teleop_follower', {}).update(
+        scheme=scheme, link_timeout=timeout, max_command_age=silence_timeout(
+            AdmissionConfig.max_age, spread), max_stamp_lead=lead)
     if config.record:
         session = pathlib.Path(config.record).resolve()
         options[OPERATOR_RECORDER] = {'output': str(session / 'operator'), 'topics': [

@@ -29,9 +29,21 @@ import numpy as np
 
 from haptic_contract.checks import finite_number, whole_number
 
-__all__ = ['DelayTrace', 'Delivery', 'EmulatedLink', 'LinkConfig', 'silence_timeout']
+__all__ = ['delay_spread', 'DelayTrace', 'Delivery', 'EmulatedLink', 'LinkConfig',
+           'silence_timeout']
 
 GAP_DEVIATIONS = 5.0  # jitter deviations a watchdog waits past its own timeout
+
+
+def delay_spread(jitter: float, trace: 'DelayTrace | None' = None) -> float:
+    """Return how far a link's one-way delays spread (s, one SD): its jitter and a trace's own.
+
+    Why: a measured link's delay rises and falls, and a rise of d leaves it silent for d (a
+    message never overtakes another) then delivers a backlog d late; a fall delivers messages
+    early. The watchdogs and the admission must wait that out as they wait out jitter.
+    """
+    own = 0.0 if trace is None else float(np.std(trace.delays))
+    return math.hypot(jitter, own)
 
 
 def silence_timeout(timeout: float, jitter: float) -> float:
