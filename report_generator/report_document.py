@@ -243,12 +243,12 @@ def _teleop_chapter(findings: Findings) -> list[str]:
         '`bench/delay_traces/`), each way half a round trip, with the same loss and no jitter '
         'added; their delay is the longest they replay. From 0 s: its first minute, 299–648 ms '
         'round trips. From 365 s: its worst stretch, round trips up to 2.3 s, the delay '
-        'rising by up to 460 ms from one sample to the next. Over that stretch *model* and '
-        '*tdpa* never reach the patient: the follower\'s admission (a backlog after a silence '
-        'is refused, and so is a stamp ahead of the link) refuses the bunches that each rise '
-        'and fall of the delay releases, hundreds a second, and the robot holds off the '
-        'patient. Safe, not usable: a link this unsteady needs admission bounds that follow '
-        'its spread, which they do not yet.',
+        'rising by up to 460 ms from one sample to the next. Both ends\' watchdogs and '
+        'admission bounds (a backlog after a silence is refused, and so is a stamp ahead of '
+        'the link) wait out the link\'s spread, a trace\'s own rises and falls included; the '
+        'rows marked *fixed bounds (before)* hold them at the nodes\' defaults (0.1 s, 0.05 s), '
+        'as before: over the worst stretch the follower then refused the bunches each swing of '
+        'the delay released, hundreds a second, and the robot never reached the patient.',
         '']
     parts += ['### In lockstep', '']
     parts += _stored(findings, 'teleop_lockstep', lambda rows: [
