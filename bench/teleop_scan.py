@@ -66,11 +66,12 @@ import psutil
 
 from haptic_bringup.bag import typestore_with
 from haptic_bringup.hold_request import hold_during
-from haptic_bringup.launcher import Loop, LoopConfig
+from haptic_bringup.launcher import LINK_TIMEOUT, Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import read_numbers, read_session_start, read_vectors
 from haptic_contract.graph import absolute, REMOTE_PREFIX, TELEOP_HOLD
 from link_emulator.link import DelayTrace
+from teleop_protocol.admission import AdmissionConfig
 
 __all__ = ['figures', 'felt_steps', 'hold_error', 'read_scan', 'run', 'main']
 
@@ -89,9 +90,10 @@ CPU_WINDOW = (3.0, 15.0)  # [s] after the session closed: the press and the swee
 SWEEP = (5.0, 16.0)  # [s] from the session's start: the scan's sweep along the patient (scan.yaml)
 HOLD_SETTLE = 0.5  # [s] after the sweep begins, or the hold arrives, before the error counts
 HOLD_FORCE = 8.0  # [N] held in a hold run: the scan's own press
+_FIXED = {'link_timeout': LINK_TIMEOUT, 'max_stamp_lead': AdmissionConfig.max_lead}
 FIXED_BOUNDS = {  # the nodes' own defaults: the bounds before they followed the link's spread
-    'teleop_leader': {'link_timeout': 0.1, 'max_feedback_age': 0.1, 'max_stamp_lead': 0.05},
-    'teleop_follower': {'link_timeout': 0.1, 'max_command_age': 0.1, 'max_stamp_lead': 0.05}}
+    'teleop_leader': {**_FIXED, 'max_feedback_age': AdmissionConfig.max_age},
+    'teleop_follower': {**_FIXED, 'max_command_age': AdmissionConfig.max_age}}
 SCAN_LIMIT = 60.0  # [s] a scan ends within this, or it failed: the span of a trace it replays
 SITE_STREAMS = ('in-process', 'dds')
 TOPICS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
@@ -311,10 +313,10 @@ def print_hold_errors(rows: list) -> None:
 def measured_traces(delay_trace: pathlib.Path | None, starts: list,
                     folder: pathlib.Path) -> list:
     """Return the CSVs of delays to replay: the one given, then the shipped link from each."""
-    shipped = []
+    shipped, echo = [], echo_delays() if starts else None
     for start in starts:
         shipped.append(folder / f'argentina_malaga_from_{start:g}s.csv')
-        echo_delays().after(start, SCAN_LIMIT).to_csv(shipped[-1])
+        echo.after(start, SCAN_LIMIT).to_csv(shipped[-1])
     return ([delay_trace] if delay_trace else []) + shipped
 
 

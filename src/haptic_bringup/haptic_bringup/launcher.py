@@ -196,14 +196,11 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
     trace = config.link.get('delay_trace')
     spread = delay_spread(float(config.link.get('jitter', 0.0)),
                           DelayTrace.from_csv(trace) if trace else None)
-    timeout = silence_timeout(LINK_TIMEOUT, spread)
-    lead = silence_timeout(AdmissionConfig.max_lead, spread)
-    options.setdefault('teleop_leader', {}).update(
-        scheme=scheme, link_timeout=timeout, max_feedback_age=silence_timeout(
-            AdmissionConfig.max_age, spread), max_stamp_lead=lead)
-    options.setdefault('teleop_follower', {}).update(
-        scheme=scheme, link_timeout=timeout, max_command_age=silence_timeout(
-            AdmissionConfig.max_age, spread), max_stamp_lead=lead)
+    bounds = {'link_timeout': silence_timeout(LINK_TIMEOUT, spread),
+              'max_stamp_lead': silence_timeout(AdmissionConfig.max_lead, spread)}
+    age = silence_timeout(AdmissionConfig.max_age, spread)
+    options.setdefault('teleop_leader', {}).update(scheme=scheme, max_feedback_age=age, **bounds)
+    options.setdefault('teleop_follower', {}).update(scheme=scheme, max_command_age=age, **bounds)
     if config.record:
         session = pathlib.Path(config.record).resolve()
         options[OPERATOR_RECORDER] = {'output': str(session / 'operator'), 'topics': [
