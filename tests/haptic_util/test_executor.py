@@ -7,9 +7,12 @@ import subprocess
 import sys
 import time
 
+from privilege import ROOT, WITHOUT_REALTIME
 import pytest
 
 from haptic_bringup.launcher import loop_environment
+
+SCHED_OTHER, SCHED_FIFO = 0, 1  # Linux's policy numbers
 
 RAISES_ONCE = """
 import sys
@@ -97,9 +100,34 @@ class Overrun(Node):
 sys.exit(run_nodes([Overrun]))
 """
 
+REALTIME = """
+import os, sys
+from rclpy.node import Node
+from haptic_util.executor import request_stop, run_nodes
+from haptic_util.parameters import declare_parameters, RealtimeParams
 
-def start(script: str, tmp_path) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, '-c', script], stdout=subprocess.PIPE,
+class Loop(Node):  # a 1 kHz node: it asks, by its parameter
+    def __init__(self):
+        super().__init__('loop', parameter_overrides=[])
+        declare_parameters(self, RealtimeParams)
+        self.create_timer(0.01, self.tick)
+
+    def tick(self):
+        for task in sorted(os.listdir('/proc/self/task')):
+            print(os.sched_getscheduler(int(task)), os.sched_getparam(int(task)).sched_priority)
+        request_stop()
+
+class Other(Node):  # one that does not ask
+    def __init__(self):
+        super().__init__('other')
+
+sys.exit(run_nodes([Loop, Other], sys.argv))
+"""
+
+
+def start(script: str, tmp_path, *args: str, prefix: tuple = ()) -> subprocess.Popen:
+    return subprocess.Popen([*prefix, sys.executable, '-c', script, *args],
+                            stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, start_new_session=True,
                             env=loop_environment(97, tmp_path / 'log'))
 
@@ -158,3 +186,23 @@ def test_a_node_whose_callbacks_never_catch_up_still_stops_at_sigint(tmp_path):
     finally:
         process.kill()  # one that did not stop would spin on after the test
     assert process.returncode == 0, err
+
+
+@pytest.mark.skipif(not ROOT, reason='SCHED_FIFO needs root here (CI runs as root)')
+@pytest.mark.parametrize('priority', [30, 0])
+def test_a_node_s_thread_priority_puts_its_whole_process_under_sched_fifo(tmp_path, priority):
+    process = start(REALTIME, tmp_path, '--ros-args', '-p', f'loop:thread_priority:={priority}')
+    out, err = process.communicate(timeout=120)
+    assert process.returncode == 0, err
+    threads = {tuple(int(v) for v in line.split()) for line in out.splitlines()}
+    assert threads == ({(SCHED_FIFO, priority)} if priority else {(SCHED_OTHER, 0)})
+    assert ('this process runs at SCHED_FIFO' in err) == bool(priority), err
+
+
+def test_a_node_that_may_not_run_real_time_says_why_and_runs_as_before(tmp_path):
+    process = start(REALTIME, tmp_path, prefix=WITHOUT_REALTIME)
+    out, err = process.communicate(timeout=120)
+    assert process.returncode == 0, err
+    assert {tuple(int(v) for v in line.split()) for line in out.splitlines()} == {
+        (SCHED_OTHER, 0)}
+    assert 'thread_priority 50: real-time scheduling (SCHED_FIFO) is not permitted' in err

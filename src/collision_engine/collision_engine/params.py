@@ -2,13 +2,13 @@
 from dataclasses import dataclass
 
 from haptic_contract.shared_defaults import DEFAULT_SCENE
-from haptic_util.parameters import parameter
+from haptic_util.parameters import parameter, RealtimeParams
 
 __all__ = ['CollisionNodeParams']
 
 
 @dataclass(frozen=True)
-class CollisionNodeParams:
+class CollisionNodeParams(RealtimeParams):
     scene_file: str = parameter(DEFAULT_SCENE, 'scene YAML: a path or package://<pkg>/<path>')
     report_radius: float = parameter(
         0.0, 'also publish every object within this signed distance on collision/nearby '

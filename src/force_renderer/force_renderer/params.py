@@ -3,7 +3,7 @@ from dataclasses import dataclass
 
 from haptic_contract.shared_defaults import DEFAULT_SCENE, DEVICE_DAMPING, FORCE_LIMIT, \
     LOOP_PERIOD
-from haptic_util.parameters import parameter
+from haptic_util.parameters import parameter, RealtimeParams
 
 __all__ = ['ForceRendererParams', 'LAWS']
 
@@ -11,7 +11,7 @@ LAWS = ('normal', 'centroid', 'proxy')
 
 
 @dataclass(frozen=True)
-class ForceRendererParams:
+class ForceRendererParams(RealtimeParams):
     law: str = parameter('normal', 'normal: spring-damper along the surface normal; proxy: '
                          'god-object proxy (no pop-through); centroid: the paper\'s law, for '
                          'comparison only', choices=LAWS)

@@ -54,7 +54,8 @@ from haptic_util.executor import end_process
 from link_emulator.link import delay_spread, DelayTrace, silence_timeout
 from teleop_protocol.admission import AdmissionConfig
 
-__all__ = ['LoopConfig', 'Loop', 'imager_argv', 'main', 'loop_environment', 'NODES']
+__all__ = ['LoopConfig', 'Loop', 'imager_argv', 'main', 'loop_environment', 'NODES',
+           'priority_parameters']
 
 SCAN_SCRIPT = ('teleop_leader', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
@@ -95,6 +96,9 @@ class LoopConfig:
     # Composed, the loop's process records itself; False: a recorder process does, as for three
     # processes (the baseline the benchmarks compare it with).
     record_in_process: bool = True
+    # The 1 kHz processes' real-time priority (every node but the imager, and the gateways);
+    # None: their default (``haptic_util.parameters.RealtimeParams``), 0: normal scheduling.
+    thread_priority: Optional[int] = None
 
     @property
     def remote_domain_id(self) -> int:
@@ -159,10 +163,19 @@ def node_parameters(config: LoopConfig) -> dict:
         options.setdefault('wand_driver', {})['wait_for_recorder'] = True
     if config.teleop:
         _teleop_options(config, options)
+    if config.thread_priority is not None:
+        for node in (*NODES, *TELEOP_NODES, *RECORDERS):
+            if node != IMAGER:  # it yields the cores instead (haptic_util.priority)
+                options.setdefault(node, {}).update(priority_parameters(config))
     for node, values in [*options.items(), *config.overrides.items()]:
         merged.setdefault(node, {'ros__parameters': {}})
         merged[node]['ros__parameters'].update(values)
     return merged
+
+
+def priority_parameters(config: LoopConfig) -> dict:
+    """Return the ``thread_priority`` the run sets on its 1 kHz nodes, if it sets one."""
+    return {} if config.thread_priority is None else {'thread_priority': config.thread_priority}
 
 
 def _teleop_options(config: LoopConfig, options: dict) -> None:
@@ -360,7 +373,8 @@ class Loop:
             'remote', self._composed(site_nodes(config, 'remote'), ros_args), remote_env))
         self._start_imager(ros_args, remote_env)
         self.children += loopback_gateways(self.run_dir, config.python, env, remote_env,
-                                           link=config.link)
+                                           link=config.link,
+                                           priority=priority_parameters(config))
         self._wait_for_discovery(config.remote_domain_id)
         self.children.insert(0, start_child(  # the operator's stops first
             'operator', self._composed(site_nodes(config, 'operator'), ros_args), env))
@@ -483,6 +497,9 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help='teleop: replay one-way delays from a CSV (time,delay in s)')
     parser.add_argument('--imaging', action='store_true',
                         help='teleop: the remote site images the probe\'s view (probe/image)')
+    parser.add_argument('--thread-priority', type=int, metavar='P',
+                        help='real-time (SCHED_FIFO) priority of the 1 kHz processes, 1-99 '
+                        '(default: the nodes\' own, 50); 0 for normal scheduling')
     add_run_arguments(parser, run_dir='build/launch')
     return parser.parse_args(argv)
 
@@ -515,7 +532,8 @@ def main(argv=None) -> int:
                         duration=args.duration, record=args.record, domain_id=args.domain_id,
                         params_file=args.params_file, run_dir=pathlib.Path(args.run_dir),
                         teleop=args.teleop, link=link_parameters(args),
-                        remote_domain=args.remote_domain_id, imaging=args.imaging)
+                        remote_domain=args.remote_domain_id, imaging=args.imaging,
+                        thread_priority=args.thread_priority)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     loop = Loop(config)
 

@@ -2,13 +2,13 @@
 from dataclasses import dataclass
 
 from haptic_contract.graph import LOOP_TOPICS
-from haptic_util.parameters import parameter
+from haptic_util.parameters import parameter, RealtimeParams
 
 __all__ = ['RecorderParams']
 
 
 @dataclass(frozen=True)
-class RecorderParams:
+class RecorderParams(RealtimeParams):
     output: str = parameter('bags/haptic_session', 'new bag directory to write')
     topics: tuple[str, ...] = parameter(LOOP_TOPICS, 'topics to record (others than the '
                                         'session\'s are typed from the graph)')

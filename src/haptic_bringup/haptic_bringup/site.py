@@ -31,7 +31,8 @@ from typing import Optional
 import yaml
 
 from haptic_bringup.launcher import (add_run_arguments, link_parameters, Loop, LoopConfig,
-                                     node_parameters, site_nodes, teleop_endpoints)
+                                     node_parameters, priority_parameters, site_nodes,
+                                     teleop_endpoints)
 from haptic_bringup.processes import run_until_stopped, start_child
 from haptic_contract.graph import FRAME_TOPICS, RELIABLE_CROSSINGS, TO_OPERATOR, TO_REMOTE
 from haptic_contract.teleop import Scheme, SCHEMES
@@ -72,9 +73,9 @@ def site_parameters(site: SiteConfig) -> dict:
     The recorder, if any, is in the site's process and writes its own bag (``DIR/<role>``).
     """
     merged = node_parameters(site.loop)
-    merged[f'{site.role}_gateway'] = {'ros__parameters': gateway_parameters(
+    merged[f'{site.role}_gateway'] = {'ros__parameters': {**gateway_parameters(
         site.role, listen=site.listen, connect=site.connect, certs=site.certs,
-        insecure=site.insecure, link=site.loop.link)}
+        insecure=site.insecure, link=site.loop.link), **priority_parameters(site.loop)}}
     return merged
 
 
@@ -102,14 +103,18 @@ def loopback_gateway_parameters(folder: pathlib.Path, *, link: Optional[dict] = 
 
 
 def loopback_gateways(run_dir: pathlib.Path, python: str, env: dict, remote_env: dict, *,
-                      link: Optional[dict] = None, routes: Optional[dict] = None) -> list:
-    """Start both sites' gateways on this machine (``loopback_gateway_parameters``)."""
+                      link: Optional[dict] = None, routes: Optional[dict] = None,
+                      priority: Optional[dict] = None) -> list:
+    """Start both sites' gateways on this machine (``loopback_gateway_parameters``).
+
+    ``priority`` (``priority_parameters``) sets their ``thread_priority``, if it holds one.
+    """
     gateways = []
     parameters = loopback_gateway_parameters(run_dir, link=link, routes=routes)
     for role, role_env in (('remote', remote_env), ('operator', env)):
         params = run_dir / f'{role}_gateway.yaml'
         params.write_text(yaml.safe_dump({f'{role}_gateway': {
-            'ros__parameters': parameters[role]}}))
+            'ros__parameters': {**parameters[role], **(priority or {})}}}))
         gateways.append(start_child(f'{role}_gateway', gateway_argv(python, role, params),
                                     role_env))
     return gateways

@@ -68,6 +68,7 @@ from rclpy.task import Future
 
 from haptic_util import intra_process, shared_memory
 from haptic_util.callback_errors import callback_errors, log_callback_error
+from haptic_util.priority import run_realtime, THREAD_PRIORITY
 
 __all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'end_process',
            'request_stop', 'hold_stop_signals', 'STOP_SIGNALS', 'callback_errors', 'StartupError']
@@ -77,6 +78,11 @@ SHUTDOWN_TIMEOUT = 1.0  # [s] for the executor to finish a callback in progress
 TEARDOWN_LIMIT = 20.0  # [s] for nodes to say their last words and be destroyed
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
+REALTIME_REFUSED = (
+    'thread_priority {priority}: real-time scheduling (SCHED_FIFO) is not permitted, so this '
+    'process runs at normal priority, and on a busy machine its 1 kHz loop may miss ticks. Give '
+    'your user an rtprio limit (README, "Real-time priority"), or set thread_priority:=0 to '
+    'run without it and silence this.')
 EXECUTORS = {'events': EventsExecutor, 'single_threaded': SingleThreadedExecutor}
 
 
@@ -208,6 +214,7 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
         _keep_participants(contexts)
         _flags['starting'] = False
         _freeze_what_start_made()
+        _run_realtime(nodes)
         spinner = make_executor(executor, contexts[0] if contexts else None)
         for node in nodes:
             spinner.add_node(node)
@@ -239,6 +246,23 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
         for signum in STOP_SIGNALS:
             signal.signal(signum, signal.SIG_IGN)
     return 0
+
+
+def _run_realtime(nodes: list) -> None:
+    """Run the process at the highest ``thread_priority`` its nodes ask for, or say why not.
+
+    Once they are built: a node may spend seconds compiling its kernels first, which at
+    real-time priority would hold a core from everything else on the machine.
+    """
+    asking = [node for node in nodes if node.has_parameter(THREAD_PRIORITY)]
+    priority = max((node.get_parameter(THREAD_PRIORITY).value for node in asking), default=0)
+    if priority <= 0:
+        return
+    logger = asking[0].get_logger()
+    try:
+        logger.info(f'this process runs at {run_realtime(priority)}')
+    except PermissionError:
+        logger.warn(REALTIME_REFUSED.format(priority=priority))
 
 
 def _keep_participants(contexts: list) -> None:

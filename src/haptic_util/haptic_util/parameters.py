@@ -17,7 +17,7 @@ from rclpy.node import Node
 
 from haptic_util.executor import StartupError
 
-__all__ = ['parameter', 'declare_parameters']
+__all__ = ['parameter', 'declare_parameters', 'RealtimeParams']
 
 T = TypeVar('T')
 
@@ -38,6 +38,20 @@ def parameter(default: Any, description: str, *, unit: str = '', low: Optional[f
     if isinstance(default, (list, tuple)):
         return dataclasses.field(default_factory=lambda: tuple(default), metadata=metadata)
     return dataclasses.field(default=default, metadata=metadata)
+
+
+@dataclasses.dataclass(frozen=True)
+class RealtimeParams:
+    """The parameter of the nodes on the 1 kHz path: their process's real-time priority.
+
+    Its process takes the highest its nodes ask for, once they are built
+    (``haptic_util.priority.run_realtime``).
+    """
+
+    thread_priority: int = parameter(
+        50, "SCHED_FIFO priority of this node's process, as ros2_control's controller manager "
+        "takes for its loop; 0 for the system's normal scheduling. Needs root or an rtprio "
+        'limit; without either, a warning and normal scheduling', low=0, high=99)
 
 
 def declare_parameters(node: Node, cls: Type[T]) -> T:

@@ -3,14 +3,14 @@ from dataclasses import dataclass
 
 from haptic_contract.shared_defaults import DEFAULT_SCENE, DEVICE_DAMPING, FORCE_LIMIT, \
     LOOP_RATE
-from haptic_util.parameters import parameter
+from haptic_util.parameters import parameter, RealtimeParams
 from haptic_wand_driver.simulated import DEVICE_MASS, SERVO_RATE, TORQUE_LIMIT
 
 __all__ = ['WandDriverParams']
 
 
 @dataclass(frozen=True)
-class WandDriverParams:
+class WandDriverParams(RealtimeParams):
     device: str = parameter('simulated', 'device backend: simulated (its hand from the '
                             'simulated_operator package), replay, or one a package names in the '
                             'entry point group haptic_wand_driver.wands')

@@ -2,7 +2,7 @@
 from dataclasses import dataclass
 
 from haptic_contract.teleop import HAND_SPEED, Scheme, SCHEMES
-from haptic_util.parameters import parameter
+from haptic_util.parameters import parameter, RealtimeParams
 from robot_site.force_envelope import EnvelopeConfig
 from robot_site.safety import SafetyConfig
 from teleop_protocol.admission import AdmissionConfig
@@ -39,7 +39,7 @@ class PatientBoundParams:
 
 
 @dataclass(frozen=True)
-class SimulatedRobotParams(PatientBoundParams):
+class SimulatedRobotParams(PatientBoundParams, RealtimeParams):
     rate: float = parameter(1000.0, 'TCP pose and F/T wrench publishing rate', unit='Hz',
                             low=1.0, high=10000.0)
     frame_id: str = parameter('base_link', 'the robot\'s base frame, also the scene\'s frame')
@@ -70,7 +70,7 @@ class SimulatedRobotParams(PatientBoundParams):
 
 
 @dataclass(frozen=True)
-class FollowerParams(PatientBoundParams):
+class FollowerParams(PatientBoundParams, RealtimeParams):
     scheme: str = parameter(Scheme.MODEL.value, 'bilateral scheme', choices=SCHEMES)
     rate: float = parameter(1000.0, 'control rate: a target per tick', unit='Hz', low=1.0,
                             high=10000.0)

@@ -39,7 +39,7 @@ from haptic_contract.graph import absolute, TELEOP_COMMAND, TELEOP_FEEDBACK, TOP
 from haptic_util.callback_errors import log_callback_error
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
-from haptic_util.parameters import declare_parameters, parameter
+from haptic_util.parameters import declare_parameters, parameter, RealtimeParams
 from haptic_util.qos import FRAME_QOS, LINK_QOS
 from haptic_util.transport import loopback_udp
 from link_emulator.link_stage import emulated_link, ReleaseTimer
@@ -83,7 +83,7 @@ TELEOP_TO_OPERATOR = (_route(TELEOP_FEEDBACK),)
 
 
 @dataclass(frozen=True)
-class GatewayParams(LinkStageParams):
+class GatewayParams(LinkStageParams, RealtimeParams):
     """The gateway's parameters (see config/site_gateway.yaml); the link stage is outgoing."""
 
     role: str = parameter('operator', "this site's role, and the common name of its "

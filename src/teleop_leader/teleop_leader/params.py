@@ -3,14 +3,14 @@ from dataclasses import dataclass
 
 from haptic_contract.shared_defaults import FORCE_LIMIT
 from haptic_contract.teleop import Scheme, SCHEMES
-from haptic_util.parameters import parameter
+from haptic_util.parameters import parameter, RealtimeParams
 from teleop_protocol.admission import AdmissionConfig
 
 __all__ = ['LeaderParams']
 
 
 @dataclass(frozen=True)
-class LeaderParams:
+class LeaderParams(RealtimeParams):
     scheme: str = parameter(Scheme.MODEL.value, 'bilateral scheme', choices=SCHEMES)
     force_scale: float = parameter(0.3, 'felt force per patient force', low=1e-3, high=10.0)
     position_scale: float = parameter(1.0, 'robot motion per wand motion', low=1e-3, high=10.0)
