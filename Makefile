@@ -44,7 +44,7 @@ report: $(STAMP)
 
 # Deterministic: Hypothesis's ci profile draws the same examples on every run.
 test: $(DEV_STAMP)
-	CI=$${CI:-1} $(PY) -m pytest -q tests
+	CI=$${CI:-1} $(PY) -m pytest -q --durations=15 tests
 
 # Fresh random examples, ten times as many, for the property tests (no ROS processes).
 fuzz: $(DEV_STAMP)

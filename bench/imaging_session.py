@@ -1,6 +1,7 @@
 """The probe's image in the telerobotic session: what it costs the 1 kHz loops, and how late it is.
 
-    .venv/bin/python bench/imaging_session.py [--pairs 3] [--imager 5 idle ...] [--json PATH]
+    .venv/bin/python bench/imaging_session.py [--pairs 3] [--imager 5 idle ...]
+        [--thread-priority 50 0] [--hogs 1] [--json PATH]
 
 The model-mediated scan over a 50 ms link (5 ms jitter, 1 % loss), as ``make demo`` runs it,
 with the remote site's imager on and off (``LoopConfig.imaging``), alternated in one run (on,
@@ -21,10 +22,14 @@ the session's start, ``wand/session_start``):
 
 The imager is a process of its own beside the remote site's, whose frame thread yields the cores to
 the loops (``haptic_util.priority``): by default at a niceness 5 above theirs, or under
-``SCHED_IDLE``. ``--imager`` names how, one or more (a niceness such as ``5``, or ``idle``): each
-is run beside an imaging-off run in each group of runs, the order turning from one group to the
-next, to weigh the image's lateness against the loops'. The load average is printed with each run:
-the machine is shared, and only the ratios of runs side by side are figures.
+``SCHED_IDLE``. ``--imager`` names how, one or more (a niceness such as ``5``, or ``idle``). The
+loops' own processes run under ``SCHED_FIFO`` at their nodes' ``thread_priority``;
+``--thread-priority`` names the values to run, one or more, 0 for normal scheduling (the
+baseline, as before real-time priority). Each pair of a priority and an imager is run beside an
+imaging-off run at that priority in each group of runs, the order turning from one group to the
+next. ``--hogs N`` keeps N cores busy with other processes for the whole run (a sonographer's
+workstation is never idle). The load average is printed with each run: the machine is shared,
+and only the ratios of runs side by side are figures.
 """
 import argparse
 import os
@@ -33,6 +38,7 @@ import sys
 import tempfile
 
 from bench import machine, result_files, ros_domain
+from bench.teleop_load import loaded
 from bench.teleop_scan import process_cpu
 import numpy as np
 from rosbags.highlevel import AnyReader
@@ -42,7 +48,7 @@ from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import bags, read_frames, read_session_start, read_vectors, reported
 
-__all__ = ['main', 'run', 'summary']
+__all__ = ['label', 'main', 'run', 'summary']
 
 LINK = {'delay': 0.05, 'jitter': 0.005, 'loss': 0.01}  # as the demo's scan
 WINDOW = (3.0, 15.0)  # [s] after the session's start: the press and the sweep
@@ -72,8 +78,11 @@ def imager_parameters(variant: str) -> dict:
     return {'idle': True} if variant == IDLE else {'idle': False, 'niceness': int(variant)}
 
 
-def run(variant: str, domain_id: int) -> dict:
-    """One scan with the imager off (``OFF``) or yielding as ``variant`` says; its figures."""
+def run(variant: str, priority: int, domain_id: int) -> dict:
+    """One scan, its figures: the imager off (``OFF``) or yielding as ``variant`` says.
+
+    The loops run at real-time ``priority`` (0: normal scheduling).
+    """
     imaging = variant != OFF
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
@@ -83,7 +92,7 @@ def run(variant: str, domain_id: int) -> dict:
             overrides['probe_imager'] = imager_parameters(variant)
         config = LoopConfig(teleop='model', link=dict(LINK), record=str(folder / 'bag'),
                             domain_id=domain_id, run_dir=folder / 'launch', imaging=imaging,
-                            overrides=overrides)
+                            overrides=overrides, thread_priority=priority)
         with Loop(config) as loop:
             cpu = process_cpu(loop)
             if loop.wait(60.0) is None:
@@ -95,7 +104,8 @@ def run(variant: str, domain_id: int) -> dict:
         start = read_session_start(bag, typestore)
         ticks = np.diff(_in_window(stamped['/remote/robot/tcp_pose'][0], start))
         loop_stats = np.load(stats)
-        row = {'imaging': imaging, 'variant': variant, 'load': os.getloadavg()[0],
+        row = {'imaging': imaging, 'variant': variant, 'thread_priority': priority,
+               'load': os.getloadavg()[0],
                'operator_rate_hz': float(loop_stats['rate_hz']),
                'operator_answered_percent': float(loop_stats['answered_percent']),
                'operator_round_trip_p99_s': float(loop_stats['latency_p99_s']),
@@ -123,15 +133,25 @@ def _cpu(row: dict) -> float:
     return sum(row['cpu_percent'].values())
 
 
-def summary(rows: list, variant: str) -> dict:
+def label(variant: str, priority: int) -> str:
+    """Name a way of sharing the cores: the loops' scheduling and the imager's."""
+    loops = f'SCHED_FIFO {priority}' if priority else 'normal scheduling'
+    imager = 'SCHED_IDLE' if variant == IDLE else f'niceness +{variant}'
+    return f'loops at {loops}, imager at {imager}'
+
+
+def summary(rows: list, variant: str, priority: int) -> dict:
     """Return the ratios on (as ``variant``) / off of each stream figure, and the CPU imaging adds.
 
-    ``rows`` come in groups, one run off and one with each variant side by side, which share
-    the machine's load more than runs further apart: each ratio is taken within a group, and its
-    median and range over the groups are given.
+    The runs are those with the loops at ``priority``.
+
+    ``rows`` come in groups, one run off and one with each variant side by side at each
+    priority, which share the machine's load more than runs further apart: each ratio is taken
+    within a group, and its median and range over the groups are given.
     """
     groups = sorted({row['group'] for row in rows})
-    pairs = [tuple(next(r for r in rows if r['group'] == group and r['variant'] == v)
+    pairs = [tuple(next(r for r in rows if r['group'] == group and r['variant'] == v
+                        and r['thread_priority'] == priority)
                    for v in (variant, OFF)) for group in groups]
     on, off = [pair[0] for pair in pairs], [pair[1] for pair in pairs]
 
@@ -161,8 +181,9 @@ def _print_row(row: dict) -> None:
              f'{1e3 * row["pose_to_image_p50_s"]:.1f}/{1e3 * row["pose_to_image_p99_s"]:.1f} ms '
              f'(published p99 {1e3 * row["pose_to_publication_p99_s"]:.1f} ms)'
              if row['imaging'] else '')
-    print(f'imaging {row["variant"]:>4}: operator {row["operator_rate_hz"]:.0f}'
-          f' Hz, {row["operator_answered_percent"]:.1f} % answered, round trip p99 '
+    print(f'loops {row["thread_priority"]:>2}, imaging {row["variant"]:>4}: operator '
+          f'{row["operator_rate_hz"]:.0f} Hz, {row["operator_answered_percent"]:.1f} % answered, '
+          f'round trip p99 '
           f'{1e3 * row["operator_round_trip_p99_s"]:.2f} ms; robot {row["robot_rate_hz"]:.0f} '
           f'Hz, tick p99 {1e3 * row["robot_tick_p99_s"]:.2f} ms; commands '
           f'{row["commands_hz"]:.0f}/s, feedback {row["feedback_hz"]:.0f}/s; CPU '
@@ -171,10 +192,10 @@ def _print_row(row: dict) -> None:
           + f'){image}; load {row["load"]:.1f}', flush=True)
 
 
-def _print_summary(variant: str, result: dict) -> None:
+def _print_summary(name: str, result: dict) -> None:
     ratios = [f'{key} {value:.3f} [{low:.3f}-{high:.3f}]' for (key, value), (low, high)
               in zip(result['ratios'].items(), result['ranges'].values())]
-    print(f'imager {variant}, on / off within each group, median [range] (targets: rates and '
+    print(f'{name}, on / off within each group, median [range] (targets: rates and '
           'answered >= 0.99, p99 <= 1.1): ' + ', '.join(ratios))
     print(f'  CPU: {result["cpu_on_percent"]:.0f} % of a core on, '
           f'{result["cpu_off_percent"]:.0f} % off: imaging adds {result["cpu_added_percent"]:.0f}'
@@ -193,6 +214,11 @@ def main(argv=None) -> int:
     parser.add_argument('--imager', nargs='+', default=['5'], metavar='HOW',
                         help="how the imager's frame thread yields: a niceness (0-19; the "
                         "node's default, 5) or idle (SCHED_IDLE); the first is the summary's")
+    parser.add_argument('--thread-priority', nargs='+', type=int, default=[50, 0], metavar='P',
+                        help="the loops' real-time priority, one or more (0: normal scheduling, "
+                        'the baseline); the first is the summary\'s')
+    parser.add_argument('--hogs', type=int, default=0,
+                        help='other processes, each keeping a core busy, for the whole run')
     ros_domain.add_option(parser)
     result_files.add_option(parser)
     args = parser.parse_args(argv)
@@ -200,17 +226,26 @@ def main(argv=None) -> int:
     print(f'machine: {machine.line("ros-jazzy-rclpy")}')
     for variant in args.imager:
         imager_parameters(variant)  # a bad one stops here, not after the first runs
-    rows = []
-    for group in range(args.pairs):
-        variants = [OFF, *args.imager]
-        for variant in variants[group % len(variants):] + variants[:group % len(variants)]:
-            rows.append({**run(variant, args.domain_id), 'group': group})
-            _print_row(rows[-1])
-    results = {variant: summary(rows, variant) for variant in args.imager}
-    for variant, result in results.items():
-        _print_summary(variant, result)
-    result_files.write(args.json, {'rows': rows, 'summary': results[args.imager[0]],
-                                   'variant': args.imager[0], 'variants': results})
+    cases = [(v, p) for p in args.thread_priority for v in (OFF, *args.imager)]
+
+    def runs() -> list:
+        rows = []
+        for group in range(args.pairs):
+            for variant, priority in cases[group % len(cases):] + cases[:group % len(cases)]:
+                rows.append({**run(variant, priority, args.domain_id), 'group': group})
+                _print_row(rows[-1])
+        return rows
+    rows = loaded(runs, args.hogs)
+    results = {label(v, p): summary(rows, v, p) for p in args.thread_priority
+               for v in args.imager}
+    for name, result in results.items():
+        _print_summary(name, result)
+    first = label(args.imager[0], args.thread_priority[0])
+    result_files.write(args.json, {'rows': rows, 'summary': results[first],
+                                   'variant': args.imager[0],
+                                   'thread_priority': args.thread_priority[0],
+                                   'hogs': args.hogs,
+                                   'variants': results})
     return 0
 
 

@@ -193,6 +193,18 @@ def _yielding(variant: str) -> str:
             if variant == 'idle' else f'its frame thread at niceness +{variant}')
 
 
+def _loops(priority: int) -> str:
+    """Say how the loops' processes are scheduled (``haptic_util.priority``)."""
+    return (f'every thread of the loops\' processes under SCHED_FIFO at priority {priority}'
+            if priority else 'the loops\' processes at normal scheduling')
+
+
+def _hogs(count: int) -> str:
+    return (f'with {count} other process{"es" if count > 1 else ""} keeping '
+            f'{"a core" if count == 1 else f"{count} cores"} busy throughout' if count
+            else 'with no other process keeping a core busy')
+
+
 def _met(ratio: float, bound: float, kind: str) -> bool:
     return ratio <= bound if kind == 'p99' else ratio >= bound
 
@@ -208,11 +220,13 @@ def _verdict(ratio: float, low: float, high: float, bound: float, kind: str) -> 
 def cost_section(results: dict) -> str:
     """Return what imaging costs the telerobotic session: ratios on / off, CPU, pose to image."""
     summary, variant = results['summary'], results['variant']
+    priority = results['thread_priority']
     ratios, ranges, targets = summary['ratios'], summary['ranges'], summary['targets']
+    runs = [r for r in results['rows'] if r['thread_priority'] == priority]
     rows = []
     for key, (label, kind) in STREAMS.items():
-        on = np.median([r[key] for r in results['rows'] if r['variant'] == variant])
-        off = np.median([r[key] for r in results['rows'] if not r['imaging']])
+        on = np.median([r[key] for r in runs if r['variant'] == variant])
+        off = np.median([r[key] for r in runs if not r['imaging']])
         scale, unit = (1e3, ' ms') if key.endswith('_s') else (1.0, '')
         bound = targets[kind]
         low, high = ranges[key]
@@ -224,12 +238,13 @@ def cost_section(results: dict) -> str:
     delay = summary['delay_s']
     return '\n'.join([
         markdown_table(['stream', 'imaging off', 'on', 'on / off [range]', 'target'], rows), '',
-        f'{summary["pairs"]} groups of runs, imaging off and on side by side; the figures on and '
+        f'{summary["pairs"]} groups of runs, imaging off and on side by side, '
+        f'{_hogs(results["hogs"])}; the figures on and '
         f'off are medians over the runs, each ratio is taken within a group, its median and '
         f'range over the groups given. The load average was {min(loads):.1f}-{max(loads):.1f} '
         f'(other jobs on the machine): where a ratio\'s range spans its target both ways, the '
         f'runs vary more with that load than with imaging. The imager is a process of its own '
-        f'at the remote site, {_yielding(variant)}. The '
+        f'at the remote site, {_yielding(variant)}; {_loops(priority)}. The '
         f'session\'s processes used {summary["cpu_off_percent"]:.0f} % of a core without '
         f'imaging and {summary["cpu_on_percent"]:.0f} % with it: imaging adds '
         f'{summary["cpu_added_percent"]:.0f} % at {summary["frames_hz"]:.1f} frames a second, '
@@ -242,14 +257,17 @@ def cost_section(results: dict) -> str:
 
 
 def variants_section(results: dict) -> list:
-    """Return how each way of yielding the cores did, beside imaging off in the same groups."""
+    """Return how each way of sharing the cores did, beside imaging off in the same groups.
+
+    Each is named as ``imaging_session.label`` names it.
+    """
     variants = results.get('variants', {})
     if len(variants) < 2:
         return []
     keys = ('operator_rate_hz', 'robot_rate_hz', 'robot_tick_p99_s', 'commands_hz')
-    rows = [[_yielding(name).split(' (')[0],
+    rows = [[name,
              *(f'{v["ratios"][k]:.3f}' for k in keys), f'{v["frames_hz"]:.1f}',
              f'{1e3 * v["pose_to_image_p99_s"]:.0f} ms'] for name, v in variants.items()]
-    return ['', 'Each way of yielding the cores, on / off within the same groups:', '',
-            markdown_table(['imager', *(STREAMS[k][0] for k in keys), 'frames a second',
+    return ['', 'Each way of sharing the cores, on / off within the same groups:', '',
+            markdown_table(['cores', *(STREAMS[k][0] for k in keys), 'frames a second',
                             'pose to image, p99'], rows)]

@@ -3,9 +3,9 @@
 The 1 kHz processes (the loop's nodes, each site's, the gateways) run every thread under
 ``SCHED_FIFO`` (``run_realtime``), as ros2_control's controller manager runs its update loop: no
 thread of an ordinary process, a compiler, a browser, the probe's imager, then delays a tick.
-Beside the imager on a 2-core machine where the two sites took 1.6 of the cores, the loops fell
-to 0.83 of their rate without it and held 1.00 with it (``bench/imaging_session.py``). It needs
-root or an ``rtprio`` limit; without either the process says so once and runs as before.
+Beside the imager, with another process keeping one of two cores busy, the robot's rate fell to
+0.81 of itself without it and held 1.02 with it (``bench/imaging_session.py``). It needs root
+or an ``rtprio`` limit; without either the process says so once and runs as before.
 
 The imager's frame thread yields (``yield_thread``). On two cores the probe's imager
 (milliseconds of compiled work a frame) takes its turns from the 1 kHz loops when the cores are
