@@ -3,19 +3,20 @@
 The 1 kHz processes (the loop's nodes, each site's, the gateways) run every thread under
 ``SCHED_FIFO`` (``run_realtime``), as ros2_control's controller manager runs its update loop: no
 thread of an ordinary process, a compiler, a browser, the probe's imager, then delays a tick.
-Beside the imager, with another process keeping one of two cores busy, the robot's rate fell to
-0.81 of itself without it and held 1.02 with it (``bench/imaging_session.py``). It needs root
-or an ``rtprio`` limit; without either the process says so once and runs as before.
+With another process keeping one of two cores busy, turning the imager on took the robot's rate
+to 0.81 of what it was with the imager off; under ``SCHED_FIFO`` it stayed at 1.02
+(``bench/imaging_session.py``). It needs root or an ``rtprio`` limit; without either the
+process says so once and runs as before.
 
 The imager's frame thread yields (``yield_thread``). On two cores the probe's imager
 (milliseconds of compiled work a frame) takes its turns from the 1 kHz loops when the cores are
-full. A higher niceness gives it a smaller share, but the
-scheduler (EEVDF) still lets it finish its time slice, about 3 ms, before a loop that wakes gets
-the core: a late tick. Under ``SCHED_IDLE`` a waking thread of any other policy preempts it at
-once, and it runs only on what the others leave. Only the thread that computes yields, never
-one that takes or sends messages: a thread starved while it holds a lock of the middleware's
-shared memory would stall every process that writes to it, the robot's among them. Linux keeps
-both per thread; neither needs a privilege.
+full. A higher niceness gives it a smaller share, but the scheduler (EEVDF) still lets it finish
+its time slice, about 3 ms, before a loop that wakes gets the core: a late tick. Under
+``SCHED_IDLE`` a waking thread of any other policy preempts it at once, and it runs only on what
+the others leave. Only the thread that computes yields, never one that takes or sends messages:
+a thread starved while it holds a lock of the middleware's shared memory would stall every
+process that writes to it, the robot's among them. Linux keeps both per thread; neither needs a
+privilege.
 """
 import os
 import threading
