@@ -70,7 +70,7 @@ def udp_socket() -> socket.socket:
 class Echo(Node):
     """The remote end: each ping, from DDS or from UDP, sent straight back the way it came.
 
-    It runs as the loop's nodes do, at their real-time priority (``RealtimeParams``).
+    It runs as the loop's nodes do, at their priority (``RealtimeParams``).
     """
 
     def __init__(self, udp_port: int) -> None:
@@ -183,9 +183,11 @@ class UdpEnd:
 def realtime_end() -> str:
     """Run this process as the loop's nodes run, before its DDS threads start; say how it runs.
 
-    The gateways run real-time: ends at normal priority beside them would measure how long the
-    gateways keep them from a core, not what they add to the path.
+    Beside real-time gateways, ends at normal priority would measure how long the gateways keep
+    them from a core, not what they add to the path.
     """
+    if not RealtimeParams.thread_priority:
+        return 'normal scheduling, as the nodes by default'
     try:
         return run_realtime(RealtimeParams.thread_priority)
     except PermissionError:

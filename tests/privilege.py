@@ -9,16 +9,16 @@ from haptic_util.parameters import RealtimeParams
 __all__ = ['as_real_time_as_the_loop', 'ROOT', 'WITHOUT_REALTIME']
 
 ROOT = os.geteuid() == 0  # CI runs as root
-# A command's prefix that takes the right away, as a user without an rtprio limit has it:
-# no CAP_SYS_NICE (util-linux's setpriv), and an rtprio limit of 0 (prlimit).
-WITHOUT_REALTIME = ('prlimit', '--rtprio=0', 'setpriv', '--bounding-set', '-sys_nice',
-                    '--inh-caps', '-sys_nice')
+# A command's prefix that takes the right away, as a user without an rtprio limit has it: an
+# rtprio limit of 0 (prlimit), and as root no CAP_SYS_NICE either (util-linux's setpriv).
+WITHOUT_REALTIME = ('prlimit', '--rtprio=0', *(
+    ('setpriv', '--bounding-set', '-sys_nice', '--inh-caps', '-sys_nice') if ROOT else ()))
 assert all(shutil.which(tool) for tool in ('prlimit', 'setpriv')), 'util-linux is missing'
 
 
 @contextlib.contextmanager
 def as_real_time_as_the_loop():
-    """Run the calling thread under SCHED_FIFO at the loops' default priority, where it may.
+    """Run the calling thread as the loop's nodes run by default: under SCHED_FIFO, if they do.
 
     A peer that floods the loop is the worst case when it is scheduled as the loop is; at normal
     priority, beside nodes that run real-time, it would not flood at all. Where it may not (nor,
@@ -27,8 +27,9 @@ def as_real_time_as_the_loop():
     thread = threading.get_native_id()
     policy, param = os.sched_getscheduler(thread), os.sched_getparam(thread)
     try:
-        os.sched_setscheduler(thread, os.SCHED_FIFO,
-                              os.sched_param(RealtimeParams.thread_priority))
+        if RealtimeParams.thread_priority:
+            os.sched_setscheduler(thread, os.SCHED_FIFO,
+                                  os.sched_param(RealtimeParams.thread_priority))
     except PermissionError:
         pass
     try:

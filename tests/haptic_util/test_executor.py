@@ -2,6 +2,7 @@
 
 Each test runs a real process, since signals and the executor's spin are what is tested.
 """
+import os
 import signal
 import subprocess
 import sys
@@ -11,8 +12,6 @@ from privilege import ROOT, WITHOUT_REALTIME
 import pytest
 
 from haptic_bringup.launcher import loop_environment
-
-SCHED_OTHER, SCHED_FIFO = 0, 1  # Linux's policy numbers
 
 RAISES_ONCE = """
 import sys
@@ -108,7 +107,7 @@ from haptic_util.parameters import declare_parameters, RealtimeParams
 
 class Loop(Node):  # a 1 kHz node: it asks, by its parameter
     def __init__(self):
-        super().__init__('loop', parameter_overrides=[])
+        super().__init__('loop')
         declare_parameters(self, RealtimeParams)
         self.create_timer(0.01, self.tick)
 
@@ -189,20 +188,21 @@ def test_a_node_whose_callbacks_never_catch_up_still_stops_at_sigint(tmp_path):
 
 
 @pytest.mark.skipif(not ROOT, reason='SCHED_FIFO needs root here (CI runs as root)')
-@pytest.mark.parametrize('priority', [30, 0])
+@pytest.mark.parametrize('priority', [30, 0])  # 0: the default
 def test_a_node_s_thread_priority_puts_its_whole_process_under_sched_fifo(tmp_path, priority):
     process = start(REALTIME, tmp_path, '--ros-args', '-p', f'loop:thread_priority:={priority}')
     out, err = process.communicate(timeout=120)
     assert process.returncode == 0, err
     threads = {tuple(int(v) for v in line.split()) for line in out.splitlines()}
-    assert threads == ({(SCHED_FIFO, priority)} if priority else {(SCHED_OTHER, 0)})
+    assert threads == ({(os.SCHED_FIFO, priority)} if priority else {(os.SCHED_OTHER, 0)})
     assert ('this process runs at SCHED_FIFO' in err) == bool(priority), err
 
 
 def test_a_node_that_may_not_run_real_time_says_why_and_runs_as_before(tmp_path):
-    process = start(REALTIME, tmp_path, prefix=WITHOUT_REALTIME)
+    process = start(REALTIME, tmp_path, '--ros-args', '-p', 'loop:thread_priority:=50',
+                    prefix=WITHOUT_REALTIME)
     out, err = process.communicate(timeout=120)
     assert process.returncode == 0, err
     assert {tuple(int(v) for v in line.split()) for line in out.splitlines()} == {
-        (SCHED_OTHER, 0)}
+        (os.SCHED_OTHER, 0)}
     assert 'thread_priority 50: real-time scheduling (SCHED_FIFO) is not permitted' in err

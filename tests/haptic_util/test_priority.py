@@ -1,5 +1,6 @@
 """Who gets the cores first, read from the kernel: a yielding thread, a real-time process."""
 import errno
+import os
 import subprocess
 import sys
 
@@ -26,7 +27,6 @@ for task in sorted(os.listdir('/proc/self/task')):
         print(task, fields[16], fields[38])  # fields 19 and 41: nice, policy
 stop.set()
 """
-SCHED_OTHER, SCHED_IDLE = 0, 5  # Linux's policy numbers
 
 
 @pytest.mark.parametrize('idle', [False, True])
@@ -40,8 +40,8 @@ def test_the_thread_that_asks_yields_and_the_others_keep_their_priority(idle):
     assert said == f'SCHED_{"IDLE" if idle else "OTHER"}, niceness {niceness}'
     kernel = {task: (int(nice), int(policy))
               for task, nice, policy in (line.split() for line in threads)}
-    assert kernel.pop(worker) == (niceness, SCHED_IDLE if idle else SCHED_OTHER)
-    assert kernel and set(kernel.values()) == {(base, SCHED_OTHER)}  # the main thread's
+    assert kernel.pop(worker) == (niceness, os.SCHED_IDLE if idle else os.SCHED_OTHER)
+    assert kernel and set(kernel.values()) == {(base, os.SCHED_OTHER)}  # the main thread's
 
 
 # In a child, with the right or without it: its threads before, and one it starts after.
@@ -61,7 +61,6 @@ for task in sorted(os.listdir('/proc/self/task')):
     print(task, os.sched_getscheduler(int(task)), os.sched_getparam(int(task)).sched_priority)
 started.set()
 """
-SCHED_FIFO = 1
 
 
 def _run_child(prefix: tuple = ()) -> tuple:
@@ -75,10 +74,10 @@ def _run_child(prefix: tuple = ()) -> tuple:
 def test_every_thread_runs_real_time_and_one_started_after_inherits_it():
     said, policies, count = _run_child()
     assert said == 'SCHED_FIFO, priority 50, 2 threads'
-    assert count == 3 and policies == {(SCHED_FIFO, 50)}
+    assert count == 3 and policies == {(os.SCHED_FIFO, 50)}
 
 
 def test_a_process_that_may_not_is_refused_and_keeps_its_scheduling():
     said, policies, count = _run_child(WITHOUT_REALTIME)
     assert said == f'refused {errno.EPERM}'
-    assert count == 3 and policies == {(SCHED_OTHER, 0)}
+    assert count == 3 and policies == {(os.SCHED_OTHER, 0)}

@@ -97,7 +97,7 @@ class LoopConfig:
     # processes (the baseline the benchmarks compare it with).
     record_in_process: bool = True
     # The 1 kHz processes' real-time priority (every node but the imager, and the gateways);
-    # None: their default (``haptic_util.parameters.RealtimeParams``), 0: normal scheduling.
+    # None: their own (``haptic_util.parameters.RealtimeParams``: 0, normal scheduling).
     thread_priority: Optional[int] = None
 
     @property
@@ -498,8 +498,8 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument('--imaging', action='store_true',
                         help='teleop: the remote site images the probe\'s view (probe/image)')
     parser.add_argument('--thread-priority', type=int, metavar='P',
-                        help='real-time (SCHED_FIFO) priority of the 1 kHz processes, 1-99 '
-                        '(default: the nodes\' own, 50); 0 for normal scheduling')
+                        help='real-time (SCHED_FIFO) priority of the 1 kHz processes, 1-99, '
+                        'for example 50 (default: the nodes\' own, 0: normal scheduling)')
     add_run_arguments(parser, run_dir='build/launch')
     return parser.parse_args(argv)
 

@@ -49,9 +49,9 @@ class RealtimeParams:
     """
 
     thread_priority: int = parameter(
-        50, "SCHED_FIFO priority of this node's process, as ros2_control's controller manager "
-        "takes for its loop; 0 for the system's normal scheduling. Needs root or an rtprio "
-        'limit; without either, a warning and normal scheduling', low=0, high=99)
+        0, "SCHED_FIFO priority (1-99) of this node's process, as ros2_control's controller "
+        "manager takes for its loop (50); 0 for the system's normal scheduling. Needs root or "
+        'an rtprio limit; without either, a warning and normal scheduling', low=0, high=99)
 
 
 def declare_parameters(node: Node, cls: Type[T]) -> T:

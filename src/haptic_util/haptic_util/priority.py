@@ -1,8 +1,10 @@
 """Who gets the cores first: the 1 kHz processes at real-time priority; the imager's work last.
 
-The 1 kHz processes (the loop's nodes, each site's, the gateways) run every thread under
-``SCHED_FIFO`` (``run_realtime``), as ros2_control's controller manager runs its update loop: no
-thread of an ordinary process, a compiler, a browser, the probe's imager, then delays a tick.
+Asked to (``thread_priority``), the 1 kHz processes (the loop's nodes, each site's, the gateways)
+run every thread under ``SCHED_FIFO`` (``run_realtime``), as ros2_control's controller manager
+runs its update loop: no thread of an ordinary process, a compiler, a browser, the probe's
+imager, then delays a tick. It is not the default yet: what then runs at normal priority, the
+imager and the tests' stand-in attackers among them, gets only what the loops leave.
 With another process keeping one of two cores busy, turning the imager on took the robot's rate
 to 0.81 of what it was with the imager off; under ``SCHED_FIFO`` it stayed at 1.02
 (``bench/imaging_session.py``). It needs root or an ``rtprio`` limit; without either the
