@@ -4,10 +4,10 @@ Asked to (``thread_priority``), the 1 kHz processes (the loop's nodes, each site
 run every thread under ``SCHED_FIFO`` (``run_realtime``), as ros2_control's controller manager
 runs its update loop: no thread of an ordinary process, a compiler, a browser, the probe's
 imager, then delays a tick. It is not the default yet: what then runs at normal priority, the
-imager and the tests' stand-in attackers among them, gets only what the loops leave.
-With another process keeping one of two cores busy, turning the imager on took the robot's rate
-to 0.81 of what it was with the imager off; under ``SCHED_FIFO`` it stayed at 1.02
-(``bench/imaging_session.py``). It needs root or an ``rtprio`` limit; without either the
+imager and the tests' stand-in attackers among them, gets only what the loops leave. With
+another process keeping one of two cores busy, turning the imager on took the robot's rate to
+0.81 of what it was with the imager off at normal scheduling; under ``SCHED_FIFO`` it stayed at
+1.02 (``bench/imaging_session.py``). It needs root or an ``rtprio`` limit; without either the
 process says so once and runs as before.
 
 The imager's frame thread yields (``yield_thread``). On two cores the probe's imager
