@@ -23,9 +23,9 @@ the session's start, ``wand/session_start``):
 The imager is a process of its own beside the remote site's, whose frame thread yields the cores to
 the loops (``haptic_util.priority``): by default at a niceness 5 above theirs, or under
 ``SCHED_IDLE``. ``--imager`` names how, one or more (a niceness such as ``5``, or ``idle``). The
-loops' own processes run under ``SCHED_FIFO`` at their nodes' ``thread_priority``;
-``--thread-priority`` names the values to run, one or more, 0 for normal scheduling (the
-baseline, as before real-time priority). Each pair of a priority and an imager is run beside an
+loops' own processes run at each real-time priority ``--thread-priority`` names (``SCHED_FIFO``,
+the nodes' ``thread_priority``), one or more; 0 is normal scheduling, the nodes' default and the
+baseline. Each pair of a priority and an imager is run beside an
 imaging-off run at that priority in each group of runs, the order turning from one group to the
 next. ``--hogs N`` keeps N cores busy with other processes for the whole run (a sonographer's
 workstation is never idle). The load average is printed with each run: the machine is shared,
