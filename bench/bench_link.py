@@ -39,7 +39,6 @@ from haptic_bringup.processes import start_child, stop_children
 from haptic_bringup.site import loopback_gateways
 from haptic_util.executor import run_nodes
 from haptic_util.parameters import declare_parameters, RealtimeParams
-from haptic_util.priority import run_realtime
 from haptic_util.qos import LINK_QOS
 
 PING, PONG = 'bench/ping', 'bench/pong'
@@ -180,20 +179,6 @@ class UdpEnd:
         self.socket.close()
 
 
-def realtime_end() -> str:
-    """Run this process as the loop's nodes run, before its DDS threads start; say how it runs.
-
-    Beside real-time gateways, ends at normal priority would measure how long the gateways keep
-    them from a core, not what they add to the path.
-    """
-    if not RealtimeParams.thread_priority:
-        return 'normal scheduling, as the nodes by default'
-    try:
-        return run_realtime(RealtimeParams.thread_priority)
-    except PermissionError:
-        return 'normal scheduling (real-time scheduling is not permitted here)'
-
-
 def free_udp_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(('127.0.0.1', 0))
@@ -261,7 +246,6 @@ def main(argv=None) -> int:
         gateways = {child.name.split('_')[0]: child for child in loopback_gateways(
             folder, sys.executable, loop_environment(args.domain_id, folder / 'log'),
             loop_environment(args.domain_id + 1, folder / 'log'), routes=routes)}
-        print(f'this end: {realtime_end()}')  # its children started as usual
         pinger = Pinger()
         dds, udp = DdsEnd(args.domain_id, pinger), UdpEnd(udp_port, pinger)
         pids = {f'{role} gateway': child.pid for role, child in gateways.items()}

@@ -8,7 +8,6 @@ import time
 
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 import numpy as np
-from privilege import as_real_time_as_the_loop
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -109,21 +108,19 @@ class LoopClient:
         """Publish ``count`` poses alone (no twist) as fast as this client can; return the rate.
 
         Each pose is serialized once and only its stamp rewritten, so the flood is limited by
-        DDS, not by Python message conversion; and this thread is scheduled as the loop's are
-        (``as_real_time_as_the_loop``). The rate (Hz) is what was actually sent.
+        DDS, not by Python message conversion. The rate (Hz) is what was actually sent.
         """
         pose = PoseStamped()
         pose.header.frame_id = 'world'
         pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = position
         pose.pose.orientation.w = 1.0
         cdr = bytearray(serialize_message(pose))
-        with as_real_time_as_the_loop():
-            start = time.monotonic()
-            for _ in range(count):
-                sec, nanosec = divmod(time.time_ns(), 1_000_000_000)  # ROS time is system time
-                struct.pack_into('<iI', cdr, STAMP_OFFSET, sec, nanosec)
-                self.pose_pub.publish(bytes(cdr))
-            return count / (time.monotonic() - start)
+        start = time.monotonic()
+        for _ in range(count):
+            sec, nanosec = divmod(time.time_ns(), 1_000_000_000)  # ROS time is system time
+            struct.pack_into('<iI', cdr, STAMP_OFFSET, sec, nanosec)
+            self.pose_pub.publish(bytes(cdr))
+        return count / (time.monotonic() - start)
 
     def exchange(self, position, *, timeout: float = ANSWER_TIMEOUT, **kwargs):
         """Send one pose (see ``send``) and wait for the wrench that answers it.
