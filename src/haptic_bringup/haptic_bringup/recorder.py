@@ -17,9 +17,10 @@ reliably); ``/diagnostics``; and a report of its own: messages written and dropp
   What it guarantees: every message that reached it is in the bag, and every one DDS lost on the
   way is counted in its report (``lost: <topic>``, from the gaps DDS sees in each writer's
   sequence). What it cannot: take a best-effort message its process was too starved to take in
-  time; Fast DDS's shared-memory queue of a reader holds 512 messages, under 0.1 s of the loop's
-  streams. A loss after a writer's last message has no later one to show it: the nodes' final
-  reports (what each says it published) are the full account (``haptic_bringup.session``).
+  time. Its shared-memory port holds 8192 messages (``haptic_util.transport``); the writers'
+  side, each process's 512 kB segment, holds about 0.2 s of a stopped recorder's streams. A
+  loss after a writer's last message has no later one to show it: the nodes' final reports
+  (what each says it published) are the full account (``haptic_bringup.session``).
 
 The reports of the recorder's own process are handed over as published
 (``haptic_util.diagnostics.listen``), the last ones too, which are written while the nodes are
@@ -50,6 +51,7 @@ from haptic_util.parameters import declare_parameters
 from haptic_util.qos import FRAME_QOS, LATCHED_QOS, RECORDER_QOS, RELIABLE_RECORDER_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
+from haptic_util.transport import deep_shared_memory
 
 __all__ = ['Recorder', 'BagRecorder', 'main', 'custom_definitions', 'message_class']
 
@@ -263,6 +265,7 @@ def _matching_qos(publishers) -> QoSProfile:
 
 
 def main(args=None) -> int:
+    deep_shared_memory()
     return run_nodes([BagRecorder], args)
 
 

@@ -1,4 +1,6 @@
-"""A relay between sites talks to its site over UDP on 127.0.0.1, never Fast DDS's shared memory.
+"""Fast DDS transports of our own for two kinds of process, on loopback only.
+
+A relay between sites talks to its site over UDP on 127.0.0.1, never Fast DDS's shared memory.
 
 Why: a relay (the site gateway) stands for the network between the sites, and
 it may stop: SIGSTOP in a test, a link down, a process descheduled. Over shared memory, a site
@@ -13,20 +15,34 @@ With ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``, rmw_fastrtps adds a shared-mem
 its own, whatever ``FASTDDS_BUILTIN_TRANSPORTS`` says; so the relay leaves the range to Fast DDS
 and gives its own profile (``config/loopback_udp.xml``): UDP on 127.0.0.1 only, discovery by
 unicast to 127.0.0.1. No packet leaves loopback, as with the LOCALHOST range.
+
+A recorder of its own process (``--separate``) takes the 1 kHz streams over shared memory, with
+a port queue 16 times the default: 8192 messages, 1.4 s of the loop's six streams. Fast DDS
+queues every message for a participant in one port (512 by default, under 0.1 s of those
+streams) until its receiving thread takes it into a reader's history, and drops what a full
+port cannot hold. On a loaded machine that thread was descheduled longer, and the recorder lost
+the same 175 to 240 messages of each stream (a CI run; here with the machine's cores hogged).
 """
 import os
 import pathlib
 
 from ament_index_python.packages import get_package_share_directory
 
-__all__ = ['loopback_udp']
-
-PROFILE = ('haptic_util', 'config/loopback_udp.xml')
+__all__ = ['deep_shared_memory', 'loopback_udp']
 
 
 def loopback_udp() -> None:
     """Make the DDS participants this process makes next UDP peers on 127.0.0.1 only."""
-    package, relative = PROFILE
-    profile = pathlib.Path(get_package_share_directory(package)) / relative
+    _use_profile('loopback_udp.xml')
+
+
+def deep_shared_memory() -> None:
+    """Give the DDS participants this process makes next a shared-memory port 8192 deep."""
+    _use_profile('deep_shared_memory.xml')
+
+
+def _use_profile(name: str) -> None:
+    """Leave the discovery range to Fast DDS, which then takes our profile (``config/name``)."""
+    profile = pathlib.Path(get_package_share_directory('haptic_util')) / 'config' / name
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'SYSTEM_DEFAULT'
     os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(profile)
