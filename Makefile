@@ -42,9 +42,14 @@ demo: $(STAMP)
 report: $(STAMP)
 	$(PY) report_generator/report.py --demo-dir build/demo --out report
 
-# Deterministic: Hypothesis's ci profile draws the same examples on every run.
+# Deterministic: Hypothesis's ci profile draws the same examples on every run. The tests that
+# start no ROS node or process and time nothing share both cores; then the others, one at a
+# time (tests/conftest.py marks them serial).
 test: $(DEV_STAMP)
-	CI=$${CI:-1} $(PY) -m pytest -q --durations=15 tests
+	export CI=$${CI:-1}; \
+	$(PY) -m pytest -q -n 2 -m 'not serial' --durations=10 tests; shared=$$?; \
+	$(PY) -m pytest -q -m serial --durations=15 tests; alone=$$?; \
+	exit $$(( shared || alone ))
 
 # Fresh random examples, ten times as many, for the property tests (no ROS processes).
 fuzz: $(DEV_STAMP)

@@ -10,6 +10,7 @@ fresh random examples, ten times as many (``fuzzing.examples``); ``dev`` is Hypo
 ``HYPOTHESIS_PROFILE`` picks one explicitly.
 """
 import os
+import pathlib
 
 from hypothesis import HealthCheck, settings
 import pytest
@@ -27,6 +28,26 @@ settings.register_profile('fuzz', deadline=None, print_blob=True,
 settings.register_profile('dev', deadline=None)
 settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE')
                       or ('ci' if os.environ.get('CI') else 'dev'))
+
+
+TESTS = pathlib.Path(__file__).resolve().parent
+# Tests that start ROS nodes or processes, or time what they run. ``make test`` runs them one at
+# a time after the others, which share both cores (pytest-xdist): no sibling test takes a core
+# from what they measure.
+SERIAL = ('integration/', 'haptic_util/', 'haptic_wand_driver/', 'robot_site/', 'teleop_leader/',
+          'haptic_bringup/', 'site_gateway/', 'ultrasound_sim/test_imaging_session.py',
+          'collision_engine/test_jit.py')
+
+
+def pytest_configure(config):
+    config.addinivalue_line('markers', 'serial: starts ROS nodes or processes, or times what '
+                            'it runs: run alone (make test runs them after the others)')
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.path.resolve().relative_to(TESTS).as_posix().startswith(SERIAL):
+            item.add_marker(pytest.mark.serial)
 
 
 def pytest_sessionstart(session):
