@@ -31,7 +31,9 @@ from haptic_util.qos import HAPTIC_STREAM_QOS
 
 MAX_PATIENT_FORCE = 20.0  # [N] the follower's and the robot's default
 POSE = MessageCodec(PoseStamped)
-PRESSING = 5.0  # [N] the patient's force once the scan presses: the attacks start then
+PRESSING = 5.0  # [N] the patient's force once the scan presses: the quiet window starts then
+QUIET = 1.0  # [s] pressed and not attacked, just before the attacks
+HELD = 0.375  # of the quiet window's median force: pressed still (a robot let go retracts to 0)
 
 
 class Stranger:
@@ -145,6 +147,9 @@ def attacked(tmp_path_factory):
             assert stranger.heard is not None, 'the operator\'s commands were never heard'
             assert stranger.pressed >= PRESSING, 'the scan never pressed the patient'
             session = stranger.heard[COMMAND.index('session')]
+            quiet = time.time()
+            time.sleep(QUIET)  # pressed, not attacked: what the attacks are compared with
+            windows['quiet'] = (quiet, time.time(), 0)
 
             def attack(name, publisher, make, rate, duration):
                 start = time.time()
@@ -170,8 +175,6 @@ def attacked(tmp_path_factory):
                    1000, 0.5)
             attack('tcp below', stranger.tcp, lambda: stranger.pose('base_link', -0.05),
                    2000, 0.5)
-            windows['quiet'] = (windows['another session'][0] - 2.0,
-                                windows['another session'][0], 0)
         finally:
             stranger.close()
         assert loop.wait(60.0) is not None, 'the scan did not end'
@@ -180,7 +183,10 @@ def attacked(tmp_path_factory):
 
 def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
     """Pressed within the limit through every attack, and never let go through those on the
-    link's content: had one locked the operator out, the robot would have held and retracted.
+    link's content: had one locked the operator out, the robot would have held and retracted
+    to no force. Pressed still means more than ``HELD`` of the force of the quiet second just
+    before the attacks (3 N of the scan's 8 N): on a slow or loaded machine the scan presses
+    less (a CI run pressed 3.4 N as the attacks began, 2.9 N as they ended, and failed 3 N).
 
     A 20 kHz flood costs the remote site's one Python process about half a core to refuse,
     stranger by stranger: on a loaded machine it may fall behind the operator's commands, and
@@ -195,9 +201,11 @@ def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
     times, patient = series['/remote/robot/ft_sensor/wrench']
     force = np.linalg.norm(patient, axis=1)
     assert force.max() <= MAX_PATIENT_FORCE
+    pressed = np.median(force[window(times, *windows['quiet'][:2])])
+    assert pressed > 3.0
     for name, (start, end, _) in windows.items():
         if name not in ('quiet', 'flood', 'after the flood', 'deep target', 'tcp below'):
-            assert force[(times >= start) & (times < end)].min() > 3.0, name
+            assert force[(times >= start) & (times < end)].min() > HELD * pressed, name
     _, end, _ = windows['after the flood']
     felt_times, felt = series['/wand/applied_wrench']
     felt_after = np.median(np.linalg.norm(felt[window(felt_times, end - 0.5, end)], axis=1))
@@ -210,7 +218,9 @@ def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
 def test_the_operator_s_site_keeps_its_rate_through_every_attack(attacked):
     """The attacks reach the remote site only: the operator's site goes on at its rate (a forged
     echo once took it from 954 Hz to 0 for the rest of the run). Through the attacks on the
-    link's content it keeps 80 % of its rate before them, and in no attack does it stop. The
+    link's content it keeps 80 % of its rate in the quiet second before them, pressed as in
+    them (a slow machine's loop runs slower in contact: with a core busy, 560-620 Hz pressed
+    against 700-830 Hz in the approach, before any attack), and in no attack does it stop. The
     stranger's flood takes one of this machine's two cores: during it, the operator's site may
     get less of the machine, which is not what is tested here."""
     _, series, windows = attacked
