@@ -37,6 +37,8 @@ TESTS = pathlib.Path(__file__).resolve().parent
 SERIAL = ('integration/', 'haptic_util/', 'haptic_wand_driver/', 'robot_site/', 'teleop_leader/',
           'haptic_bringup/', 'site_gateway/', 'ultrasound_sim/test_imaging_session.py',
           'collision_engine/test_jit.py')
+# Of those folders, what times nothing: a build, and processes refused at start.
+SHARED = ('integration/test_colcon_build.py', 'integration/test_bad_configuration.py')
 
 
 def pytest_configure(config):
@@ -46,7 +48,8 @@ def pytest_configure(config):
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        if item.path.resolve().relative_to(TESTS).as_posix().startswith(SERIAL):
+        relative = item.path.resolve().relative_to(TESTS).as_posix()
+        if relative.startswith(SERIAL) and not relative.startswith(SHARED):
             item.add_marker(pytest.mark.serial)
 
 
