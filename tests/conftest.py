@@ -1,4 +1,4 @@
-"""Shared test set-up: domains, Hypothesis profiles, and no shared memory left behind.
+"""Shared test set-up: domains, Hypothesis profiles, serial tests, no shared memory left behind.
 
 The tests' helpers here (``domains``, ``fuzzing``, ``load``) import by name: pytest puts this
 file's folder on the path as it loads it (its default import mode). The ground truth, the
