@@ -21,7 +21,9 @@ import pytest
 from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_wand_driver.params import WandDriverParams
 
-TRIALS = 20  # per kind of fault, alternating between the collision and the force node
+# Per kind of fault, alternating between the collision and the force node. A kill costs a
+# restart, about 5 s here (imports, the scene); 20 of them took a CI run's 30 minutes too close.
+TRIALS = {'SIGKILL': 10, 'SIGSTOP 100 ms': 20}
 FAULTY = ('collision_engine', 'force_renderer')
 TIME_TO_ZERO = 0.010  # [s] the issue's bound
 PAUSE = 0.100  # [s] SIGSTOP length
@@ -92,11 +94,11 @@ def wait_for_steady_contact(client: LoopClient, timeout: float = 10.0) -> None:
     raise TimeoutError('the wand did not settle into contact')
 
 
-def fault_trials(loop, client, fault) -> list:
-    """Run TRIALS faults; per trial, the node, the clock just before and just after the signal,
+def fault_trials(loop, client, fault, count: int) -> list:
+    """Run ``count`` faults; per trial, the node, the clock just before and just after the signal,
     when the node was back (restarted or resumed), and how long the loop took to recover [s]."""
     trials = []
-    for trial in range(TRIALS):
+    for trial in range(count):
         wait_for_steady_contact(client)
         name = FAULTY[trial % 2]
         before_ns, after_ns, resumed_ns = fault(loop, name)
@@ -222,8 +224,8 @@ def seen_from_outside(applied: list, faults) -> np.ndarray:
 
 def test_faults_mid_contact_zero_the_force_within_10_ms_and_the_loop_recovers(pressing_loop):
     loop, client, stats = pressing_loop
-    kills = fault_trials(loop, client, kill_and_restart)
-    pauses = fault_trials(loop, client, pause_and_resume)
+    kills = fault_trials(loop, client, kill_and_restart, TRIALS['SIGKILL'])
+    pauses = fault_trials(loop, client, pause_and_resume, TRIALS['SIGSTOP 100 ms'])
     others = {c.name: c.pid for c in loop.children if c.name not in FAULTY}
     assert all(loop.child(name).returncode is None for name in others), 'a bystander died'
     loop.stop()  # the driver writes its record on a clean stop
@@ -248,4 +250,4 @@ def test_faults_mid_contact_zero_the_force_within_10_ms_and_the_loop_recovers(pr
               f'restarted again to rejoin: {len(REJOINS)}')
         assert delays.max() <= TIME_TO_ZERO, f'{label}: {delays}'
         assert outside[:, 0].max() <= TIME_TO_ZERO, f'{label}, outside: {outside}'
-        assert len(trials) >= TRIALS
+        assert len(trials) == TRIALS[label]
