@@ -205,7 +205,7 @@ def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
     assert pressed > 3.0
     for name, (start, end, _) in windows.items():
         if name not in ('quiet', 'flood', 'after the flood', 'deep target', 'tcp below'):
-            assert force[(times >= start) & (times < end)].min() > HELD * pressed, name
+            assert force[window(times, start, end)].min() > HELD * pressed, name
     _, end, _ = windows['after the flood']
     felt_times, felt = series['/wand/applied_wrench']
     felt_after = np.median(np.linalg.norm(felt[window(felt_times, end - 0.5, end)], axis=1))
