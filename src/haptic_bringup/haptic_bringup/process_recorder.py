@@ -9,18 +9,19 @@ bag's bounded queue, and the bag's own thread encodes and writes them
 a whole queue behind, what is dropped is counted in the recorder's report rather than lost
 unseen. A stream that reaches the process over DDS (what crossed the link, at a telerobotic
 site) is taken by the one reader that feeds the node using it: the bag holds exactly what that
-node received. The process's reports, the last ones included, are handed over as published.
-(In a process whose streams go through DDS, ``--no-intra-process``, a benchmark's baseline, it
-takes them over DDS as its nodes do.)
+node received, read as the node reads it (the robot's commands: ``link_subscription``). The
+process's reports, the last ones included, are handed over as published. (In a process whose
+streams go through DDS, ``--no-intra-process``, a benchmark's baseline, it takes them over DDS
+as its nodes do.)
 
 The process builds this node last (``haptic_bringup.composed``), so it is destroyed last, after
 every other node has said its last words. Each telerobotic site runs one and writes its own bag
 (``operator``, ``remote``: see ``haptic_bringup.session``).
 """
 from haptic_bringup.recorder import message_class, Recorder
-from haptic_contract.graph import STREAMS, TOPIC_TYPES
+from haptic_contract.graph import absolute, STREAMS, TELEOP_COMMAND, TOPIC_TYPES
 from haptic_util.cdr import MessageCodec
-from haptic_util.intra_process import stream_subscription
+from haptic_util.intra_process import link_subscription, stream_subscription
 
 __all__ = ['ProcessRecorder']
 
@@ -37,5 +38,6 @@ class ProcessRecorder(Recorder):
             return
         codec = MessageCodec(message_class(TOPIC_TYPES[topic]))
         self.bag.add_topic(name, TOPIC_TYPES[topic], encode=codec.encode)
-        stream_subscription(self, codec, topic, lambda values: self.put(name, values),
-                            refused=self.refused)
+        subscribe = link_subscription if topic == absolute(TELEOP_COMMAND) else \
+            stream_subscription
+        subscribe(self, codec, topic, lambda values: self.put(name, values), refused=self.refused)

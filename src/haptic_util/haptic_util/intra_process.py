@@ -21,6 +21,8 @@ process's executor is single-threaded (``executor.EXECUTORS``), so the queue tak
 
 Without ``enable`` (one node per process), a stream is CDR over DDS, parsed and serialized by
 its codec, and a publisher skips the write while nobody reads it. Streams use the haptic QoS.
+A topic that comes from the network (the link's) may be read at a bounded rate instead
+(``max_rate``, ``haptic_util.polled_reader``), so that a flood on it is shed by DDS.
 
 A publisher learns its DDS readers from the matched events its node's executor delivers, not
 by asking DDS on every message (about 1.3 µs a call, six streams a tick): like any ROS 2
@@ -35,16 +37,18 @@ from rclpy.qos import QoSProfile
 
 from haptic_util.callback_errors import log_callback_error
 from haptic_util.cdr import MalformedMessage, MessageCodec
-from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.polled_reader import PolledReader
+from haptic_util.qos import HAPTIC_STREAM_QOS, LINK_INTAKE_RATE, LINK_QOS
 from haptic_util.tally import Tally
 
-__all__ = ['close', 'enable', 'stream_publisher', 'stream_subscription',
+__all__ = ['close', 'enable', 'link_subscription', 'stream_publisher', 'stream_subscription',
            'StreamPublisher', 'StreamSubscription']
 
 _state = {'enabled': False}
 _topics: dict = {}  # resolved topic -> _Topic, while enabled
 _pending: deque = deque()  # (subscription, leaf values) to deliver, in publishing order
 _draining = [False]
+_polled: list = []  # every PolledReader made, destroyed by ``close``
 
 
 def enable() -> None:
@@ -58,6 +62,8 @@ def close() -> None:
         record.subscriptions.clear()  # the publishers hold these lists
     _topics.clear()
     _pending.clear()
+    while _polled:
+        _polled.pop().destroy()
     _state['enabled'] = False
 
 
@@ -71,16 +77,15 @@ class _Topic:
         self.reader = None  # (node, subscription) taking it over DDS while nobody here publishes
 
     def take_over_dds(self, node: Node, codec: MessageCodec, topic: str, *, refused: Tally,
-                      qos: QoSProfile) -> None:
+                      qos: QoSProfile, max_rate: float | None) -> None:
         """Take the topic over DDS for every subscription of the process, unless it does.
 
-        The first subscription's node reads it, with that subscription's QoS, and counts what
-        is malformed in its ``refused``.
+        The first subscription's node reads it, with that subscription's QoS and rate, and
+        counts what is malformed in its ``refused``.
         """
         if self.reader is None and not self.publishers:
-            self.reader = (node, node.create_subscription(
-                codec.message_class, topic, _decoding(codec, topic, refused, self.deliver), qos,
-                raw=True))
+            self.reader = (node, _dds_reader(node, codec, topic, self.deliver, refused=refused,
+                                             qos=qos, max_rate=max_rate))
 
     def deliver(self, values: Sequence) -> None:
         _pending.extend((subscription, values) for subscription in self.subscriptions)
@@ -89,8 +94,12 @@ class _Topic:
     def served_locally(self) -> None:
         """Stop taking the topic over DDS: a node of this process publishes it."""
         if self.reader is not None:
-            node, subscription = self.reader
-            node.destroy_subscription(subscription)
+            node, reader = self.reader
+            if isinstance(reader, PolledReader):
+                _polled.remove(reader)
+                reader.destroy()
+            else:
+                node.destroy_subscription(reader)
             self.reader = None
 
     def dds_publisher_count(self) -> int:
@@ -159,23 +168,35 @@ class StreamSubscription:
 
     def __init__(self, node: Node, codec: MessageCodec, topic: str,
                  callback: Callable[[Sequence], None], *, refused: Tally,
-                 qos: QoSProfile = HAPTIC_STREAM_QOS) -> None:
+                 qos: QoSProfile = HAPTIC_STREAM_QOS, max_rate: float | None = None) -> None:
         self.callback = callback
         self._topic = _topic(node, codec.message_class, topic)
         self._dds = None  # its own DDS reader, while intra-process delivery is off
         if self._topic is not None:
             self._topic.subscriptions.append(self)
-            self._topic.take_over_dds(node, codec, topic, refused=refused, qos=qos)
+            self._topic.take_over_dds(node, codec, topic, refused=refused, qos=qos,
+                                      max_rate=max_rate)
         else:
-            self._dds = node.create_subscription(
-                codec.message_class, topic, _decoding(codec, topic, refused, callback), qos,
-                raw=True)
+            self._dds = _dds_reader(node, codec, topic, callback, refused=refused, qos=qos,
+                                    max_rate=max_rate)
 
     def get_publisher_count(self) -> int:
         """Return how many publishers match: of this process, and over DDS."""
         if self._topic is None:
             return self._dds.get_publisher_count()
         return len(self._topic.publishers) + self._topic.dds_publisher_count()
+
+
+def _dds_reader(node: Node, codec: MessageCodec, topic: str,
+                deliver: Callable[[Sequence], None], *, refused: Tally, qos: QoSProfile,
+                max_rate: float | None):
+    """Return a DDS reader of ``topic`` for ``node``: taken by its executor, or polled."""
+    take = _decoding(codec, topic, refused, deliver)
+    if max_rate is None:
+        return node.create_subscription(codec.message_class, topic, take, qos, raw=True)
+    reader = PolledReader(node, codec.message_class, topic, take, qos, max_rate)
+    _polled.append(reader)
+    return reader
 
 
 def _decoding(codec: MessageCodec, topic: str, refused: Tally,
@@ -216,11 +237,28 @@ def stream_publisher(node: Node, codec: MessageCodec, topic: str) -> StreamPubli
 
 def stream_subscription(node: Node, codec: MessageCodec, topic: str,
                         callback: Callable[[Sequence], None], *, refused: Tally,
-                        qos: QoSProfile = HAPTIC_STREAM_QOS) -> StreamSubscription:
+                        qos: QoSProfile = HAPTIC_STREAM_QOS,
+                        max_rate: float | None = None) -> StreamSubscription:
     """Return a subscription of a 1 kHz stream: ``callback`` gets each message's leaf values.
 
     Malformed messages are counted in the node's ``refused`` tally, which its report logs.
     ``qos`` must match the publishers' (the haptic streams'); a deeper history is the one
-    choice left to the reader.
+    choice left to the reader. With ``max_rate`` (Hz), what comes over DDS is taken at most
+    that fast (``haptic_util.polled_reader``): for what any network peer may publish.
     """
-    return StreamSubscription(node, codec, topic, callback, refused=refused, qos=qos)
+    return StreamSubscription(node, codec, topic, callback, refused=refused, qos=qos,
+                              max_rate=max_rate)
+
+
+def link_subscription(node: Node, codec: MessageCodec, topic: str,
+                      callback: Callable[[Sequence], None], *,
+                      refused: Tally) -> StreamSubscription:
+    """Return a subscription of a stream that comes over the link to the robot's site.
+
+    Anything on the site's network may publish it too: it is read with the link's history, at
+    most ``LINK_INTAKE_RATE`` messages a second from all publishers together, so that a flood
+    leaves the robot its rate. (The operator's site takes its 100 Hz feedback as it comes: a
+    timer polling it at 1 kHz would cost more than it reads.)
+    """
+    return stream_subscription(node, codec, topic, callback, refused=refused, qos=LINK_QOS,
+                               max_rate=LINK_INTAKE_RATE)

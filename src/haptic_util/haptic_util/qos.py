@@ -8,7 +8,8 @@ transient-local, so that a late subscriber, such as a recorder or RViz, still re
 """
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-__all__ = ['FRAME_QOS', 'HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_QOS', 'NEWEST_STREAM_QOS',
+__all__ = ['FRAME_QOS', 'HAPTIC_STREAM_QOS', 'LATCHED_QOS', 'LINK_INTAKE_RATE', 'LINK_QOS',
+           'NEWEST_STREAM_QOS',
            'RECORDER_QOS', 'RELIABLE_RECORDER_QOS', 'MARKER_QOS']
 
 STREAM_DEPTH = 10
@@ -39,6 +40,10 @@ NEWEST_STREAM_QOS = _best_effort(1)
 # 20 kHz flood, and 100 ms of the link's own 1 kHz. Not deeper: a gateway reading the commands
 # 1000 deep stopped taking them a few seconds into an attacked session (cause not found).
 LINK_QOS = _best_effort(100)
+# [Hz] what the robot's site takes of the commands at most, from every publisher together: 4 x
+# their 1 kHz, so that a burst from a jittered link is taken within a few ticks, while a
+# flood is shed by the reader's history, in DDS (haptic_util.polled_reader).
+LINK_INTAKE_RATE = 4000.0
 
 # A recorder must not lose samples while it writes: same policy, a deep history.
 RECORDER_QOS = _best_effort(2000)

@@ -11,6 +11,7 @@ It follows only once the robot has said what it is (``robot/impedance``, latched
 bound holds only for the robot's own stiffness, so a robot whose stiffness is not this node's
 ``robot_stiffness`` is not commanded at all (an error says so), and commands are checked against
 its workspace. Every refused command is counted and logged once a second with its reason.
+Commands are taken at most ``LINK_INTAKE_RATE`` a second, whoever sends them.
 """
 import math
 from typing import Sequence
@@ -30,10 +31,11 @@ from haptic_contract.teleop_fields import (COMMAND, command_from_fields, command
 from haptic_msgs.msg import RobotImpedance
 from haptic_util.diagnostics import Diagnostics, ERROR, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
-from haptic_util.intra_process import stream_publisher, stream_subscription
+from haptic_util.intra_process import (link_subscription, stream_publisher,
+                                       stream_subscription)
 from haptic_util.parameters import declare_parameters
 from haptic_util.paths import resolve_path
-from haptic_util.qos import LATCHED_QOS, LINK_QOS
+from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from robot_site.assembly import admission_config, follower, follower_config, follower_safety
@@ -74,8 +76,7 @@ class FollowerNode(Node):
         self._sent = 0
         self._target_pub = stream_publisher(self, POSE, ROBOT_TARGET_POSE)
         self._feedback_pub = stream_publisher(self, FEEDBACK, TELEOP_FEEDBACK)
-        stream_subscription(self, COMMAND, TELEOP_COMMAND, self.on_command,
-                            refused=self._refused, qos=LINK_QOS)
+        link_subscription(self, COMMAND, TELEOP_COMMAND, self.on_command, refused=self._refused)
         for codec, topic, callback in ((POSE, ROBOT_TCP_POSE, self.on_tcp),
                                        (WRENCH, ROBOT_FT_WRENCH, self.on_wrench)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
