@@ -31,9 +31,26 @@ from haptic_util.qos import HAPTIC_STREAM_QOS
 
 MAX_PATIENT_FORCE = 20.0  # [N] the follower's and the robot's default
 POSE = MessageCodec(PoseStamped)
-PRESSING = 5.0  # [N] the patient's force once the scan presses: the quiet window starts then
-QUIET = 1.0  # [s] pressed and not attacked, just before the attacks
-HELD = 0.375  # of the quiet window's median force: pressed still (a robot let go retracts to 0)
+PRESSING = 4.0  # [N] the patient's force once the scan presses (8 N, less on a loaded machine)
+# The attacks on the link's content, each after a quiet window: alternated, so that the scan's
+# own changes (deeper, then sweeping) fall in both.
+CONTENT = ('another session', 'ahead', 'numbered far ahead', 'absurd speed', 'malformed')
+QUIET = 0.5  # [s] pressed and not attacked, just before each attack on the content
+# Both sites' 1 kHz processes and their gateways run real-time, as README asks of a session
+# on a shared machine: the stranger, at normal scheduling, does not outrank them (CI runs as
+# root). At normal scheduling, on 2 cores, the link stalled 0.1-0.25 s now and then, attacked
+# or not, and each stall held the robot back and cost the scan force for good.
+SESSION_PRIORITY = 50
+HELD = 0.375  # of the quiet windows' median force: pressed still (a robot let go retracts to 0)
+
+
+def quiet_windows(windows: dict) -> list:
+    return [name for name in windows if name.startswith('quiet before')]
+
+
+def during(times: np.ndarray, windows: dict, names) -> np.ndarray:
+    """Which of ``times`` fall in any of the named windows."""
+    return np.any([window(times, *windows[name][:2]) for name in names], axis=0)
 
 
 class Stranger:
@@ -132,7 +149,8 @@ def attacked(tmp_path_factory):
     config = LoopConfig(teleop='model', duration=SCAN_DURATION, record=str(folder / 'bag'),
                         domain_id=session_domain_id(),
                         remote_domain=session_domain_id(second=True), run_dir=folder / 'launch',
-                        intra_process=False, link={'delay': DELAY, 'jitter': 0.1 * DELAY})
+                        intra_process=False, link={'delay': DELAY, 'jitter': 0.1 * DELAY},
+                        thread_priority=SESSION_PRIORITY)
     windows = {}
     with Loop(config) as loop:
         # From the session's start: a fresh clone's first session compiles its kernels first.
@@ -147,11 +165,12 @@ def attacked(tmp_path_factory):
             assert stranger.heard is not None, 'the operator\'s commands were never heard'
             assert stranger.pressed >= PRESSING, 'the scan never pressed the patient'
             session = stranger.heard[COMMAND.index('session')]
-            quiet = time.time()
-            time.sleep(QUIET)  # pressed, not attacked: what the attacks are compared with
-            windows['quiet'] = (quiet, time.time(), 0)
 
             def attack(name, publisher, make, rate, duration):
+                if name in CONTENT:  # pressed, not attacked: what the attack is compared with
+                    quiet = time.time()
+                    time.sleep(QUIET)
+                    windows[f'quiet before {name}'] = (quiet, time.time(), 0)
                 start = time.time()
                 sent = stranger.repeat(publisher, make, rate, duration)
                 windows[name] = (start, time.time(), sent)
@@ -184,9 +203,13 @@ def attacked(tmp_path_factory):
 def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
     """Pressed within the limit through every attack, and never let go through those on the
     link's content: had one locked the operator out, the robot would have held and retracted
-    to no force. Pressed still means more than ``HELD`` of the force of the quiet second just
-    before the attacks (3 N of the scan's 8 N): on a slow or loaded machine the scan presses
-    less (a CI run pressed 3.4 N as the attacks began, 2.9 N as they ended, and failed 3 N).
+    to no force. Pressed still means a median force in each of those attacks, and in the quiet
+    windows between them, of more than ``HELD`` of the quiet windows' median (3 N of the scan's
+    8 N): on a slow or loaded machine the scan presses less (a CI run pressed 3.4 N as the
+    attacks began, 2.9 N as they ended, and failed 3 N). A median, not the least: should the
+    link stall for 0.1 s, attacked or not, the robot holds and retracts for a moment, as it
+    must. A lockout holds it at no force for good: the next window's median shows that, and
+    after the last attack on the content, the flood and the check after it do.
 
     A 20 kHz flood costs the remote site's one Python process about half a core to refuse,
     stranger by stranger: on a loaded machine it may fall behind the operator's commands, and
@@ -201,11 +224,10 @@ def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
     times, patient = series['/remote/robot/ft_sensor/wrench']
     force = np.linalg.norm(patient, axis=1)
     assert force.max() <= MAX_PATIENT_FORCE
-    pressed = np.median(force[window(times, *windows['quiet'][:2])])
+    pressed = np.median(force[during(times, windows, quiet_windows(windows))])
     assert pressed > 3.0
-    for name, (start, end, _) in windows.items():
-        if name not in ('quiet', 'flood', 'after the flood', 'deep target', 'tcp below'):
-            assert force[window(times, start, end)].min() > HELD * pressed, name
+    for name in (*CONTENT, *quiet_windows(windows)):
+        assert np.median(force[during(times, windows, [name])]) > HELD * pressed, name
     _, end, _ = windows['after the flood']
     felt_times, felt = series['/wand/applied_wrench']
     felt_after = np.median(np.linalg.norm(felt[window(felt_times, end - 0.5, end)], axis=1))
@@ -218,22 +240,49 @@ def test_the_patient_is_never_pressed_past_the_limit_nor_let_go(attacked):
 def test_the_operator_s_site_keeps_its_rate_through_every_attack(attacked):
     """The attacks reach the remote site only: the operator's site goes on at its rate (a forged
     echo once took it from 954 Hz to 0 for the rest of the run). Through the attacks on the
-    link's content it keeps 80 % of its rate in the quiet second before them, pressed as in
-    them (a slow machine's loop runs slower in contact: with a core busy, 560-620 Hz pressed
-    against 700-830 Hz in the approach, before any attack), and in no attack does it stop. The
-    stranger's flood takes one of this machine's two cores: during it, the operator's site may
-    get less of the machine, which is not what is tested here."""
+    link's content it keeps 80 % of its rate in the quiet windows between them, pressed as in
+    them: a slow machine's loop runs slower in contact (with a core busy, 560-620 Hz pressed
+    against 700-830 Hz in the approach), and its rate wanders as the scan presses deeper and
+    sweeps (here 460-950 Hz in half-second windows), which alternation shares between both. A
+    CI run compared the attacks with the second before them all, and they got 0.72 of it. In
+    no attack does the site stop. The stranger's flood takes one of this machine's two cores:
+    during it, the operator's site may get less of the machine, which is not what is tested
+    here."""
     _, series, windows = attacked
     poses = series['/wand/pose'][0]
 
+    def rate(names):
+        spans = [windows[name][:2] for name in names]
+        return (np.count_nonzero(during(poses, windows, names))
+                / sum(end - start for start, end in spans))
+    quiet, under_attack = rate(quiet_windows(windows)), rate(CONTENT)
+    print(f'\nthe operator\'s site: {under_attack:.0f} Hz through the attacks on the content, '
+          f'{quiet:.0f} Hz in the quiet windows between them; by window, '
+          + ', '.join(f'{name} {rate([name]):.0f}' for name in windows))
+    assert under_attack >= 0.8 * quiet
+    for name in windows:
+        assert rate([name]) >= 0.25 * quiet, name
+
+
+def test_the_robot_s_site_keeps_its_rate_through_the_flood(attacked):
+    """The flood is shed by the follower's reader, in DDS, not queued in the site's process: the
+    robot's own streams go on. At normal scheduling, when the follower took every message as
+    its executor delivered it, one Python callback each, the robot's site published 1 message
+    in the flood's second and none for 1.3 s after it (here, 3 runs; taken at a bounded rate,
+    it kept 522-967 Hz). Real-time, as here, that baseline kept 681 and 933 Hz (2 runs) and the
+    bounded reader 847-916 Hz (3): the bound matters most where the site is not real-time."""
+    _, series, windows = attacked
+    tcp = series['/remote/robot/tcp_pose'][0]
+
     def rate(start, end):
-        return np.count_nonzero((poses >= start) & (poses < end)) / (end - start)
-    quiet = rate(*windows['quiet'][:2])
-    content = [windows[name][:2] for name in
-               ('another session', 'ahead', 'numbered far ahead', 'absurd speed', 'malformed')]
-    assert rate(content[0][0], content[-1][1]) >= 0.8 * quiet
-    for name, (start, end, _) in windows.items():
-        assert rate(start, end) >= 0.25 * quiet, name
+        return np.count_nonzero((tcp >= start) & (tcp < end)) / (end - start)
+    quiet = np.mean([rate(*windows[name][:2]) for name in quiet_windows(windows)])
+    start, end, _ = windows['flood']
+    flood, after = rate(start, end), rate(end, end + 0.5)
+    print(f'\nthe robot\'s site: {flood:.0f} Hz through the flood, {after:.0f} Hz in the half '
+          f'second after it, {quiet:.0f} Hz in the quiet windows')
+    assert flood >= 0.5 * quiet
+    assert after >= 0.5 * quiet
 
 
 def test_each_attack_is_refused_and_named_by_the_follower(attacked):
