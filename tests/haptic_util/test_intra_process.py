@@ -27,14 +27,6 @@ MATCH_TIMEOUT = 10.0  # [s] for DDS discovery between two participants
 
 
 @pytest.fixture
-def context():
-    context = Context()
-    rclpy.init(context=context, domain_id=session_domain_id())
-    yield context
-    rclpy.try_shutdown(context=context)
-
-
-@pytest.fixture
 def bus():
     intra_process.enable()
     yield

@@ -1,11 +1,8 @@
 """A topic read at a bounded rate: what a tick takes, in order, and what DDS sheds."""
 import time
 
-from domains import session_domain_id
 from geometry_msgs.msg import PoseStamped
 import pytest
-import rclpy
-from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
@@ -18,14 +15,6 @@ POSE = MessageCodec(PoseStamped)
 QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=20,
                  reliability=ReliabilityPolicy.RELIABLE)
 MATCH_TIMEOUT = 10.0  # [s]
-
-
-@pytest.fixture
-def context():
-    context = Context()
-    rclpy.init(context=context, domain_id=session_domain_id())
-    yield context
-    rclpy.try_shutdown(context=context)
 
 
 def pose(k: int) -> tuple:
