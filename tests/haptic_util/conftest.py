@@ -7,7 +7,7 @@ from rclpy.context import Context
 
 @pytest.fixture
 def context():
-    """An rclpy context of its own, on the session's domain, shut down after the test."""
+    """Yield an rclpy context of its own, on the session's domain; shut it down after."""
     context = Context()
     rclpy.init(context=context, domain_id=session_domain_id())
     yield context
