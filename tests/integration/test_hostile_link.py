@@ -174,9 +174,8 @@ def attacked(tmp_path_factory):
     windows = {}
     # The stranger is on the network before the sites start, as one would be. One that joined
     # mid-session stalled the real-time sites for 0.2-0.34 s as the patient was first pressed,
-    # and the scan never pressed 4 N (a CI run). Likely (README, real-time priority): their
-    # writers, opening the newcomer's shared-memory port, wait for its listener to answer (Fast
-    # DDS's port health check), and one at normal scheduling beside them answers late.
+    # and the scan never pressed 4 N (a CI run). The cause is not found (README, real-time
+    # priority).
     stranger = Stranger(config.remote_domain_id)
     try:
         with Loop(config) as loop:
