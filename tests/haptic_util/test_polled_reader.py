@@ -1,8 +1,11 @@
 """A topic read at a bounded rate: what a tick takes, in order, and what DDS sheds."""
 import time
 
+from domains import session_domain_id
 from geometry_msgs.msg import PoseStamped
 import pytest
+import rclpy
+from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
@@ -52,6 +55,23 @@ def test_its_subscription_is_on_a_hidden_node_that_no_executor_of_the_owner_spin
     assert len(list(owner.timers)) == 1  # the tick that takes
     reader.destroy()
     assert list(owner.timers) == []
+
+
+def test_a_node_renamed_on_the_command_line_keeps_its_name_to_itself():
+    context = Context()
+    rclpy.init(context=context, domain_id=session_domain_id(),
+               args=['follower', '--ros-args', '-r', '__node:=renamed'])
+    try:
+        owner = Node('teleop_follower', context=context)
+        reader = PolledReader(owner, PoseStamped, 'teleop/pose', lambda data: None, QOS, 4000.0)
+        deadline = time.monotonic() + MATCH_TIMEOUT
+        while '_renamed_intake' not in owner.get_node_names() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        names = owner.get_node_names()  # the domain's: other tests' nodes may linger in it
+        assert '_renamed_intake' in names and names.count('renamed') == 1
+        reader.destroy()
+    finally:
+        rclpy.try_shutdown(context=context)
 
 
 @pytest.mark.parametrize('max_rate', [0.0, -1.0, float('nan')])

@@ -49,9 +49,11 @@ class PolledReader:
         self._msg_type = msg_type
         self._deliver = deliver
         self._owner = node
+        # Not the process's arguments: a ``__node`` remap would give it the owner's name. The
+        # topic is resolved by the owner, with its remaps.
         self._intake = Node(f'_{node.get_name()}_intake', namespace=node.get_namespace(),
-                            context=node.context, start_parameter_services=False,
-                            enable_rosout=False)
+                            context=node.context, use_global_arguments=False,
+                            start_parameter_services=False, enable_rosout=False)
         self._subscription = self._intake.create_subscription(
             msg_type, node.resolve_topic_name(topic), lambda _: None, qos, raw=True)
         self._timer = node.create_timer(TICK, self.take)
