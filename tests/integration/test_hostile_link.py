@@ -59,6 +59,12 @@ def during(times: np.ndarray, windows: dict, names) -> np.ndarray:
     return np.any([window(times, *windows[name][:2]) for name in names], axis=0)
 
 
+def rate(times: np.ndarray, spans) -> float:
+    """Messages a second stamped ``times`` over the (start, end) ``spans`` together."""
+    count = sum(np.count_nonzero(window(times, start, end)) for start, end in spans)
+    return count / sum(end - start for start, end in spans)
+
+
 class Stranger:
     """A process on the remote site's network: it hears and publishes what it likes."""
 
@@ -276,17 +282,15 @@ def test_the_operator_s_site_keeps_its_rate_through_every_attack(attacked):
     _, series, windows = attacked
     poses = series['/wand/pose'][0]
 
-    def rate(names):
-        spans = [windows[name][:2] for name in names]
-        return (np.count_nonzero(during(poses, windows, names))
-                / sum(end - start for start, end in spans))
-    quiet, under_attack = rate(quiet_windows(windows)), rate(CONTENT)
+    def rate_in(names):
+        return rate(poses, [windows[name][:2] for name in names])
+    quiet, under_attack = rate_in(quiet_windows(windows)), rate_in(CONTENT)
     print(f'\nthe operator\'s site: {under_attack:.0f} Hz through the attacks on the content, '
           f'{quiet:.0f} Hz in the quiet windows between them; by window, '
-          + ', '.join(f'{name} {rate([name]):.0f}' for name in windows))
+          + ', '.join(f'{name} {rate_in([name]):.0f}' for name in windows))
     assert under_attack >= 0.8 * quiet
     for name in windows:
-        assert rate([name]) >= 0.25 * quiet, name
+        assert rate_in([name]) >= 0.25 * quiet, name
 
 
 def test_the_robot_s_site_keeps_its_rate_through_the_flood(attacked):
@@ -299,12 +303,9 @@ def test_the_robot_s_site_keeps_its_rate_through_the_flood(attacked):
     core hogged): the bound matters most where the site is not real-time."""
     _, series, windows = attacked
     tcp = series['/remote/robot/tcp_pose'][0]
-
-    def rate(start, end):
-        return np.count_nonzero((tcp >= start) & (tcp < end)) / (end - start)
-    quiet = np.mean([rate(*windows[name][:2]) for name in quiet_windows(windows)])
+    quiet = rate(tcp, [windows[name][:2] for name in quiet_windows(windows)])
     start, end, _ = windows['flood']
-    flood, after = rate(start, end), rate(end, end + 0.5)
+    flood, after = rate(tcp, [(start, end)]), rate(tcp, [(end, end + 0.5)])
     print(f'\nthe robot\'s site: {flood:.0f} Hz through the flood, {after:.0f} Hz in the half '
           f'second after it, {quiet:.0f} Hz in the quiet windows')
     assert flood >= 0.5 * quiet

@@ -74,7 +74,7 @@ class _Topic:
         self.msg_type = msg_type
         self.publishers: list = []
         self.subscriptions: list = []
-        self.reader = None  # (node, subscription) taking it over DDS while nobody here publishes
+        self.reader = None  # (node, its DDS reader) while nobody here publishes: see _dds_reader
 
     def take_over_dds(self, node: Node, codec: MessageCodec, topic: str, *, refused: Tally,
                       qos: QoSProfile, max_rate: float | None) -> None:
