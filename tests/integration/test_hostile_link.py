@@ -56,15 +56,20 @@ def quiet_windows(windows: dict) -> list:
     return [name for name in windows if name.startswith('quiet before')]
 
 
+def spans(windows: dict, names) -> list:
+    """Return the (start, end) of each named window."""
+    return [windows[name][:2] for name in names]
+
+
 def during(times: np.ndarray, windows: dict, names) -> np.ndarray:
     """Which of ``times`` fall in any of the named windows."""
-    return np.any([window(times, *windows[name][:2]) for name in names], axis=0)
+    return np.any([window(times, *span) for span in spans(windows, names)], axis=0)
 
 
-def rate(times: np.ndarray, spans) -> float:
-    """Messages a second stamped ``times`` over the (start, end) ``spans`` together."""
-    count = sum(np.count_nonzero(window(times, start, end)) for start, end in spans)
-    return count / sum(end - start for start, end in spans)
+def rate(times: np.ndarray, intervals) -> float:
+    """Messages a second stamped ``times`` over the (start, end) ``intervals`` together."""
+    count = sum(np.count_nonzero(window(times, start, end)) for start, end in intervals)
+    return count / sum(end - start for start, end in intervals)
 
 
 class Stranger:
@@ -285,7 +290,7 @@ def test_the_operator_s_site_keeps_its_rate_through_every_attack(attacked):
     poses = series['/wand/pose'][0]
 
     def rate_in(names):
-        return rate(poses, [windows[name][:2] for name in names])
+        return rate(poses, spans(windows, names))
     quiet, under_attack = rate_in(quiet_windows(windows)), rate_in(CONTENT)
     print(f'\nthe operator\'s site: {under_attack:.0f} Hz through the attacks on the content, '
           f'{quiet:.0f} Hz in the quiet windows between them; by window, '
@@ -305,7 +310,7 @@ def test_the_robot_s_site_keeps_its_rate_through_the_flood(attacked):
     core hogged): the bound matters most where the site is not real-time."""
     _, series, windows = attacked
     tcp = series['/remote/robot/tcp_pose'][0]
-    quiet = rate(tcp, [windows[name][:2] for name in quiet_windows(windows)])
+    quiet = rate(tcp, spans(windows, quiet_windows(windows)))
     start, end, _ = windows['flood']
     flood, after = rate(tcp, [(start, end)]), rate(tcp, [(end, end + 0.5)])
     print(f'\nthe robot\'s site: {flood:.0f} Hz through the flood, {after:.0f} Hz in the half '
