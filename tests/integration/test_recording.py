@@ -26,7 +26,7 @@ from haptic_bringup.session import (bags, published_counts, PUBLISHERS, reported
                                     SITE_PUBLISHERS, topic_counts)
 
 DURATION = 4.0  # [s] of tapping
-RECORDER_PAUSE = 0.15  # [s]
+RECORDER_PAUSE = 0.5  # [s]
 TELEOP = {'teleop': 'model', 'link': {'delay': 0.05, 'jitter': 0.005, 'loss': 0.01}}
 RECORDERS = {'separate': ['recorder'], 'composed': ['recorder'],
              'teleop': ['operator_recorder', 'remote_recorder']}
@@ -104,10 +104,11 @@ def test_with_a_core_hogged_the_bag_holds_every_message_each_node_published(tmp_
 
 
 def test_a_recorder_process_paused_mid_session_loses_nothing(tmp_path):
-    """Its process stopped for 0.15 s (SIGSTOP), as a busy machine may deschedule it: the loop's
-    six streams, about 900 messages meanwhile, wait in its shared-memory port 8192 deep
-    (``haptic_util.transport``). With Fast DDS's default port, 512 deep, each of three runs
-    lost 59 to 66 messages of every stream. Stopped 0.3 s, the writers' segments overflow."""
+    """Its process stopped for 0.5 s (SIGSTOP), as a busy machine may deschedule it: the loop's
+    six streams, about 3000 messages meanwhile, wait in its shared-memory port 8192 deep, their
+    buffers in the writers' segments of 8 MB (``haptic_util.transport``). With Fast DDS's
+    default port, 512 deep, stopped 0.15 s, each of three runs lost 59 to 66 messages of every
+    stream; with its default segments, 512 kB, stopped 0.25 s, 80 of each of the driver's."""
     with Loop(session_config(tmp_path, duration=DURATION)) as loop:
         wait_for_the_session_start(loop.config.domain_id, 180.0)
         time.sleep(1.0)

@@ -51,6 +51,7 @@ from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGE
 from haptic_contract.teleop import Scheme, SCHEMES
 from haptic_util import shared_memory
 from haptic_util.executor import end_process
+from haptic_util.transport import deep_shared_memory_environment
 from link_emulator.link import delay_spread, DelayTrace, silence_timeout
 from teleop_protocol.admission import AdmissionConfig
 
@@ -337,6 +338,7 @@ class Loop:
         config = self.config
         ros_args = ['--ros-args', '--params-file', str(params)]
         if config.recorder_process:
+            env = {**env, **deep_shared_memory_environment()}  # every writer too
             self.children.append(start_child(
                 'recorder', [config.python, '-m', RECORDER_MODULE, *ros_args], env))
         if config.teleop:

@@ -17,8 +17,8 @@ reliably); ``/diagnostics``; and a report of its own: messages written and dropp
   What it guarantees: every message that reached it is in the bag, and every one DDS lost on the
   way is counted in its report (``lost: <topic>``, from the gaps DDS sees in each writer's
   sequence). What it cannot: take a best-effort message its process was too starved to take in
-  time. Its shared-memory port holds 8192 messages (``haptic_util.transport``); the writers'
-  side, each process's 512 kB segment, holds about 0.2 s of a stopped recorder's streams. A
+  time. Its shared-memory port holds 8192 messages, 1.4 s of the loop's streams, and the
+  processes it records get segments that hold longer (``haptic_util.transport``). A
   loss after a writer's last message has no later one to show it: the nodes' final reports
   (what each says it published) are the full account (``haptic_bringup.session``).
 

@@ -29,6 +29,7 @@ import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, local_discovery
 from haptic_contract.graph import EXECUTABLES, LOOP_RECORDER, NODES as LOOP_NODES
+from haptic_util.transport import deep_shared_memory_environment
 
 NODES = tuple((entry.package, EXECUTABLES[name], name) for name, entry in LOOP_NODES.items())
 
@@ -72,11 +73,13 @@ def _nodes(context):
             parameters=[_config(p) for p, _, _ in NODES] + extra + [overrides] + driver
             + recorder))
     else:
+        # Recorded by a process of its own: the writers' shared memory as deep as its reader's.
+        env = deep_shared_memory_environment() if record else {}
         for package, executable, name in NODES:
             values = dict(overrides, **driver_values) if name == 'wand_driver' else overrides
             actions += loop.add(name, Node(
                 package=package, executable=executable, name=name, output='screen',
-                parameters=[_config(package), *extra, values]))
+                parameters=[_config(package), *extra, values], additional_env=env))
         if record:
             actions += loop.add(LOOP_RECORDER, Node(
                 package='haptic_bringup', executable='recorder', output='screen',

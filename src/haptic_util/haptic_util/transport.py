@@ -23,28 +23,38 @@ streams) until its receiving thread takes it into a reader's history, and drops 
 port cannot hold. On a loaded machine that thread was descheduled longer, and the recorder lost
 the same 175 to 240 messages of each stream (a CI run; here with the machine's cores hogged).
 Its process stopped for 0.15 s, it lost 59 to 66 of each with the default port, none with this
-(``tests/integration/test_recording.py``).
+(``tests/integration/test_recording.py``). Until the recorder takes a message, it also holds the
+writer's buffer, about 1 kB a message, in the writer's segment: Fast DDS's default 512 kB held
+0.17 s of the wand driver's three streams (the recorder stopped 0.25 s lost 80 of each; 0.4 s,
+188). So the processes that a recorder process records get the same profile, whose segments of
+8 MB hold longer than its port: stopped 0.4, 0.8 and 1.2 s, it lost nothing; 1.6 s, 1546 to
+1552 of each stream, its port full.
 """
 import os
 import pathlib
 
 from ament_index_python.packages import get_package_share_directory
 
-__all__ = ['deep_shared_memory', 'loopback_udp']
+__all__ = ['deep_shared_memory', 'deep_shared_memory_environment', 'loopback_udp']
 
 
 def loopback_udp() -> None:
     """Make the DDS participants this process makes next UDP peers on 127.0.0.1 only."""
-    _use_profile('loopback_udp.xml')
+    os.environ.update(_profile_environment('loopback_udp.xml'))
 
 
 def deep_shared_memory() -> None:
-    """Give the DDS participants this process makes next a shared-memory port 8192 deep."""
-    _use_profile('deep_shared_memory.xml')
+    """Give the DDS participants this process makes next deep shared memory (see above)."""
+    os.environ.update(deep_shared_memory_environment())
 
 
-def _use_profile(name: str) -> None:
+def deep_shared_memory_environment() -> dict:
+    """Return the variables that give a process's DDS participants deep shared memory."""
+    return _profile_environment('deep_shared_memory.xml')
+
+
+def _profile_environment(name: str) -> dict:
     """Leave the discovery range to Fast DDS, which then takes our profile (``config/name``)."""
     profile = pathlib.Path(get_package_share_directory('haptic_util')) / 'config' / name
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'SYSTEM_DEFAULT'
-    os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(profile)
+    return {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SYSTEM_DEFAULT',
+            'FASTRTPS_DEFAULT_PROFILES_FILE': str(profile)}
