@@ -137,9 +137,9 @@ def test_a_key_readable_by_others_or_a_missing_file_is_refused(credentials, tmp_
         Credentials.of_site(credentials.ca.parent, 'operator')
 
 
-def test_streams_drop_and_are_express_what_must_arrive_blocks_frames_go_last():
+def test_streams_drop_and_are_batched_what_must_arrive_blocks_frames_go_last():
     stream, reliable = publisher_options('stream'), publisher_options('reliable')
-    assert stream['express'] and stream['priority'] == zenoh.Priority.REAL_TIME
+    assert not stream['express'] and stream['priority'] == zenoh.Priority.REAL_TIME
     assert stream['congestion_control'] == zenoh.CongestionControl.DROP
     assert reliable['congestion_control'] == zenoh.CongestionControl.BLOCK
     assert reliable['reliability'] == zenoh.Reliability.RELIABLE

@@ -164,10 +164,11 @@ def _qos(kind: str) -> QoSProfile:
     admission lets through at once (``inbound.BURST``). Read with the haptic streams' 10, a
     gateway descheduled past 10 ms lost messages at its own read: at load 11, counted hop by
     hop, all 192 of 15000 pings ``bench_link`` lost (none between the gateways, none at its
-    echo); read 100 deep, none was lost there. What a gateway then hands Zenoh at once may
+    echo); read 100 deep, none was lost there. What a gateway then handed Zenoh at once could
     still overflow Zenoh's queue of 16 express messages (dropped, not blocked: 20 of 16000 in
-    that run). Read 1000 deep, the operator's gateway once stopped taking commands a few
-    seconds into the attacked session (cause not found).
+    that run); streams are batched since (``zenoh_config``). Read 1000 deep, the operator's
+    gateway once stopped taking commands a few seconds into the attacked session (cause not
+    found).
     """
     return {RELIABLE: RELIABLE_QOS, FRAME: FRAME_QOS}.get(kind, LINK_QOS)
 
