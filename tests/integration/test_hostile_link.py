@@ -45,10 +45,10 @@ QUIET = 0.5  # [s] pressed and not attacked, just before each attack on the cont
 # stall held the robot back and cost the scan force for good.
 SESSION_PRIORITY = 50
 # The stranger stands for another host on the network, with a CPU of its own: its process runs
-# real-time above the sites, so that their 1.5 of this machine's 2 cores do not starve what it
-# sends. Below them, its publishing thread woke up to 0.8 s late and sent 1-6 of an attack's 25
-# (CI runs); above them it sends all 25. Its flood, which would take a core here, it sends below
-# the sites: another host would bring that core.
+# real-time above the sites, so that their 1.3-1.9 of this machine's 2 cores do not starve what
+# it sends. Below them, its publishing thread woke up to 0.8 s late and sent 1-16 of an attack's
+# 25 (6 in a CI run); above them it sends all 25. Its flood, which would take a core here, it
+# sends below the sites: another host would bring that core.
 STRANGER_PRIORITY = SESSION_PRIORITY + 10
 FLOOD_PRIORITY = SESSION_PRIORITY - 10
 HELD = 0.375  # of the quiet windows' median force: pressed still (a robot let go retracts to 0)
