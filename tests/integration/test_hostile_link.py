@@ -29,11 +29,14 @@ from test_teleop import (DELAY, FORCE_SCALE, reports, streams, wait_for_the_sess
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
 from haptic_contract.teleop_fields import COMMAND
 from haptic_msgs.msg import TeleopCommand
-from haptic_util.cdr import MalformedMessage, MessageCodec
+from haptic_util.cdr import MessageCodec
+from haptic_util.newest import NewestMessage
 from haptic_util.qos import HAPTIC_STREAM_QOS
+from haptic_util.tally import Tally
 
 MAX_PATIENT_FORCE = 20.0  # [N] the follower's and the robot's default
 POSE = MessageCodec(PoseStamped)
+WRENCH = MessageCodec(WrenchStamped)
 PRESSING = 4.0  # [N] the patient's force once the scan presses (8 N, less on a loaded machine)
 # The attacks on the link's content, each after a quiet window: alternated, so that the scan's
 # own changes (deeper, then sweeping) fall in both.
@@ -87,13 +90,13 @@ class Stranger:
     def __init__(self, domain: int) -> None:
         self.context = Context()
         rclpy.init(context=self.context, domain_id=domain)
-        self.node = Node('stranger', context=self.context)  # spun by no executor
+        self.node = Node('stranger', context=self.context)
         self.heard = None  # the operator's latest command, as fields
         self.pressed = 0.0  # [N] the patient's force, as the robot's sensor says
-        self._commands = self.node.create_subscription(
-            TeleopCommand, 'teleop/command', lambda _: None, HAPTIC_STREAM_QOS, raw=True)
-        self._wrenches = self.node.create_subscription(
-            WrenchStamped, 'robot/ft_sensor/wrench', lambda _: None, HAPTIC_STREAM_QOS)
+        refused = Tally()  # its own malformed commands, heard back
+        self._commands = NewestMessage(self.node, COMMAND, 'teleop/command', refused=refused)
+        self._wrenches = NewestMessage(self.node, WRENCH, 'robot/ft_sensor/wrench',
+                                       refused=refused)
         self.command = self.node.create_publisher(TeleopCommand, 'teleop/command',
                                                   HAPTIC_STREAM_QOS)
         self.target = self.node.create_publisher(PoseStamped, 'robot/target_pose',
@@ -101,18 +104,15 @@ class Stranger:
         self.tcp = self.node.create_publisher(PoseStamped, 'robot/tcp_pose', HAPTIC_STREAM_QOS)
 
     def listen(self) -> None:
-        """Take what arrived since the last call: the readers keep their last few."""
-        for data in taken(self._commands, TeleopCommand, raw=True):
-            self._hear(data)
-        for wrench in taken(self._wrenches, WrenchStamped, raw=False):
-            self.pressed = abs(wrench.wrench.force.z)
+        """Take the newest command and force, if any came since the last call."""
+        command, wrench = self._commands.take(), self._wrenches.take()
+        if command is not None:
+            self._hear(command)
+        if wrench is not None:
+            self.pressed = abs(wrench[WRENCH.index('wrench.force.z')])
 
-    def _hear(self, data: bytes) -> None:
+    def _hear(self, fields) -> None:
         """Keep the operator's latest command: not one of ours, which it also hears."""
-        try:
-            fields = COMMAND.decode(data)
-        except MalformedMessage:
-            return
         session = fields[COMMAND.index('session')]
         stamp = fields[COMMAND.index('header.stamp.sec')]
         if self.heard is None or (session == self.heard[COMMAND.index('session')]
@@ -157,14 +157,10 @@ class Stranger:
         return sent
 
     def close(self) -> None:
+        self._commands.destroy()
+        self._wrenches.destroy()
         self.node.destroy_node()
         self.context.try_shutdown()
-
-
-def taken(subscription, msg_type, raw: bool):
-    """Yield the messages waiting in ``subscription``'s reader, oldest first."""
-    while (message := subscription.handle.take_message(msg_type, raw)) is not None:
-        yield message[0]
 
 
 @contextlib.contextmanager

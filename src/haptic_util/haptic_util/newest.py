@@ -28,8 +28,11 @@ class NewestMessage:
     def __init__(self, node: Node, codec: MessageCodec, topic: str, *, refused: Tally) -> None:
         self._codec, self._refused = codec, refused
         self._kind = f'malformed {topic}'
+        # No log or parameters of its own (as ``PolledReader``'s intake): two readers of one
+        # node would register its name's log publisher twice.
         self._reader = Node(f'{node.get_name()}_newest', namespace=node.get_namespace(),
-                            context=node.context)
+                            context=node.context, start_parameter_services=False,
+                            enable_rosout=False)
         self._subscription = self._reader.create_subscription(
             codec.message_class, topic, lambda data: None, NEWEST_STREAM_QOS, raw=True)
 
