@@ -61,14 +61,17 @@ def test_in_one_process_a_message_reaches_its_subscriber_as_values_before_publis
     assert list(subscriber.subscriptions) == []  # nothing taken over DDS
 
 
+@pytest.mark.parametrize('max_rate', [None, 1000.0], ids=['taken', 'polled'])
 def test_a_subscription_made_before_its_publisher_stops_taking_the_topic_over_dds(
-        context, bus):
+        context, bus, max_rate):
+    """Its DDS reader goes: the subscription the executor takes, or a polled reader's timer."""
     subscriber = node(context, 'collision')
     subscription = stream_subscription(subscriber, POSE, 'wand/pose', lambda values: None,
-                                       refused=Tally())
-    assert [s.topic_name for s in subscriber.subscriptions] == ['/wand/pose']
+                                       refused=Tally(), max_rate=max_rate)
+    readers = (len(list(subscriber.subscriptions)), len(list(subscriber.timers)))
+    assert readers == ((1, 0) if max_rate is None else (0, 1))
     publisher = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')
-    assert list(subscriber.subscriptions) == []
+    assert (len(list(subscriber.subscriptions)), len(list(subscriber.timers))) == (0, 0)
     assert publisher.get_subscription_count() == 1 and subscription.get_publisher_count() == 1
 
 

@@ -74,7 +74,7 @@ class _Topic:
         self.msg_type = msg_type
         self.publishers: list = []
         self.subscriptions: list = []
-        self.reader = None  # (node, its DDS reader) while nobody here publishes: see _dds_reader
+        self.reader = None  # (its DDS reader, what destroys it) while nobody here publishes
 
     def take_over_dds(self, node: Node, codec: MessageCodec, topic: str, *, refused: Tally,
                       qos: QoSProfile, max_rate: float | None) -> None:
@@ -84,8 +84,8 @@ class _Topic:
         counts what is malformed in its ``refused``.
         """
         if self.reader is None and not self.publishers:
-            self.reader = (node, _dds_reader(node, codec, topic, self.deliver, refused=refused,
-                                             qos=qos, max_rate=max_rate))
+            self.reader = _dds_reader(node, codec, topic, self.deliver, refused=refused,
+                                      qos=qos, max_rate=max_rate)
 
     def deliver(self, values: Sequence) -> None:
         _pending.extend((subscription, values) for subscription in self.subscriptions)
@@ -94,16 +94,12 @@ class _Topic:
     def served_locally(self) -> None:
         """Stop taking the topic over DDS: a node of this process publishes it."""
         if self.reader is not None:
-            node, reader = self.reader
-            if isinstance(reader, PolledReader):
-                _polled.remove(reader)
-                reader.destroy()
-            else:
-                node.destroy_subscription(reader)
+            _, destroy = self.reader
+            destroy()
             self.reader = None
 
     def dds_publisher_count(self) -> int:
-        return self.reader[1].get_publisher_count() if self.reader is not None else 0
+        return self.reader[0].get_publisher_count() if self.reader is not None else 0
 
 
 def _topic(node: Node, msg_type, topic: str) -> _Topic | None:
@@ -177,8 +173,8 @@ class StreamSubscription:
             self._topic.take_over_dds(node, codec, topic, refused=refused, qos=qos,
                                       max_rate=max_rate)
         else:
-            self._dds = _dds_reader(node, codec, topic, callback, refused=refused, qos=qos,
-                                    max_rate=max_rate)
+            self._dds, _ = _dds_reader(node, codec, topic, callback, refused=refused, qos=qos,
+                                       max_rate=max_rate)
 
     def get_publisher_count(self) -> int:
         """Return how many publishers match: of this process, and over DDS."""
@@ -189,14 +185,19 @@ class StreamSubscription:
 
 def _dds_reader(node: Node, codec: MessageCodec, topic: str,
                 deliver: Callable[[Sequence], None], *, refused: Tally, qos: QoSProfile,
-                max_rate: float | None):
-    """Return a DDS reader of ``topic`` for ``node``: taken by its executor, or polled."""
+                max_rate: float | None) -> tuple:
+    """Return a DDS reader of ``topic`` for ``node`` (executor-taken or polled), its destroyer."""
     take = _decoding(codec, topic, refused, deliver)
     if max_rate is None:
-        return node.create_subscription(codec.message_class, topic, take, qos, raw=True)
+        subscription = node.create_subscription(codec.message_class, topic, take, qos, raw=True)
+        return subscription, lambda: node.destroy_subscription(subscription)
     reader = PolledReader(node, codec.message_class, topic, take, qos, max_rate)
     _polled.append(reader)
-    return reader
+
+    def destroy() -> None:
+        _polled.remove(reader)
+        reader.destroy()
+    return reader, destroy
 
 
 def _decoding(codec: MessageCodec, topic: str, refused: Tally,
