@@ -64,10 +64,14 @@ def streams(folder: pathlib.Path) -> dict:
 
 
 def zeroed(folder: pathlib.Path, since: float) -> float:
-    """When the device first applied no force after ``since``, by its own stamp (s).
+    """By when the device's force had stopped after ``since``, by its own stamps (s).
 
-    The stamp is the device's tick; the bag's receive time is the recorder's, which a busy
-    recorder delays. A device that stalled has no ticks in between, so it still shows.
+    Each applied wrench is the mean over the servo periods that ended since the tick before
+    (``SimulatedWand.applied``, as ``test_fail_safe.seen_from_outside`` reads it): the first one
+    after ``since`` that is zero means no force from the tick before it on, whose stamp this
+    returns. Not the zero one's own: at a slowed driver's 10 ms ticks the force stopped up to a
+    tick before it. The stamp is the device's tick; the bag's receive time is the recorder's,
+    which a busy recorder delays. A device that stalled has no ticks in between, so it shows.
     """
     times, felt = read_vectors(folder / 'bag', typestore_with(custom_definitions()),
                                {'/wand/applied_wrench': 'wrench'},
@@ -75,7 +79,8 @@ def zeroed(folder: pathlib.Path, since: float) -> float:
     after = times > since
     ticks = np.diff(times[after][:200])
     print(f'device ticks after {since:.3f}: longest gap {1e3 * ticks.max():.1f} ms')
-    return times[after & (np.linalg.norm(felt, axis=1) == 0.0)][0]
+    first_zero = np.flatnonzero(after & (np.linalg.norm(felt, axis=1) == 0.0))[0]
+    return times[first_zero - 1]
 
 
 def reports(folder: pathlib.Path, node: str, key: str) -> list:
