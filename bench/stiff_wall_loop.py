@@ -2,11 +2,16 @@
 
     .venv/bin/python bench/stiff_wall_loop.py [--stiffness 160 1000 5000 20000 100000]
                                               [--duration 6] [--rendering local remote]
-                                              [--json PATH]
+                                              [--layouts composed separate] [--json PATH]
 
 The virtual-wall sweep (``stiffness_sweep.py``) checks the force law against a simulated device
-with a zero-order hold. Here the whole loop runs, three processes over ROS 2: the simulated
-wand taps the cuboid's end face. With ``remote`` rendering the device holds each wrench as it
+with a zero-order hold. Here the whole loop runs over ROS 2 and the simulated wand taps the
+cuboid's end face, in each layout: ``composed`` (one process, ``haptic_loop``'s and the launch
+file's default) and ``separate`` (three processes over DDS, the baseline). A model that comes
+later than its lifetime, or after the tip has left its ``valid_radius``, renders nothing, and
+the device's passivity then keeps the wall where the hand fell to: a loop whose latency spikes
+(the three processes' p99 is 12-16 ms here, ``bench_loop.py``) lets the hand fall millimetres
+into a stiff wall on some taps. With ``remote`` rendering the device holds each wrench as it
 arrives, about a millisecond after the pose it answers; with ``local`` rendering it renders the
 contact model against its current position at its 4 kHz servo rate. Every figure comes from the
 bag: contacts per tap (1 is a clean tap, more are rebounds), the net work of the force the device
@@ -45,17 +50,19 @@ __all__ = ['compare', 'ideal_depth', 'run', 'main']
 
 SCENE = 'package://collision_engine/scenes/cuboid.yaml'
 TAP_PERIOD = 1.05  # [s] the cuboid script's taps come about this often
+LAYOUTS = ('composed', 'separate')
 IDEAL_RATE = 50_000.0  # [Hz] taken as continuous: the depth moves < 0.5 % from 20 kHz to 100 kHz
 
 
-def run(stiffness: float, rendering: str, *, duration: float = 6.0, domain_id: int = 42) -> dict:
+def run(stiffness: float, rendering: str, *, layout: str = 'composed', duration: float = 6.0,
+        domain_id: int = 42) -> dict:
     """One session of the cuboid taps at ``stiffness`` N/m per axis; returns its figures."""
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         stats = folder / 'stats.npz'
         config = LoopConfig(
-            scene=SCENE, experiment='cuboid', duration=duration, record=str(folder / 'bag'),
-            domain_id=domain_id, run_dir=folder / 'launch',
+            composed=layout == 'composed', scene=SCENE, experiment='cuboid', duration=duration,
+            record=str(folder / 'bag'), domain_id=domain_id, run_dir=folder / 'launch',
             overrides={'force_renderer': {'scene_file': '', 'stiffness': [stiffness] * 3},
                        'wand_driver': {'rendering': rendering, 'stats_file': str(stats)}})
         with Loop(config) as loop:
@@ -65,7 +72,7 @@ def run(stiffness: float, rendering: str, *, duration: float = 6.0, domain_id: i
         record = np.load(stats)
         contacts = contact_intervals(session)
         taps = max(1, round((session.time[-1] - 0.5) / TAP_PERIOD))
-        return {'stiffness': stiffness, 'rendering': rendering,
+        return {'stiffness': stiffness, 'rendering': rendering, 'layout': layout,
                 'contacts_per_tap': len(contacts) / taps,
                 'net_work_j': applied_work(session),
                 'max_depth_m': max((c.max_depth for c in contacts), default=0.0),
@@ -73,12 +80,12 @@ def run(stiffness: float, rendering: str, *, duration: float = 6.0, domain_id: i
                 'answered_percent': float(record['answered_percent'])}
 
 
-def compare(stiffness: float, renderings=('local', 'remote'), *, duration: float = 6.0,
-            domain_id: int = 42) -> list[dict]:
-    """``run`` once per rendering at ``stiffness``, each with the continuous wall's depth."""
+def compare(stiffness: float, renderings=('local', 'remote'), layouts=LAYOUTS, *,
+            duration: float = 6.0, domain_id: int = 42) -> list[dict]:
+    """``run`` once per layout and rendering at ``stiffness``, with the continuous wall's depth."""
     ideal = ideal_depth(stiffness, duration=duration)
-    return [{**run(stiffness, rendering, duration=duration, domain_id=domain_id),
-             'ideal_depth_m': ideal} for rendering in renderings]
+    return [{**run(stiffness, rendering, layout=layout, duration=duration, domain_id=domain_id),
+             'ideal_depth_m': ideal} for layout in layouts for rendering in renderings]
 
 
 class _ContinuousWall:
@@ -125,22 +132,24 @@ def main(argv=None) -> int:
     parser.add_argument('--rendering', nargs='+', default=['local', 'remote'],
                         choices=['local', 'remote'])
     parser.add_argument('--duration', type=float, default=6.0)
+    parser.add_argument('--layouts', nargs='+', default=list(LAYOUTS), choices=LAYOUTS)
     ros_domain.add_option(parser)
     result_files.add_option(parser)
     args = parser.parse_args(argv)
     ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy", "numba")}')
-    print(f'{"K N/m":>8} {"rendering":>9} {"contacts/tap":>12} {"net work mJ":>11} '
-          f'{"depth mm":>8} {"/ ideal":>7} {"peak N":>7} {"answered":>8}')
+    print(f'{"K N/m":>8} {"layout":>9} {"rendering":>9} {"contacts/tap":>12} '
+          f'{"net work mJ":>11} {"depth mm":>8} {"/ ideal":>7} {"peak N":>7} {"answered":>8}')
     rows = []
     for stiffness in args.stiffness:
-        rows += compare(stiffness, args.rendering, duration=args.duration,
-                        domain_id=args.domain_id)
-        for r in rows[-len(args.rendering):]:
-            print(f'{stiffness:8.0f} {r["rendering"]:>9} {r["contacts_per_tap"]:12.1f} '
-                  f'{1e3 * r["net_work_j"]:11.2f} {1e3 * r["max_depth_m"]:8.2f} '
-                  f'{r["max_depth_m"] / r["ideal_depth_m"]:7.2f} {r["peak_force_n"]:7.2f} '
-                  f'{r["answered_percent"]:8.2f}', flush=True)
+        measured = compare(stiffness, args.rendering, args.layouts, duration=args.duration,
+                           domain_id=args.domain_id)
+        for r in measured:
+            print(f'{stiffness:8.0f} {r["layout"]:>9} {r["rendering"]:>9} '
+                  f'{r["contacts_per_tap"]:12.1f} {1e3 * r["net_work_j"]:11.2f} '
+                  f'{1e3 * r["max_depth_m"]:8.2f} {r["max_depth_m"] / r["ideal_depth_m"]:7.2f} '
+                  f'{r["peak_force_n"]:7.2f} {r["answered_percent"]:8.2f}', flush=True)
+        rows += measured
     result_files.write(args.json, rows)
     return 0
 

@@ -178,9 +178,14 @@ def _stability_chapter(findings: Findings) -> list[str]:
         sweep_section(sweep['rows']), '', identical_modes(sweep['rows']), '',
         '![stiffness sweep](stiffness_sweep.png)', ''])
     parts += ['### A stiff wall over the real ROS 2 loop', '',
-              'The sweep above closes the loop in one process with an ideal hold; here the three '
-              'nodes run over ROS 2 (`bench/stiff_wall_loop.py`: the cuboid taps, both passivity '
-              'controllers on). *Remote*: the wand holds each wrench as it arrives, about a '
+              'The sweep above closes the loop in one process with an ideal hold; here the loop '
+              'runs over ROS 2 (`bench/stiff_wall_loop.py`: the cuboid taps, both passivity '
+              'controllers on), in both layouts: *composed*, the nodes in one process (the '
+              'launchers\' default), and *separate*, three processes over DDS (the baseline, '
+              'whose round trip\'s p99 is several times the composed one\'s: a model that comes '
+              'after its lifetime, or once the tip has left its 0.5 mm, renders nothing, the '
+              'hand falls in, and the device\'s passivity keeps the wall where the hand fell '
+              'to). *Remote*: the wand holds each wrench as it arrives, about a '
               'millisecond after the pose it answers. *Local*: the wand renders the contact '
               'model against its current position at its 4 kHz servo rate. Every figure is read '
               'from the bag: *contacts per tap* above 1 are rebounds (a lift over 0.1 mm); *net '

@@ -368,10 +368,10 @@ def servo_section(rows: list) -> str:
 def stiff_wall_section(rows: list) -> str:
     """Tabulate rebounds, work, depth and force of the stiff wall over the loop."""
     return markdown_table(
-        ['K N/m', 'rendering', 'contacts per tap', 'net work on the tip (mJ)',
+        ['K N/m', 'layout', 'rendering', 'contacts per tap', 'net work on the tip (mJ)',
          'deepest (mm)', 'deepest / continuous wall', 'peak applied force (N)',
          'poses answered'],
-        [[f'{r["stiffness"]:.0f}', r['rendering'],
+        [[f'{r["stiffness"]:.0f}', r['layout'], r['rendering'],
           f'{r["contacts_per_tap"]:.1f}', f'{1e3 * r["net_work_j"]:+.2f}',
           f'{1e3 * r["max_depth_m"]:.2f}', f'{r["max_depth_m"] / r["ideal_depth_m"]:.2f}',
           f'{r["peak_force_n"]:.2f}', f'{r["answered_percent"]:.2f} %'] for r in rows])
