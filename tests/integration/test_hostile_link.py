@@ -17,7 +17,7 @@ import os
 import time
 
 from domains import session_domain_id
-from geometry_msgs.msg import PoseStamped, WrenchStamped
+from geometry_msgs.msg import PoseStamped
 import numpy as np
 import pytest
 import rclpy
@@ -27,16 +27,14 @@ from test_teleop import (DELAY, FORCE_SCALE, reports, streams, wait_for_the_sess
                          window)
 
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION
+from haptic_contract.streams import POSE, WRENCH
 from haptic_contract.teleop_fields import COMMAND
 from haptic_msgs.msg import TeleopCommand
-from haptic_util.cdr import MessageCodec
 from haptic_util.newest import NewestMessage
 from haptic_util.qos import HAPTIC_STREAM_QOS
 from haptic_util.tally import Tally
 
 MAX_PATIENT_FORCE = 20.0  # [N] the follower's and the robot's default
-POSE = MessageCodec(PoseStamped)
-WRENCH = MessageCodec(WrenchStamped)
 PRESSING = 4.0  # [N] the patient's force once the scan presses (8 N, less on a loaded machine)
 # The attacks on the link's content, each after a quiet window: alternated, so that the scan's
 # own changes (deeper, then sweeping) fall in both.
