@@ -6,12 +6,16 @@ Why: a command that crosses to the remote site and the feedback that comes back 
 that is deployed: DDS in the operator's domain, the operator's gateway, Zenoh over mutual TLS,
 the remote gateway, DDS in the remote domain, and back. Its floor is the same two end processes
 exchanging the same bytes (a stamped PoseStamped's CDR) as UDP datagrams on the same loopback:
-what any transport between them must at least take. This process sends ``--rate`` numbered
-pings; an echo process (``bench_link.py echo``, in the next DDS domain) sends each back at once
-on both paths. The cases alternate within one invocation, so they share the machine's state;
-each figure is given beside its floor, and as the round trip added over it. A ping with no pong
-0.5 s after the window ends is lost. Each gateway's CPU is read from outside (psutil) over the
-measured window, in % of one core. No emulated delay: the stage passes messages straight on.
+what any transport between them must at least take. Between the two, the same end processes
+exchange them over a Zenoh session of their own each, with the gateways' settings (mutual TLS,
+access control, the streams' publisher options): what Zenoh itself takes, with no DDS and no
+gateway process on the path; the least a gateway in the sites' own processes could add. This
+process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in the next DDS
+domain) sends each back at once on every path. The cases alternate within one invocation, so they
+share the machine's state; each figure is given beside its floor, and as the round trip added
+over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's CPU, and the
+echo's, is read from outside (psutil) over the measured window, in % of one core. No emulated
+delay: the stage passes messages straight on.
 """
 import argparse
 import os
@@ -40,9 +44,14 @@ from haptic_bringup.site import loopback_gateways
 from haptic_util.executor import run_nodes
 from haptic_util.parameters import declare_parameters, RealtimeParams
 from haptic_util.qos import LINK_QOS
+from site_gateway.gateway import open_session
+from site_gateway.routes import site_routes, STREAM
+from site_gateway.zenoh_config import Credentials, publisher_options, session_config
 
 PING, PONG = 'bench/ping', 'bench/pong'
 POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
+DIRECT_PREFIX = 'bench'  # the direct case's Zenoh keys (its sessions reach no gateway's)
+CASES = ('floor', 'zenoh', 'gateways')
 SEQUENCE = struct.Struct('<i')  # the ping's number, in its header's stamp.sec (after CDR's 4)
 WARM_UP = 1.0  # [s] of pongs coming back before a window is measured
 DRAIN = 0.5  # [s] after a window, for the last pongs
@@ -66,17 +75,38 @@ def udp_socket() -> socket.socket:
     return udp
 
 
-class Echo(Node):
-    """The remote end: each ping, from DDS or from UDP, sent straight back the way it came.
+def direct_session(role: str, certs: pathlib.Path, endpoint: str) -> tuple:
+    """Return ``role``'s Zenoh configuration in the direct case, its key to put, its key to take.
 
-    It runs as the loop's nodes do, at their priority (``RealtimeParams``).
+    As the gateways' (``site_gateway.zenoh_config``): the remote end listens, the operator's
+    dials, each with its site's certificate from ``certs``.
+    """
+    routes = site_routes(role, [f'{PING}:{POSE_TYPE}'], [f'{PONG}:{POSE_TYPE}'])
+    ends = {'listen': (endpoint,) if role == 'remote' else (),
+            'connect': (endpoint,) if role == 'operator' else ()}
+    config = session_config(routes, **ends, credentials=Credentials.of_site(certs, role),
+                            prefix=DIRECT_PREFIX)
+    return (config, routes.outgoing[0].key(DIRECT_PREFIX),
+            routes.incoming[0].any_role_key(DIRECT_PREFIX))
+
+
+class Echo(Node):
+    """The remote end: each ping, from DDS, UDP or Zenoh, sent straight back the way it came.
+
+    It runs as the loop's nodes do, at their priority (``RealtimeParams``). Zenoh's pings are
+    answered in Zenoh's thread, as UDP's are in a thread of their own.
     """
 
-    def __init__(self, udp_port: int) -> None:
+    def __init__(self, udp_port: int, certs: pathlib.Path, endpoint: str) -> None:
         super().__init__('bench_link_echo')
         declare_parameters(self, RealtimeParams)
         self._pong = self.create_publisher(PoseStamped, PONG, LINK_QOS)
         self.create_subscription(PoseStamped, PING, self._pong.publish, LINK_QOS, raw=True)
+        config, pong_key, ping_key = direct_session('remote', certs, endpoint)
+        self.session = open_session(config, self.get_name())
+        pong = self.session.declare_publisher(pong_key, **publisher_options(STREAM))
+        self._listener = self.session.declare_subscriber(
+            ping_key, lambda sample: pong.put(sample.payload.to_bytes()))
         self._socket = udp_socket()
         self._socket.bind(('127.0.0.1', udp_port))
         threading.Thread(target=self._echo_udp, daemon=True).start()
@@ -179,8 +209,27 @@ class UdpEnd:
         self.socket.close()
 
 
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+class ZenohEnd:
+    """This process's own Zenoh session with the echo's: Zenoh alone, no DDS, no gateway."""
+
+    def __init__(self, certs: pathlib.Path, endpoint: str, pinger: Pinger) -> None:
+        config, ping_key, pong_key = direct_session('operator', certs, endpoint)
+        self.session = open_session(config, 'bench_link')
+        self.send = self.session.declare_publisher(ping_key, **publisher_options(STREAM)).put
+        self._listener = self.session.declare_subscriber(
+            pong_key, lambda sample: pinger.on_pong(sample.payload.to_bytes()))
+
+    @staticmethod
+    def wait(seconds: float) -> None:
+        time.sleep(seconds)  # the pongs are taken in Zenoh's thread
+
+    def close(self) -> None:
+        self.session.close()
+
+
+def free_port(kind: int) -> int:
+    """Return a free loopback port of socket ``kind`` (SOCK_DGRAM, SOCK_STREAM)."""
+    with socket.socket(socket.AF_INET, kind) as probe:
         probe.bind(('127.0.0.1', 0))
         return probe.getsockname()[1]
 
@@ -222,10 +271,10 @@ def measure(case: str, end, pinger: Pinger, args, pids: dict, first: int) -> dic
 def main(argv=None) -> int:
     argv = sys.argv if argv is None else argv
     if len(argv) > 1 and argv[1] == 'echo':
-        return run_nodes([lambda: Echo(int(argv[2]))], argv)
+        return run_nodes([lambda: Echo(int(argv[2]), pathlib.Path(argv[3]), argv[4])], argv)
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
-    parser.add_argument('--runs', type=int, default=1, help='alternated rounds of both cases')
+    parser.add_argument('--runs', type=int, default=1, help='alternated rounds of the cases')
     parser.add_argument('--rate', type=float, default=1000.0, help='[Hz] pings')
     ros_domain.add_option(parser, help="the operator's side; the echo's is the next")
     result_files.add_option(parser)
@@ -236,59 +285,76 @@ def main(argv=None) -> int:
     print(f'{args.rate:g} Hz pings for {args.seconds:g} s per case, {args.runs} alternated '
           f'round(s); round trip in ms; CPU in % of one core over the window')
     print(f'{"case":<9} {"p50":>8} {"p99":>8} {"p99.9":>8} {"lost/sent":>12} CPU')
-    results = {'floor': [], 'gateways': []}
+    results = {case: [] for case in CASES}
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
-        udp_port = free_udp_port()
-        echo = start_child('echo', [sys.executable, __file__, 'echo', str(udp_port), '--ros-args'],
-                           loop_environment(args.domain_id + 1, folder / 'log'))
         routes = {'to_remote': [f'{PING}:{POSE_TYPE}'], 'to_operator': [f'{PONG}:{POSE_TYPE}']}
         gateways = {child.name.split('_')[0]: child for child in loopback_gateways(
             folder, sys.executable, loop_environment(args.domain_id, folder / 'log'),
             loop_environment(args.domain_id + 1, folder / 'log'), routes=routes)}
+        udp_port = free_port(socket.SOCK_DGRAM)
+        direct = f'tls/127.0.0.1:{free_port(socket.SOCK_STREAM)}'
+        echo = start_child('echo', [sys.executable, __file__, 'echo', str(udp_port),
+                                    str(folder / 'certs'), direct, '--ros-args'],
+                           loop_environment(args.domain_id + 1, folder / 'log'))
         pinger = Pinger()
-        dds, udp = DdsEnd(args.domain_id, pinger), UdpEnd(udp_port, pinger)
-        pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
+        ends = {'floor': UdpEnd(udp_port, pinger),
+                'zenoh': ZenohEnd(folder / 'certs', direct, pinger),
+                'gateways': DdsEnd(args.domain_id, pinger)}
+        gateway_pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
+        watched = {'floor': {'echo': echo.pid}, 'zenoh': {'echo': echo.pid},
+                   'gateways': {**gateway_pids, 'echo': echo.pid}}
         try:
-            warmed = connect(udp, pinger, -2_000_000)
-            connect(dds, pinger, warmed)
+            first = -3_000_000
+            for case in CASES:
+                first = connect(ends[case], pinger, first)
             first = 0
             for _ in range(args.runs):
-                for case, end, watched in (('floor', udp, {'echo': echo.pid}),
-                                           ('gateways', dds, {**pids, 'echo': echo.pid})):
-                    results[case].append(measure(case, end, pinger, args, watched, first))
+                for case in CASES:
+                    results[case].append(measure(case, ends[case], pinger, args, watched[case],
+                                                 first))
                     first += int(args.rate * args.seconds)
         finally:
-            udp.close()
-            dds.close()
+            for end in ends.values():
+                end.close()
             stop_children([*gateways.values(), echo])
     summary = summarize(results)
     print(f'load average after: {os.getloadavg()[0]:.2f}')
-    print('added by the gateways over the floor (median of rounds): ' + ', '.join(
-        f'p{q:g} {summary["added_ms"][f"p{q:g}"]:.3f} ms ({summary["ratio"][f"p{q:g}"]:.1f} x)'
-        for q in PERCENTILES)
-        + f'; lost {summary["lost"]} of {summary["sent"]}; gateways\' CPU '
-        + ', '.join(f'{name} {cpu:.1f} %' for name, cpu in summary['gateway_cpu_pct'].items()))
+    for case, what in (('zenoh', 'Zenoh alone'), ('gateways', 'the gateways')):
+        print(f'added by {what} over the floor (median of rounds): ' + ', '.join(
+            f'p{q:g} {summary[case]["added_ms"][f"p{q:g}"]:.3f} ms '
+            f'({summary[case]["ratio"][f"p{q:g}"]:.1f} x)' for q in PERCENTILES)
+            + f'; lost {summary[case]["lost"]} of {summary[case]["sent"]}')
+    print('CPU (median of rounds): ' + ', '.join(
+        f'{name} {cpu:.1f} %' for name, cpu in summary['gateway_cpu_pct'].items())
+        + '; the echo ' + ', '.join(
+            f'{cpu:.1f} % ({case})' for case, cpu in summary['echo_cpu_pct'].items()))
     result_files.write(args.json, {'rate_hz': args.rate, 'seconds': args.seconds,
                                    'runs': results, 'summary': summary})
     return 0
 
 
 def summarize(results: dict) -> dict:
-    """Return the round trip added over the floor, its ratio, the loss, each gateway's CPU."""
-    def median(case: str, key: str) -> float:
-        return float(np.median([run[key] for run in results[case]]))
-    added, ratio = {}, {}
-    for q in PERCENTILES:
-        key = f'p{q:g}_ms'
-        added[f'p{q:g}'] = median('gateways', key) - median('floor', key)
-        ratio[f'p{q:g}'] = median('gateways', key) / median('floor', key)
-    gateways = results['gateways']
-    cpu = {name: float(np.median([run['cpu_pct'][name] for run in gateways]))
-           for name in gateways[0]['cpu_pct'] if name.endswith('gateway')}
-    return {'added_ms': added, 'ratio': ratio, 'gateway_cpu_pct': cpu,
-            'lost': sum(run['lost'] for run in gateways),
-            'sent': sum(run['sent'] for run in gateways),
+    """Return what Zenoh alone and the gateways add over the floor; each gateway's CPU, the echo's.
+
+    What each adds is the round trip's added quantiles, their ratios, and the loss.
+    """
+    def median(case: str, key) -> float:
+        return float(np.median([key(run) for run in results[case]]))
+
+    def over_floor(case: str) -> dict:
+        keys = {f'p{q:g}': (lambda run, q=q: run[f'p{q:g}_ms']) for q in PERCENTILES}
+        return {'added_ms': {q: median(case, key) - median('floor', key)
+                             for q, key in keys.items()},
+                'ratio': {q: median(case, key) / median('floor', key) for q, key in keys.items()},
+                'lost': sum(run['lost'] for run in results[case]),
+                'sent': sum(run['sent'] for run in results[case])}
+    return {'zenoh': over_floor('zenoh'), 'gateways': over_floor('gateways'),
+            'gateway_cpu_pct': {name: median('gateways', lambda run, n=name: run['cpu_pct'][n])
+                                for name in results['gateways'][0]['cpu_pct']
+                                if name.endswith('gateway')},
+            'echo_cpu_pct': {case: median(case, lambda run: run['cpu_pct']['echo'])
+                             for case in CASES},
             'floor_lost': sum(run['lost'] for run in results['floor'])}
 
 

@@ -268,7 +268,10 @@ def _teleop_chapter(findings: Findings) -> list[str]:
               'The deployed path, DDS to the operator\'s gateway, Zenoh over mutual TLS, the '
               'remote gateway and DDS, and back, at 1 kHz and no emulated delay, beside its '
               'floor: the same two processes exchanging the same bytes as UDP datagrams on the '
-              'same loopback, alternated in one run (`bench/bench_link.py`).', '']
+              'same loopback, and between them the same two processes over Zenoh sessions of '
+              'their own with the gateways\' settings (no DDS, no gateway process: the least a '
+              'gateway in the sites\' own processes could add), alternated in one run '
+              '(`bench/bench_link.py`).', '']
     parts += _stored(findings, 'link', lambda stored: [link_section(stored), ''])
     parts += ['### On a busy machine', '',
               'The issue\'s command, `haptic_loop --teleop SCHEME --delay 0.1 --jitter 0.01 '

@@ -435,17 +435,22 @@ def teleop_load_section(rows: list) -> str:
 
 
 def link_section(stored: dict) -> str:
-    """Tabulate the gateways' round trip beside plain UDP's, the loss, each gateway's CPU."""
+    """Tabulate the round trip over plain UDP, Zenoh alone and the gateways; the loss; the CPU."""
     def median(case: str, key: str) -> float:
         return float(np.median([run[key] for run in stored['runs'][case]]))
     summary = stored['summary']
     quantiles = ('p50', 'p99', 'p99.9')
-    rows = [[case, *(f'{median(case, f"{q}_ms"):.3f}' for q in quantiles),
+    paths = {'floor': 'plain UDP (the floor)', 'zenoh': 'Zenoh alone, between the end processes',
+             'gateways': 'the gateways (deployed)'}
+    rows = [[paths[case], *(f'{median(case, f"{q}_ms"):.3f}' for q in quantiles),
              f'{sum(r["lost"] for r in stored["runs"][case])} of '
-             f'{sum(r["sent"] for r in stored["runs"][case])}'] for case in ('floor', 'gateways')]
-    added = (f'{summary["added_ms"][q]:+.3f} ({summary["ratio"][q]:.1f} ×)' for q in quantiles)
-    rows.append(['added by the gateways', *added, ''])
+             f'{sum(r["sent"] for r in stored["runs"][case])}'] for case in paths]
+    for case in ('zenoh', 'gateways'):
+        added = (f'{summary[case]["added_ms"][q]:+.3f} ({summary[case]["ratio"][q]:.1f} ×)'
+                 for q in quantiles)
+        rows.append([f'added by {paths[case].split(",")[0].lower()}', *added, ''])
     cpu = ', '.join(f'{name} {value:.1f} %' for name, value in summary['gateway_cpu_pct'].items())
+    echo = ', '.join(f'{value:.1f} % ({case})' for case, value in summary['echo_cpu_pct'].items())
     return (markdown_table(['path', 'round trip p50 (ms)', 'p99 (ms)', 'p99.9 (ms)', 'lost'],
                            rows)
-            + f'\n\nEach gateway\'s CPU over the window, in % of one core: {cpu}.')
+            + f'\n\nCPU over the window, in % of one core: {cpu}; the echo {echo}.')

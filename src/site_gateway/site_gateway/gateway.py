@@ -50,7 +50,7 @@ from site_gateway.routes import bye_key, FRAME, other_role, RELIABLE, ROLES, sit
 from site_gateway.zenoh_config import (check_endpoints, Credentials, LEASE, publisher_options,
                                        session_config)
 
-__all__ = ['GatewayNode', 'GatewayParams', 'main']
+__all__ = ['GatewayNode', 'GatewayParams', 'main', 'open_session']
 
 NODE_NAME = 'site_gateway'
 DIAGNOSTICS_PERIOD = 1.0  # [s]
@@ -142,7 +142,8 @@ def _plan(params: GatewayParams, name: str) -> tuple:
     return routes, config
 
 
-def _open(config: dict, name: str) -> zenoh.Session:
+def open_session(config: dict, name: str) -> zenoh.Session:
+    """Open a gateway's Zenoh session, with its runtime and log; raise StartupError if it fails."""
     os.environ.setdefault('NO_COLOR', '1')  # Zenoh's log lines, plain in a log file
     os.environ.setdefault('ZENOH_RUNTIME', ZENOH_RUNTIME)
     zenoh.init_log_from_env_or(ZENOH_LOG)
@@ -190,7 +191,7 @@ class GatewayNode(Node):
                                       if crossing.kind == RELIABLE})
         self._inbound = Inbound(routes.incoming, params.key_prefix, params.max_rate)
         self._peers, self._connections, self._closing = set(), 0, False
-        self.session = _open(config, name)
+        self.session = open_session(config, name)
         self._outgoing = [self.session.declare_publisher(c.key(self._prefix),
                                                          **publisher_options(c.kind))
                           for c in routes.outgoing]
