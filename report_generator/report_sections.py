@@ -63,6 +63,7 @@ def headline_section(recordings: dict, results: dict) -> str:
     return markdown_table(header, rows)
 
 
+LINK_ADDED_BY = {'zenoh': 'Zenoh alone', 'gateways': 'the gateways'}  # link_section's rows
 DEFINITIONS = f"""\
 How to read it:
 
@@ -448,7 +449,7 @@ def link_section(stored: dict) -> str:
     for case in ('zenoh', 'gateways'):
         added = (f'{summary[case]["added_ms"][q]:+.3f} ({summary[case]["ratio"][q]:.1f} ×)'
                  for q in quantiles)
-        rows.append([f'added by {paths[case].split(",")[0].lower()}', *added, ''])
+        rows.append([f'added by {LINK_ADDED_BY[case]}', *added, ''])
     cpu = ', '.join(f'{name} {value:.1f} %' for name, value in summary['gateway_cpu_pct'].items())
     echo = ', '.join(f'{value:.1f} % ({case})' for case, value in summary['echo_cpu_pct'].items())
     return (markdown_table(['path', 'round trip p50 (ms)', 'p99 (ms)', 'p99.9 (ms)', 'lost'],
