@@ -63,7 +63,6 @@ def headline_section(recordings: dict, results: dict) -> str:
     return markdown_table(header, rows)
 
 
-LINK_ADDED_BY = {'zenoh': 'Zenoh alone', 'gateways': 'the gateways'}  # link_section's rows
 DEFINITIONS = f"""\
 How to read it:
 
@@ -443,13 +442,14 @@ def link_section(stored: dict) -> str:
     quantiles = ('p50', 'p99', 'p99.9')
     paths = {'floor': 'plain UDP (the floor)', 'zenoh': 'Zenoh alone, between the end processes',
              'gateways': 'the gateways (deployed)'}
+    added_by = {'zenoh': 'Zenoh alone', 'gateways': 'the gateways'}
     rows = [[paths[case], *(f'{median(case, f"{q}_ms"):.3f}' for q in quantiles),
              f'{sum(r["lost"] for r in stored["runs"][case])} of '
              f'{sum(r["sent"] for r in stored["runs"][case])}'] for case in paths]
-    for case in ('zenoh', 'gateways'):
+    for case, what in added_by.items():
         added = (f'{summary[case]["added_ms"][q]:+.3f} ({summary[case]["ratio"][q]:.1f} ×)'
                  for q in quantiles)
-        rows.append([f'added by {LINK_ADDED_BY[case]}', *added, ''])
+        rows.append([f'added by {what}', *added, ''])
     cpu = ', '.join(f'{name} {value:.1f} %' for name, value in summary['gateway_cpu_pct'].items())
     echo = ', '.join(f'{value:.1f} % ({case})' for case, value in summary['echo_cpu_pct'].items())
     return (markdown_table(['path', 'round trip p50 (ms)', 'p99 (ms)', 'p99.9 (ms)', 'lost'],
