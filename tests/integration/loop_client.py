@@ -30,25 +30,39 @@ class LoopClient:
     """Publishes ``wand/pose`` and ``wand/twist``; records ``wand/wrench`` and collision states."""
 
     def __init__(self, domain_id: int) -> None:
+        self.domain_id = domain_id
+        self.wrenches = {}
+        self.answer_stamps = {'force_renderer': [], 'collision_engine': []}  # [ns] every one
+        self.arrivals = {}  # stamp key -> when its first wrench arrived [ns, this clock]
+        self.states = {}
+        self.applied = []  # (stamp [ns], |force| [N]) of each wand/applied_wrench, as it came
+        self._join()
+
+    def _join(self) -> None:
+        """Make this client's participant, node, publishers and subscriptions."""
         self.context = Context()
-        rclpy.init(context=self.context, domain_id=domain_id)
+        rclpy.init(context=self.context, domain_id=self.domain_id)
         self.node = Node('test_wand', context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.pose_pub = self.node.create_publisher(PoseStamped, 'wand/pose', HAPTIC_STREAM_QOS)
         self.twist_pub = self.node.create_publisher(TwistStamped, 'wand/twist',
                                                     HAPTIC_STREAM_QOS)
-        self.wrenches = {}
-        self.answer_stamps = {'force_renderer': [], 'collision_engine': []}  # [ns] every one
-        self.arrivals = {}  # stamp key -> when its first wrench arrived [ns, this clock]
-        self.states = {}
         self.wrench_sub = self.node.create_subscription(
             WrenchStamped, 'wand/wrench', self._on_wrench, HAPTIC_STREAM_QOS)
         self.state_sub = self.node.create_subscription(
             CollisionState, 'collision/state', self._on_state, HAPTIC_STREAM_QOS)
-        self.applied = []  # (stamp [ns], |force| [N]) of each wand/applied_wrench, as it came
         self.node.create_subscription(WrenchStamped, 'wand/applied_wrench', self._on_applied,
                                       RECORDER_QOS)  # deep: nothing lost while a test sleeps
+
+    def rejoin(self) -> None:
+        """Leave DDS and join it anew as another participant, keeping what was recorded.
+
+        A process SIGKILLed while it wrote to this client could leave the client's own
+        participant undelivered to, by the restarted process as well (Fast DDS 2.14).
+        """
+        self.close()
+        self._join()
 
     def _on_wrench(self, msg: WrenchStamped) -> None:
         key = (msg.header.stamp.sec, msg.header.stamp.nanosec)

@@ -29,7 +29,7 @@ TIME_TO_ZERO = 0.010  # [s] the issue's bound
 PAUSE = 0.100  # [s] SIGSTOP length
 RECOVERY_TIMEOUT = 60.0  # [s] a restarted node imports and loads its scene first
 REJOIN_TIMEOUT = 20.0  # [s] a restarted node that has not rejoined by then is restarted again
-REJOIN_ATTEMPTS = 3
+REJOIN_ATTEMPTS = 4  # this client, the node, this client, the node
 STEADY = 0.2  # [s] of unbroken contact force before each fault
 PRESSING = """\
 waypoints:
@@ -123,28 +123,38 @@ def killed_at(client, name: str, before: int, back: int) -> int:
 
 
 def rejoined(loop, client, name: str, since_ns: int) -> int:
-    """Wait for the restarted ``name`` to rejoin the loop; restart it again if it does not.
+    """Wait for the restarted ``name`` to rejoin the loop; if it does not, rejoin each side anew.
 
-    Fast DDS 2.14 sometimes never delivers to a participant restarted after a SIGKILL
-    (eProsima/Fast-DDS#5053, #5469, open): about one restart in fifteen here. A supervisor
-    restarts such a node again, as this does; the attempts are counted and printed. Returns
-    when the force came back [ns].
+    Fast DDS 2.14 sometimes never delivers from or to a participant restarted after a SIGKILL
+    (eProsima/Fast-DDS#5053, #5469, open): about one restart in fifteen here. In one CI run
+    (2026-11-28) the side that no longer received was this client: the restarted force node
+    and three more restarts of it each published wrenches (the last, some 870 a second), the
+    wand driver took them (78.7 % of its 115 567 poses answered, most after the first of those
+    restarts), and this client saw none. So this client joins
+    anew first (``LoopClient.rejoin``), then the node is restarted again, as a supervisor
+    would, and so on; each attempt is counted and printed. Returns when the force came back
+    [ns].
     """
     for attempt in range(REJOIN_ATTEMPTS):
         try:
             return wait_for_fresh_force(client, since_ns, REJOIN_TIMEOUT)
         except TimeoutError as silence:
             # Whether the restarted process was still running tells a silent one from a dead one.
-            REJOINS.append(f'{name} ({silence}; exit code {loop.child(name).returncode})')
-            os.killpg(loop.child(name).pid, signal.SIGKILL)
-            loop.restart(name)
+            side = 'this client' if attempt % 2 == 0 else name
+            REJOINS.append(f'{side} ({name} silent: {silence}; exit code '
+                           f'{loop.child(name).returncode})')
+            if side == name:
+                os.killpg(loop.child(name).pid, signal.SIGKILL)
+                loop.restart(name)
+            else:
+                client.rejoin()
     try:
         return wait_for_fresh_force(client, since_ns, RECOVERY_TIMEOUT)
     except TimeoutError as error:
-        raise TimeoutError(f'{error}; after restarting {name} again: {REJOINS}') from None
+        raise TimeoutError(f'{error}; after joining anew: {REJOINS}') from None
 
 
-REJOINS = []  # nodes restarted again because they did not rejoin
+REJOINS = []  # sides joined anew (this client or a node) because a restart did not rejoin
 
 
 def signal_group(pid: int, signum: int) -> tuple:
@@ -247,7 +257,7 @@ def test_faults_mid_contact_zero_the_force_within_10_ms_and_the_loop_recovers(pr
               f'seen from '
               f'outside: stopped by {1e3 * outside[:, 1].max():.2f} ms at the latest, its tick '
               f'starting {1e3 * outside[:, 0].max():.2f} ms after the signal at the latest; '
-              f'restarted again to rejoin: {len(REJOINS)}')
+              f'sides joined anew after a silent restart: {len(REJOINS)}')
         assert delays.max() <= TIME_TO_ZERO, f'{label}: {delays}'
         assert outside[:, 0].max() <= TIME_TO_ZERO, f'{label}, outside: {outside}'
         assert len(trials) == TRIALS[label]
