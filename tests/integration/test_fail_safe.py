@@ -29,7 +29,6 @@ TIME_TO_ZERO = 0.010  # [s] the issue's bound
 PAUSE = 0.100  # [s] SIGSTOP length
 RECOVERY_TIMEOUT = 60.0  # [s] a restarted node imports and loads its scene first
 REJOIN_TIMEOUT = 20.0  # [s] a restarted node that has not rejoined by then is restarted again
-REJOIN_ATTEMPTS = 4  # this client, the node, this client, the node
 STEADY = 0.2  # [s] of unbroken contact force before each fault
 PRESSING = """\
 waypoints:
@@ -123,31 +122,31 @@ def killed_at(client, name: str, before: int, back: int) -> int:
 
 
 def rejoined(loop, client, name: str, since_ns: int) -> int:
-    """Wait for the restarted ``name`` to rejoin the loop; if it does not, rejoin each side anew.
+    """Wait for the restarted ``name`` to rejoin the loop; if it does not, join each side anew.
 
-    Fast DDS 2.14 sometimes never delivers from or to a participant restarted after a SIGKILL
-    (eProsima/Fast-DDS#5053, #5469, open): about one restart in fifteen here. In one CI run
-    (2026-11-28) the side that no longer received was this client: the restarted force node
-    and three more restarts of it each published wrenches (the last, some 870 a second), the
-    wand driver took them (78.7 % of its 115 567 poses answered, most after the first of those
-    restarts), and this client saw none. So this client joins
-    anew first (``LoopClient.rejoin``), then the node is restarted again, as a supervisor
-    would, and so on; each attempt is counted and printed. Returns when the force came back
-    [ns].
+    Fast DDS 2.14 sometimes never delivers between a restarted participant and one that
+    survived a peer's SIGKILL (eProsima/Fast-DDS#5053, #5469, open). Twice (2026-11-28), the
+    side at fault was a survivor, and restarting the killed node again, four times, did not
+    help: in a CI run, this client (the restarted force node published some 870 wrenches a
+    second, the wand driver took them, this client saw none); in a local run, the collision
+    node (it answered every pose; the restarted force node received nothing and published no
+    wrench). So, as a supervisor would, the other faulty node is restarted, then this client
+    joins anew (``LoopClient.rejoin``), then the node is restarted again; each is counted and
+    printed. Returns when the force came back [ns].
     """
-    for attempt in range(REJOIN_ATTEMPTS):
+    other = FAULTY[1 - FAULTY.index(name)]
+    for side in (other, 'this client', name):
         try:
             return wait_for_fresh_force(client, since_ns, REJOIN_TIMEOUT)
         except TimeoutError as silence:
             # Whether the restarted process was still running tells a silent one from a dead one.
-            side = 'this client' if attempt % 2 == 0 else name
             REJOINS.append(f'{side} ({name} silent: {silence}; exit code '
                            f'{loop.child(name).returncode})')
-            if side == name:
-                os.killpg(loop.child(name).pid, signal.SIGKILL)
-                loop.restart(name)
-            else:
+            if side == 'this client':
                 client.rejoin()
+            else:
+                os.killpg(loop.child(side).pid, signal.SIGKILL)
+                loop.restart(side)
     try:
         return wait_for_fresh_force(client, since_ns, RECOVERY_TIMEOUT)
     except TimeoutError as error:
