@@ -28,7 +28,7 @@ FAULTY = ('collision_engine', 'force_renderer')
 TIME_TO_ZERO = 0.010  # [s] the issue's bound
 PAUSE = 0.100  # [s] SIGSTOP length
 RECOVERY_TIMEOUT = 60.0  # [s] a restarted node imports and loads its scene first
-REJOIN_TIMEOUT = 20.0  # [s] a restarted node that has not rejoined by then is restarted again
+REJOIN_TIMEOUT = 20.0  # [s] a restarted node that has not rejoined by then: a side joins anew
 STEADY = 0.2  # [s] of unbroken contact force before each fault
 PRESSING = """\
 waypoints:
@@ -126,13 +126,14 @@ def rejoined(loop, client, name: str, since_ns: int) -> int:
 
     Fast DDS 2.14 sometimes never delivers between a restarted participant and one that
     survived a peer's SIGKILL (eProsima/Fast-DDS#5053, #5469, open). Twice (2026-11-28), the
-    side at fault was a survivor, and restarting the killed node again, four times, did not
-    help: in a CI run, this client (the restarted force node published some 870 wrenches a
-    second, the wand driver took them, this client saw none); in a local run, the collision
-    node (it answered every pose; the restarted force node received nothing and published no
-    wrench). So, as a supervisor would, the other faulty node is restarted, then this client
-    joins anew (``LoopClient.rejoin``), then the node is restarted again; each is counted and
-    printed. Returns when the force came back [ns].
+    side at fault was a survivor, and restarting the killed node again did not help (three
+    times; twice, with this client joining anew twice). In a CI run it was this client: the
+    restarted force node published some 870 wrenches a second, the wand driver took them, this
+    client saw none. In a local run it was the collision node: it answered every pose, and the
+    restarted force node received nothing and published no wrench. So, as a supervisor would,
+    the other faulty node is restarted, then this client joins anew (``LoopClient.rejoin``),
+    then the node is restarted again; each is counted and printed. Returns when the force came
+    back [ns].
     """
     other = FAULTY[1 - FAULTY.index(name)]
     for side in (other, 'this client', name):
