@@ -298,13 +298,14 @@ def main(argv=None) -> int:
                                     str(folder / 'certs'), direct, '--ros-args'],
                            loop_environment(args.domain_id + 1, folder / 'log'))
         pinger = Pinger()
-        ends = {'floor': UdpEnd(udp_port, pinger),
-                'zenoh': ZenohEnd(folder / 'certs', direct, pinger),
-                'gateways': DdsEnd(args.domain_id, pinger)}
         gateway_pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
         watched = {'floor': {'echo': echo.pid}, 'zenoh': {'echo': echo.pid},
                    'gateways': {**gateway_pids, 'echo': echo.pid}}
+        ends = {}  # made one by one inside the try: one that fails still stops the others
         try:
+            ends['floor'] = UdpEnd(udp_port, pinger)
+            ends['zenoh'] = ZenohEnd(folder / 'certs', direct, pinger)
+            ends['gateways'] = DdsEnd(args.domain_id, pinger)
             first = -3_000_000
             for case in CASES:
                 first = connect(ends[case], pinger, first)
