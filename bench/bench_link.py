@@ -9,12 +9,16 @@ exchanging the same bytes (a stamped PoseStamped's CDR) as UDP datagrams on the 
 what any transport between them must at least take. Between the two, the same end processes
 exchange them over a Zenoh session of their own each, with the gateways' settings (mutual TLS,
 access control, the streams' publisher options): what Zenoh itself takes, with no DDS and no
-gateway process on the path; the least a gateway in the sites' own processes could add. This
+gateway process on the path; the least a gateway in the sites' own processes could add. And
+over the gateways as nodes of the sites' own processes (``site_gateway`` composed with a ping
+node here and an echo node there, their streams handed over in each process): the path a
+session deploys, against the gateways as processes of their own, its baseline. This
 process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in the next DDS
 domain) sends each back at once on every path. The cases alternate within one invocation, so they
 share the machine's state; each figure is given beside its floor, and as the round trip added
 over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's CPU, and the
-echo's, is read from outside (psutil) over the measured window, in % of one core. No emulated
+echo's (with its gateway, when it is in the echo's process), is read from outside (psutil) over
+the measured window, in % of one core. No emulated
 delay: the stage passes messages straight on.
 """
 import argparse
@@ -38,20 +42,23 @@ from rclpy.node import Node
 from rclpy.serialization import serialize_message
 from rclpy.task import Future
 
-from haptic_bringup.launcher import loop_environment
+from haptic_bringup.launcher import gateway_remap, loop_environment
 from haptic_bringup.processes import start_child, stop_children
-from haptic_bringup.site import loopback_gateways
+from haptic_bringup.site import loopback_gateway_files, loopback_gateways
+from haptic_util import intra_process
+from haptic_util.cdr import MessageCodec
 from haptic_util.executor import run_nodes
 from haptic_util.parameters import declare_parameters, RealtimeParams
 from haptic_util.qos import LINK_QOS
-from site_gateway.gateway import open_session
+from haptic_util.tally import Tally
+from site_gateway.gateway import GatewayNode, open_session
 from site_gateway.routes import site_routes, STREAM
 from site_gateway.zenoh_config import Credentials, publisher_options, session_config
 
 PING, PONG = 'bench/ping', 'bench/pong'
 POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
 DIRECT_PREFIX = 'bench'  # the direct case's Zenoh keys (its sessions reach no gateway's)
-CASES = ('floor', 'zenoh', 'gateways')
+CASES = ('floor', 'zenoh', 'gateways', 'in_process')
 SEQUENCE = struct.Struct('<i')  # the ping's number, in its header's stamp.sec (after CDR's 4)
 WARM_UP = 1.0  # [s] of pongs coming back before a window is measured
 DRAIN = 0.5  # [s] after a window, for the last pongs
@@ -117,6 +124,17 @@ class Echo(Node):
             self._socket.sendto(data, sender)
 
 
+class SiteEcho(Node):
+    """The remote end in its site's process: each ping its gateway hands over, handed back."""
+
+    def __init__(self) -> None:
+        super().__init__('bench_link_site_echo')
+        declare_parameters(self, RealtimeParams)
+        codec = MessageCodec(PoseStamped)
+        pong = intra_process.stream_publisher(self, codec, PONG)
+        intra_process.stream_subscription(self, codec, PING, pong.publish, refused=Tally())
+
+
 class Pinger:
     """This process's end: pings sent at a rate, each pong's round trip from its send time."""
 
@@ -124,8 +142,11 @@ class Pinger:
         self.sent, self.round_trips = {}, {}  # sequence -> send time; sequence -> round trip
 
     def on_pong(self, data: bytes) -> None:
+        self.on_sequence(SEQUENCE.unpack_from(data, 4)[0])
+
+    def on_sequence(self, sequence: int) -> None:
+        """Take the pong numbered ``sequence``, now."""
         now = time.perf_counter()
-        (sequence,) = SEQUENCE.unpack_from(data, 4)
         sent = self.sent.get(sequence)
         if sent is not None and sequence not in self.round_trips:
             self.round_trips[sequence] = now - sent
@@ -175,6 +196,36 @@ class DdsEnd:
         self.executor.shutdown()
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
+
+
+class SiteEnd(DdsEnd):
+    """This process as the operator's site: a ping node and the gateway, on one executor.
+
+    The pings are handed to the gateway in the process as a site's nodes hand it their streams
+    (their values: decoding each costs this end some microseconds), the pongs handed back.
+    """
+
+    def __init__(self, domain: int, gateway_params: pathlib.Path, pinger: Pinger) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain, args=[
+            '--ros-args', *gateway_remap('operator'), '--params-file', str(gateway_params)])
+        intra_process.enable()
+        self.gateway = GatewayNode(context=self.context)
+        self.node = Node('bench_link_site_pinger', context=self.context)
+        codec = MessageCodec(PoseStamped)
+        publisher = intra_process.stream_publisher(self.node, codec, PING)
+        intra_process.stream_subscription(self.node, codec, PONG,
+                                          lambda values: pinger.on_sequence(values[0]),
+                                          refused=Tally())
+        self.executor = EventsExecutor(context=self.context)
+        for node in (self.gateway, self.node):
+            self.executor.add_node(node)
+        self.send = lambda data: publisher.publish(codec.decode(data))
+
+    def close(self) -> None:
+        self.gateway.destroy_node()
+        intra_process.close()
+        super().close()
 
 
 class UdpEnd:
@@ -272,6 +323,9 @@ def main(argv=None) -> int:
     argv = sys.argv if argv is None else argv
     if len(argv) > 1 and argv[1] == 'echo':
         return run_nodes([lambda: Echo(int(argv[2]), pathlib.Path(argv[3]), argv[4])], argv)
+    if len(argv) > 1 and argv[1] == 'site-echo':
+        intra_process.enable()
+        return run_nodes([GatewayNode, SiteEcho], argv)
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
     parser.add_argument('--runs', type=int, default=1, help='alternated rounds of the cases')
@@ -297,15 +351,22 @@ def main(argv=None) -> int:
         echo = start_child('echo', [sys.executable, __file__, 'echo', str(udp_port),
                                     str(folder / 'certs'), direct, '--ros-args'],
                            loop_environment(args.domain_id + 1, folder / 'log'))
+        in_process = loopback_gateway_files(folder / 'in_process', routes=routes)
+        site_echo = start_child('site_echo', [
+            sys.executable, __file__, 'site-echo', '--ros-args', *gateway_remap('remote'),
+            '--params-file', str(in_process['remote'])],
+            loop_environment(args.domain_id + 3, folder / 'log'))
         pinger = Pinger()
         gateway_pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
         watched = {'floor': {'echo': echo.pid}, 'zenoh': {'echo': echo.pid},
-                   'gateways': {**gateway_pids, 'echo': echo.pid}}
+                   'gateways': {**gateway_pids, 'echo': echo.pid},
+                   'in_process': {'echo': site_echo.pid}}
         ends = {}  # made one by one inside the try: one that fails still stops the others
         try:
             ends['floor'] = UdpEnd(udp_port, pinger)
             ends['zenoh'] = ZenohEnd(folder / 'certs', direct, pinger)
             ends['gateways'] = DdsEnd(args.domain_id, pinger)
+            ends['in_process'] = SiteEnd(args.domain_id + 2, in_process['operator'], pinger)
             first = -3_000_000
             for case in CASES:
                 first = connect(ends[case], pinger, first)
@@ -318,10 +379,11 @@ def main(argv=None) -> int:
         finally:
             for end in ends.values():
                 end.close()
-            stop_children([*gateways.values(), echo])
+            stop_children([*gateways.values(), echo, site_echo])
     summary = summarize(results)
     print(f'load average after: {os.getloadavg()[0]:.2f}')
-    for case, what in (('zenoh', 'Zenoh alone'), ('gateways', 'the gateways')):
+    for case, what in (('zenoh', 'Zenoh alone'), ('gateways', 'the gateways'),
+                       ('in_process', "the gateways in the sites' processes")):
         print(f'added by {what} over the floor (median of rounds): ' + ', '.join(
             f'p{q:g} {summary[case]["added_ms"][f"p{q:g}"]:.3f} ms '
             f'({summary[case]["ratio"][f"p{q:g}"]:.1f} x)' for q in PERCENTILES)
@@ -350,7 +412,7 @@ def summarize(results: dict) -> dict:
                 'ratio': {q: median(case, key) / median('floor', key) for q, key in keys.items()},
                 'lost': sum(run['lost'] for run in results[case]),
                 'sent': sum(run['sent'] for run in results[case])}
-    return {'zenoh': over_floor('zenoh'), 'gateways': over_floor('gateways'),
+    return {**{case: over_floor(case) for case in CASES[1:]},
             'gateway_cpu_pct': {name: median('gateways', lambda run, n=name: run['cpu_pct'][n])
                                 for name in results['gateways'][0]['cpu_pct']
                                 if name.endswith('gateway')},

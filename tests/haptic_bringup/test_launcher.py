@@ -1,4 +1,5 @@
 """The local launcher's pieces: environment, parameters, and the discovery's expectations."""
+import dataclasses
 import os
 import pathlib
 import sys
@@ -68,13 +69,25 @@ def test_the_composed_loop_and_each_site_record_themselves_into_the_session(tmp_
     remote = sites['remote_recorder']['ros__parameters']
     assert operator['output'] == str(tmp_path / 'scan' / 'operator')
     assert remote['output'] == str(tmp_path / 'scan' / 'remote') and remote['prefix'] == '/remote'
-    assert site_nodes(config, 'operator') == ('wand_driver', 'teleop_leader', 'operator_recorder')
+    # Each site's gateway is in its process, before the recorder (built last, destroyed last).
+    assert site_nodes(config, 'operator') == ('wand_driver', 'teleop_leader', 'site_gateway',
+                                              'operator_recorder')
     # The imager is a process of its own beside the remote site's, as ros2 run starts it.
-    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    assert site_nodes(config, 'remote') == ('sim_robot', 'teleop_follower', 'site_gateway',
+                                            'remote_recorder')
     assert imager_argv(config, ['--ros-args'])[1:] == ['-m', 'ultrasound_sim.node', '--ros-args']
     assert operator['topics'][-1] == '/probe/image'  # recorded where it is seen
     blind = LoopConfig(teleop='model', record=str(tmp_path / 'blind'))  # no imaging by default
-    assert site_nodes(blind, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    assert site_nodes(blind, 'remote') == ('sim_robot', 'teleop_follower', 'site_gateway',
+                                           'remote_recorder')
+    # The gateway as a process of its own (the baseline): the crossing streams are DDS
+    # endpoints at each site; in the site's process, they are handed over there.
+    apart = dataclasses.replace(blind, gateway_in_process=False)
+    assert site_nodes(apart, 'remote') == ('sim_robot', 'teleop_follower', 'remote_recorder')
+    for domain in (blind.domain_id, blind.remote_domain_id):
+        for topic in ('/teleop/command', '/teleop/feedback'):
+            assert teleop_endpoints(blind)[domain][topic][1] == 0
+            assert teleop_endpoints(apart)[domain][topic][1] == 1
     assert '/probe/image' not in node_parameters(blind)['operator_recorder'][
         'ros__parameters']['topics']
     assert '/probe/image' not in teleop_endpoints(blind)[blind.remote_domain_id]

@@ -17,6 +17,7 @@ from rosbags.highlevel import AnyReader
 import yaml
 
 from haptic_bringup.bag import recover, typestore_with
+from haptic_bringup.discovery import GraphWatcher
 from haptic_bringup.hold_request import hold_during
 from haptic_bringup.launcher import Loop, LoopConfig, SCAN_DURATION, SCAN_SCRIPT
 from haptic_bringup.recorder import custom_definitions
@@ -43,13 +44,33 @@ STREAMS = {'/wand/pose': 'pose', '/wand/applied_wrench': 'wrench',
 
 
 def teleop(folder: pathlib.Path, scheme: str = 'model', duration: float = 9.0,
-           experiment: str = None, **link):
+           experiment: str = None, gateway_in_process: bool = True, **link):
     config = LoopConfig(teleop=scheme, duration=duration, record=str(folder / 'bag'),
                         experiment=experiment,
                         domain_id=session_domain_id(),
                         remote_domain=session_domain_id(second=True), run_dir=folder / 'launch',
-                        link={'delay': DELAY, 'jitter': JITTER, 'loss': 0.01, **link})
+                        link={'delay': DELAY, 'jitter': JITTER, 'loss': 0.01, **link},
+                        gateway_in_process=gateway_in_process)
     return Loop(config)
+
+
+def crossing_endpoints() -> dict:
+    """What each site's DDS domain shows of the streams that cross: (publishers, subscribers).
+
+    Read once the watcher sees each stream's publisher, and a second later: a site's endpoints
+    are one participant's, discovered together.
+    """
+    seen = {}
+    for domain, topic in ((session_domain_id(), '/teleop/feedback'),
+                          (session_domain_id(second=True), '/teleop/command')):
+        watcher = GraphWatcher(domain)
+        try:
+            assert not watcher.wait({topic: (1, 0)}, 30.0), f'{topic} never published'
+            time.sleep(1.0)
+            seen[topic] = watcher.counts(topic)
+        finally:
+            watcher.close()
+    return seen
 
 
 def streams(folder: pathlib.Path) -> dict:
@@ -101,13 +122,24 @@ def scan(tmp_path_factory):
         # 11 s, not 9: the follower reports once a second, and a hold asked at 8 s into a 9 s
         # scan was once over before a report showed it (a CI run).
         with teleop(folder, duration=11.0) as loop:
+            graph = crossing_endpoints()
             assert loop.wait(60.0) is not None, 'the scan did not end'
         assert asked.result() is not None, 'the operator\'s gateway never took the hold'
-    return folder, streams(folder)
+    return folder, streams(folder), graph
+
+
+def test_what_crosses_is_handed_over_in_each_site_s_process_and_read_from_no_dds(scan):
+    """Each gateway is a node of its site's process, and hands what crosses to the site's nodes
+    there: in each site's DDS domain, the stream that came across has its publisher (the
+    gateway's, for a recorder or a viewer elsewhere) and no reader. So what a stranger on a
+    site's network publishes on it reaches no node (``test_hostile_link`` attacks the layout
+    in which a site's streams go through DDS)."""
+    _, _, graph = scan
+    assert graph == {'/teleop/feedback': (1, 0), '/teleop/command': (1, 0)}
 
 
 def test_the_patient_is_felt_scaled_across_the_delayed_link(scan):
-    folder, series = scan
+    folder, series, _ = scan
     start = read_session_start(folder / 'bag', typestore_with(custom_definitions()))
     felt_times, felt = series['/wand/applied_wrench']
     patient_times, patient = series['/remote/robot/ft_sensor/wrench']
@@ -121,7 +153,7 @@ def test_the_patient_is_felt_scaled_across_the_delayed_link(scan):
 
 
 def test_the_operator_measures_the_round_trip_from_echoed_stamps(scan):
-    folder, _ = scan
+    folder, _, _ = scan
     round_trips = [float(v) for v in reports(folder, 'teleop_leader', 'round_trip_s')
                    if v != 'nan']
     assert round_trips, 'the leader never reported a round trip'
@@ -129,7 +161,7 @@ def test_the_operator_measures_the_round_trip_from_echoed_stamps(scan):
 
 
 def test_each_site_records_itself_into_the_session_and_loses_nothing(scan):
-    folder, series = scan
+    folder, series, _ = scan
     assert bags(folder / 'bag') == [folder / 'bag' / 'operator', folder / 'bag' / 'remote']
     assert len(series['/remote/robot/tcp_pose'][0]) > 1000
     assert len(series['/wand/pose'][0]) > 1000
@@ -146,7 +178,7 @@ def test_each_site_records_itself_into_the_session_and_loses_nothing(scan):
 def test_a_force_hold_asked_at_the_operator_s_site_crosses_and_the_remote_site_holds(scan):
     """``teleop/hold`` crosses the gateways as a reliable message: the follower, at the remote
     site, reports the force it holds."""
-    folder, _ = scan
+    folder, _, _ = scan
     held = reports(folder, 'teleop_follower', 'force_hold')
     assert held and held[0] == 'None'  # not holding as the scan began
     assert float(held[-1]) == HELD
@@ -174,10 +206,10 @@ def test_a_link_stalled_mid_contact_zeroes_the_force_the_robot_lets_go_and_both_
     stall; what the gateway held is older than the link allows and never executed; and when the
     link is back the robot and the operator's model meet again: the patient is pressed and the
     hand feels, scaled, the force the patient gets."""
-    with teleop(tmp_path, duration=SCAN_DURATION) as loop:
+    with teleop(tmp_path, duration=SCAN_DURATION, gateway_in_process=False) as loop:
         start = wait_for_the_session_start(session_domain_id(), SCAN_DURATION)
         time.sleep(max(0.0, start + PRESSING[0] + 0.5 - time.monotonic()))
-        gateway = loop.child('operator_gateway')
+        gateway = loop.child('operator_gateway')  # a process of its own, to be stopped
         dropped = time.time()
         gateway.signal(signal.SIGSTOP)
         time.sleep(0.5)

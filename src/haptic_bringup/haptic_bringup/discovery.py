@@ -23,12 +23,15 @@ class GraphWatcher:
         self._node = Node('haptic_launcher_graph', context=self._context,
                           start_parameter_services=False, enable_rosout=False)
 
+    def counts(self, topic: str) -> tuple:
+        """Return how many publishers and subscribers of ``topic`` are discovered."""
+        return self._node.count_publishers(topic), self._node.count_subscribers(topic)
+
     def missing(self, endpoints: Mapping[str, tuple]) -> list:
         """Descriptions of the endpoints not discovered yet."""
         missing = []
         for topic, (publishers, subscribers) in endpoints.items():
-            have_pub = self._node.count_publishers(topic)
-            have_sub = self._node.count_subscribers(topic)
+            have_pub, have_sub = self.counts(topic)
             if have_pub < publishers:
                 missing.append(f'{topic}: {have_pub}/{publishers} publisher(s)')
             if have_sub < subscribers:

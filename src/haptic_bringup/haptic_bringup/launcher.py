@@ -41,7 +41,8 @@ import yaml
 from haptic_bringup.discovery import GraphWatcher
 from haptic_bringup.processes import (clean_stale_shm, run_until_stopped, start_child,
                                       stop_children, wait_any_exit)
-from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, IMAGER, LOOP_RECORDER,
+from haptic_contract.graph import (absolute, COLLISION_STATE, DIAGNOSTICS, GATEWAY, IMAGER,
+                                   LOOP_RECORDER,
                                    NODES, OPERATOR_RECORDED, OPERATOR_RECORDER, OPERATOR_SITE,
                                    PROBE_IMAGE, RECORDERS, REMOTE_PREFIX, REMOTE_RECORDED,
                                    REMOTE_RECORDER, REMOTE_SITE, ROBOT_FT_WRENCH,
@@ -55,8 +56,8 @@ from haptic_util.transport import deep_shared_memory_environment
 from link_emulator.link import delay_spread, DelayTrace, silence_timeout
 from teleop_protocol.admission import AdmissionConfig
 
-__all__ = ['LoopConfig', 'Loop', 'imager_argv', 'main', 'loop_environment', 'NODES',
-           'priority_parameters']
+__all__ = ['LoopConfig', 'Loop', 'gateway_remap', 'imager_argv', 'main', 'loop_environment',
+           'NODES', 'priority_parameters']
 
 SCAN_SCRIPT = ('teleop_leader', 'config/scan.yaml')
 SCAN_DURATION = 18.5  # [s] the scan's last waypoint, and a moment at rest
@@ -100,6 +101,9 @@ class LoopConfig:
     # The 1 kHz processes' real-time priority (every node but the imager, and the gateways);
     # None: their own (``haptic_util.parameters.RealtimeParams``: 0, normal scheduling).
     thread_priority: Optional[int] = None
+    # teleop: each site's gateway is a node of its site's process; False: a process of its own
+    # (``site_gateway``), the baseline ``bench/bench_link.py`` measures it against.
+    gateway_in_process: bool = True
 
     @property
     def remote_domain_id(self) -> int:
@@ -224,13 +228,20 @@ def _teleop_options(config: LoopConfig, options: dict) -> None:
 
 
 def site_nodes(config: LoopConfig, site: str) -> tuple:
-    """Return the node names of a telerobotic site's process: its nodes, and its recorder.
+    """Return the node names of a telerobotic site's process: its nodes, its gateway, its recorder.
 
-    The remote site's imager, if any, is a process of its own (``imager_argv``).
+    The remote site's imager, if any, is a process of its own (``imager_argv``); so is each
+    site's gateway unless ``gateway_in_process``.
     """
     nodes, recorder = ((OPERATOR_SITE, OPERATOR_RECORDER) if site == 'operator' else
                        (REMOTE_SITE, REMOTE_RECORDER))
-    return (*nodes, recorder) if config.record else nodes
+    gateway = (GATEWAY,) if config.gateway_in_process else ()
+    return (*nodes, *gateway, *((recorder,) if config.record else ()))
+
+
+def gateway_remap(role: str) -> list:
+    """Return the ROS arguments that name a site process's gateway node after its role."""
+    return ['-r', f'{GATEWAY}:__node:={role}_gateway']
 
 
 def imager_argv(config: LoopConfig, ros_args: list) -> list:
@@ -254,11 +265,14 @@ def teleop_endpoints(config: LoopConfig) -> dict:
     reports = {DIAGNOSTICS: (0, 1)} if config.record else {}
     command, feedback = absolute(TELEOP_COMMAND), absolute(TELEOP_FEEDBACK)
     imaged = config.imaging
+    # What crosses is a DDS endpoint at a site unless its gateway hands it over in the process.
+    crossing = 0 if config.gateway_in_process and config.intra_process else 1
     return {
-        config.domain_id: {absolute(WAND_POSE): (1, site + recording), command: (1, 1),
-                           feedback: (1, 1 + recording), **reports,
+        config.domain_id: {absolute(WAND_POSE): (1, site + recording), command: (1, crossing),
+                           feedback: (1, crossing * (1 + recording)), **reports,
                            **({IMAGE: (1, int(bool(config.record)))} if imaged else {})},
-        config.remote_domain_id: {command: (1, 1 + recording), feedback: (1, 1),
+        config.remote_domain_id: {command: (1, crossing * (1 + recording)),
+                                  feedback: (1, crossing),
                                   absolute(ROBOT_TARGET_POSE): (1, site),
                                   absolute(ROBOT_TCP_POSE): (1, site + recording + imaged),
                                   absolute(ROBOT_FT_WRENCH): (1, site + recording), **reports,
@@ -368,18 +382,27 @@ class Loop:
         The operator's site starts its scan as soon as its own loop closes, robot or not, so it
         starts once the remote site is up (under load, the remote site took seconds longer).
         """
-        from haptic_bringup.site import loopback_gateways  # site.py builds on this module
+        from haptic_bringup.site import gateway_argv, loopback_gateway_files  # builds on this
         config = self.config
         remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
+        gateways = loopback_gateway_files(self.run_dir, link=config.link,
+                                          priority=priority_parameters(config))
+
+        def site_args(role: str) -> list:
+            in_process = [*gateway_remap(role), '--params-file', str(gateways[role])]
+            return [*ros_args, *(in_process if config.gateway_in_process else [])]
         self.children.append(start_child(
-            'remote', self._composed(site_nodes(config, 'remote'), ros_args), remote_env))
+            'remote', self._composed(site_nodes(config, 'remote'), site_args('remote')),
+            remote_env))
         self._start_imager(ros_args, remote_env)
-        self.children += loopback_gateways(self.run_dir, config.python, env, remote_env,
-                                           link=config.link,
-                                           priority=priority_parameters(config))
+        if not config.gateway_in_process:
+            self.children += [start_child(f'{role}_gateway', gateway_argv(
+                config.python, role, gateways[role]), role_env)
+                for role, role_env in (('remote', remote_env), ('operator', env))]
         self._wait_for_discovery(config.remote_domain_id)
         self.children.insert(0, start_child(  # the operator's stops first
-            'operator', self._composed(site_nodes(config, 'operator'), ros_args), env))
+            'operator', self._composed(site_nodes(config, 'operator'), site_args('operator')),
+            env))
 
     def _start_imager(self, ros_args: list, env: dict) -> None:
         """Start the remote site's imager, a process of its own, if the session images."""

@@ -30,9 +30,9 @@ from typing import Optional
 
 import yaml
 
-from haptic_bringup.launcher import (add_run_arguments, link_parameters, Loop, LoopConfig,
-                                     node_parameters, priority_parameters, site_nodes,
-                                     teleop_endpoints)
+from haptic_bringup.launcher import (add_run_arguments, gateway_remap, link_parameters, Loop,
+                                     LoopConfig, node_parameters, priority_parameters,
+                                     site_nodes, teleop_endpoints)
 from haptic_bringup.processes import run_until_stopped, start_child
 from haptic_contract.graph import FRAME_TOPICS, RELIABLE_CROSSINGS, TO_OPERATOR, TO_REMOTE
 from haptic_contract.teleop import Scheme, SCHEMES
@@ -102,22 +102,28 @@ def loopback_gateway_parameters(folder: pathlib.Path, *, link: Optional[dict] = 
             for role, side in (('remote', 'listen'), ('operator', 'connect'))}
 
 
-def loopback_gateways(run_dir: pathlib.Path, python: str, env: dict, remote_env: dict, *,
-                      link: Optional[dict] = None, routes: Optional[dict] = None,
-                      priority: Optional[dict] = None) -> list:
-    """Start both sites' gateways on this machine (``loopback_gateway_parameters``).
+def loopback_gateway_files(run_dir: pathlib.Path, *, link: Optional[dict] = None,
+                           routes: Optional[dict] = None,
+                           priority: Optional[dict] = None) -> dict:
+    """Write both sites' gateway parameters for one machine; return role → parameters file.
 
-    ``priority`` (``priority_parameters``) sets their ``thread_priority``, if it holds one.
+    See ``loopback_gateway_parameters``. ``priority`` (``priority_parameters``) sets their
+    ``thread_priority``, if it holds one.
     """
-    gateways = []
-    parameters = loopback_gateway_parameters(run_dir, link=link, routes=routes)
-    for role, role_env in (('remote', remote_env), ('operator', env)):
-        params = run_dir / f'{role}_gateway.yaml'
-        params.write_text(yaml.safe_dump({f'{role}_gateway': {
-            'ros__parameters': {**parameters[role], **(priority or {})}}}))
-        gateways.append(start_child(f'{role}_gateway', gateway_argv(python, role, params),
-                                    role_env))
-    return gateways
+    files = {}
+    for role, values in loopback_gateway_parameters(run_dir, link=link, routes=routes).items():
+        files[role] = run_dir / f'{role}_gateway.yaml'
+        files[role].write_text(yaml.safe_dump({f'{role}_gateway': {
+            'ros__parameters': {**values, **(priority or {})}}}))
+    return files
+
+
+def loopback_gateways(run_dir: pathlib.Path, python: str, env: dict, remote_env: dict, *,
+                      routes: Optional[dict] = None) -> list:
+    """Start both sites' gateways on this machine, each a process of its own."""
+    files = loopback_gateway_files(run_dir, routes=routes)
+    return [start_child(f'{role}_gateway', gateway_argv(python, role, files[role]), role_env)
+            for role, role_env in (('remote', remote_env), ('operator', env))]
 
 
 def gateway_argv(python: str, role: str, params: pathlib.Path) -> list:
@@ -138,15 +144,18 @@ class Site(Loop):
         return site_parameters(self.site)
 
     def _start_children(self, env: dict, params: pathlib.Path) -> None:
-        """Start this site's process, its imager if it images, and its gateway."""
+        """Start this site's process (with its gateway), and its imager if it images."""
         site, config = self.site, self.config
         ros_args = ['--ros-args', '--params-file', str(params)]
+        in_process = gateway_remap(site.role) if config.gateway_in_process else []
         self.children.append(start_child(
-            site.role, self._composed(site_nodes(config, site.role), ros_args), env))
+            site.role, self._composed(site_nodes(config, site.role), [*ros_args, *in_process]),
+            env))
         if site.role == 'remote':
             self._start_imager(ros_args, env)
-        self.children.append(start_child('gateway', gateway_argv(config.python, site.role, params),
-                                         env))
+        if not config.gateway_in_process:
+            self.children.append(start_child(
+                'gateway', gateway_argv(config.python, site.role, params), env))
 
     def _wait_until_up(self) -> None:
         """Wait for this site's own endpoints: the other site may not be there yet."""
@@ -214,11 +223,13 @@ def main(argv=None) -> int:
         'connecting to ' + ', '.join(args.connect)
 
     def why(ended) -> str:
+        """Say why the site stopped: its process ends by itself (0) only when its session does."""
         if ended is None:
             return 'stopped'
-        if ended.returncode == 0 and ended.name in ('gateway', args.role):
-            return 'the other site stopped' if ended.name == 'gateway' else 'the experiment ended'
-        return f'{ended.name} exited'
+        if ended.returncode != 0 or ended.name != args.role:
+            return f'{ended.name} exited'
+        return 'the experiment ended, or the other site stopped' if args.role == 'operator' \
+            else 'the other site stopped'
 
     return run_until_stopped(
         site, 'haptic_site', lambda: f'{args.role} site up in {site.startup_time:.2f} s (domain '

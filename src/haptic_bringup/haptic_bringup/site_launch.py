@@ -4,11 +4,12 @@
     ros2 launch haptic_bringup operator_site.launch.py endpoint:=tls/HOST:7447 certs:=DIR
 
 The same site as ``haptic_site`` starts (``haptic_bringup.site``), with the same parameters: the
-site's nodes in one process, its gateway, with ``record:=`` its own bag, and with ``imaging:=true``
-the remote site's imager in a process of its own (the operator's records it). The remote site
-listens on ``endpoint``, the operator's connects to it. The site stands or falls together: when its
-gateway exits because the other site stopped, or the operator's experiment ends, the launch stops
-the rest. Imported by the launch files only (``launch`` comes with a full install).
+site's nodes and its gateway in one process, with ``record:=`` its own bag, and with
+``imaging:=true`` the remote site's imager in a process of its own (the operator's records it).
+The remote site listens on ``endpoint``, the operator's connects to it. The site stands or falls
+together: when its process exits because the other site stopped, or the operator's experiment
+ends, the launch stops the rest. Imported by the launch files only (``launch`` comes with a full
+install).
 """
 import os
 import pathlib
@@ -21,7 +22,7 @@ from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, imager, local_discovery
-from haptic_bringup.launcher import LoopConfig, site_nodes
+from haptic_bringup.launcher import gateway_remap, LoopConfig, site_nodes
 from haptic_bringup.site import site_parameters, SiteConfig
 from haptic_contract.teleop import SCHEMES
 
@@ -72,11 +73,9 @@ def _processes(context, role: str):
         yaml.safe_dump(site_parameters(site), out)
     parameters = str(pathlib.Path(out.name))
     together = AllOrNothing()
-    actions = together.add(role, Node(  # its recorder, if any, in its process
+    actions = together.add(role, Node(  # its gateway and its recorder, if any, in its process
         package='haptic_bringup', executable='composed',
-        arguments=list(site_nodes(site.loop, role)), parameters=[parameters], output='screen'))
-    actions += together.add('gateway', Node(
-        package='site_gateway', executable='site_gateway', name=f'{role}_gateway',
+        arguments=list(site_nodes(site.loop, role)), ros_arguments=gateway_remap(role),
         parameters=[parameters], output='screen'))
     if role == 'remote' and site.loop.imaging:
         actions += together.add('probe_imager', imager(parameters))

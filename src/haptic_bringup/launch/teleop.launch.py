@@ -8,13 +8,14 @@
 The operator's site (``wand_driver`` and ``teleop_leader``, one process) runs in the launch's
 ``ROS_DOMAIN_ID``; the remote site (``sim_robot`` and ``teleop_follower``, one process) in
 ``remote_domain`` (default: the next domain), with ``imaging:=true`` the probe's imager
-(``probe_imager``, a process of its own) beside it; both sites' gateways join them over loopback
-mutual TLS with certificates made for the launch, the deployed path, each emulating the link on
-what it sends (``haptic_bringup.site.loopback_gateway_parameters``). ``record:=DIR`` has each
-site's process record itself with the project's recorder, into the session folder DIR (the bags
-``operator`` and ``remote``, the remote site's topics under ``/remote/``), so a Ctrl-C to the whole
-launch loses nothing. Parameters come from each package's config/, then ``params_file``, then these
-arguments, exactly as the local launcher (``haptic_loop --teleop ...``) sets them. The session
+(``probe_imager``, a process of its own) beside it; each site's gateway, a node of its process,
+joins them over loopback mutual TLS with certificates made for the launch, the deployed path,
+each emulating the link on what it sends (``haptic_bringup.site.loopback_gateway_parameters``).
+``record:=DIR`` has each site's process record itself with the project's recorder, into the
+session folder DIR (the bags ``operator`` and ``remote``, the remote site's topics under
+``/remote/``), so a Ctrl-C to the whole launch loses nothing. Parameters come from each
+package's config/, then ``params_file``, then these arguments, exactly as the local launcher
+(``haptic_loop --teleop ...``) sets them. The session
 stands or falls together, as the loop does: when one process exits, the launch stops the others.
 """
 import os
@@ -28,7 +29,7 @@ from launch_ros.actions import Node
 import yaml
 
 from haptic_bringup.launch_actions import AllOrNothing, hear_sigint, imager, local_discovery
-from haptic_bringup.launcher import LoopConfig, node_parameters, site_nodes
+from haptic_bringup.launcher import gateway_remap, LoopConfig, node_parameters, site_nodes
 from haptic_bringup.site import loopback_gateway_parameters
 from haptic_contract.teleop import SCHEMES
 
@@ -79,23 +80,20 @@ def _processes(context):
     if config.teleop not in SCHEMES:
         raise ValueError(f"scheme:={config.teleop!r}: choose direct, tdpa or model")
     parameters = _written(node_parameters(config))
+    gateways = loopback_gateway_parameters(pathlib.Path(tempfile.mkdtemp(prefix='teleop_')),
+                                           link=config.link)
     session = AllOrNothing()
     actions = []
     for site, domain in (('operator', config.domain_id), ('remote', config.remote_domain_id)):
-        actions += session.add(site, Node(
+        gateway = _written({f'{site}_gateway': {'ros__parameters': gateways[site]}})
+        actions += session.add(site, Node(  # with its gateway, in its process
             package='haptic_bringup', executable='composed',
-            arguments=list(site_nodes(config, site)), parameters=[parameters],
-            additional_env={'ROS_DOMAIN_ID': str(domain)}, output='screen'))
+            arguments=list(site_nodes(config, site)), ros_arguments=gateway_remap(site),
+            parameters=[parameters, gateway], additional_env={'ROS_DOMAIN_ID': str(domain)},
+            output='screen'))
     if config.imaging:
         actions += session.add('probe_imager', imager(parameters, additional_env={
             'ROS_DOMAIN_ID': str(config.remote_domain_id)}))
-    gateways = loopback_gateway_parameters(pathlib.Path(tempfile.mkdtemp(prefix='teleop_')),
-                                           link=config.link)
-    for role, domain in (('remote', config.remote_domain_id), ('operator', config.domain_id)):
-        actions += session.add(f'{role}_gateway', Node(
-            package='site_gateway', executable='site_gateway', name=f'{role}_gateway',
-            parameters=[_written({f'{role}_gateway': {'ros__parameters': gateways[role]}})],
-            additional_env={'ROS_DOMAIN_ID': str(domain)}, output='screen'))
     return actions
 
 

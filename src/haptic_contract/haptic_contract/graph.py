@@ -8,7 +8,7 @@ of the loop and of the two telerobotic sites. Strings only: nothing here imports
 from typing import NamedTuple
 
 __all__ = ['COLLISION_MARKERS', 'COLLISION_NEARBY', 'COLLISION_STATE', 'DIAGNOSTICS',
-           'EXECUTABLES', 'FRAME_TOPICS', 'IMAGER', 'LATCHED_TOPICS', 'LOOP_RECORDER',
+           'EXECUTABLES', 'FRAME_TOPICS', 'GATEWAY', 'IMAGER', 'LATCHED_TOPICS', 'LOOP_RECORDER',
            'LOOP_TOPICS', 'NodeEntry', 'NODES', 'OPERATOR_RECORDED', 'OPERATOR_RECORDER',
            'OPERATOR_SITE', 'PROBE_IMAGE', 'PUBLISHERS', 'RECORDERS', 'RELIABLE_CROSSINGS',
            'RELIABLE_TOPICS', 'REMOTE_PREFIX', 'REMOTE_RECORDED', 'REMOTE_RECORDER', 'REMOTE_SITE',
@@ -106,18 +106,22 @@ TELEOP_NODES = {
     'sim_robot': NodeEntry('robot_site', 'robot_site.robot_node', 'SimulatedRobotNode'),
     'teleop_follower': NodeEntry('robot_site', 'robot_site.follower_node', 'FollowerNode'),
     'probe_imager': NodeEntry('ultrasound_sim', 'ultrasound_sim.node', 'ProbeImagerNode'),
+    'site_gateway': NodeEntry('site_gateway', 'site_gateway.gateway', 'GatewayNode'),
 }
 # Each node's executable in its package (``ros2 run``, the launch files), by node name.
 EXECUTABLES = {'wand_driver': 'wand_driver', 'collision_engine': 'collision_node',
                'force_renderer': 'force_node', 'teleop_leader': 'teleop_leader',
                'sim_robot': 'sim_robot', 'teleop_follower': 'teleop_follower',
-               'probe_imager': 'probe_imager'}
+               'probe_imager': 'probe_imager', 'site_gateway': 'site_gateway'}
 # Each telerobotic site is one process. The remote site's ultrasound scanner, when the session
 # images, is a process of its own beside it: in the robot's, its frames held the robot's 1 kHz
 # loop back for the GIL.
 OPERATOR_SITE = ('wand_driver', 'teleop_leader')
 REMOTE_SITE = ('sim_robot', 'teleop_follower')
 IMAGER = 'probe_imager'
+# Each site's gateway to the other: in its site's process, under its role's name
+# (``<role>_gateway``); or, the baseline, a process of its own.
+GATEWAY = 'site_gateway'
 # The recorder in each kind of process (haptic_bringup.process_recorder), by its node name.
 RECORDERS = LOOP_RECORDER, OPERATOR_RECORDER, REMOTE_RECORDER = (
     'recorder', 'operator_recorder', 'remote_recorder')

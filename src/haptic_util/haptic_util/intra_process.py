@@ -41,8 +41,8 @@ from haptic_util.polled_reader import PolledReader
 from haptic_util.qos import HAPTIC_STREAM_QOS, LINK_INTAKE_RATE, LINK_QOS
 from haptic_util.tally import Tally
 
-__all__ = ['close', 'enable', 'link_subscription', 'stream_publisher', 'stream_subscription',
-           'StreamPublisher', 'StreamSubscription']
+__all__ = ['close', 'enable', 'enabled', 'link_subscription', 'stream_publisher',
+           'stream_subscription', 'StreamPublisher', 'StreamSubscription']
 
 _state = {'enabled': False}
 _topics: dict = {}  # resolved topic -> _Topic, while enabled
@@ -54,6 +54,11 @@ _polled: list = []  # every PolledReader made, destroyed by ``close``
 def enable() -> None:
     """Hand streams between this process's nodes over in the process (call before making them)."""
     _state['enabled'] = True
+
+
+def enabled() -> bool:
+    """Whether streams are handed over in this process (a composed process's nodes)."""
+    return _state['enabled']
 
 
 def close() -> None:

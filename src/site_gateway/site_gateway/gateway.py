@@ -18,6 +18,16 @@ When the other site's gateway stops, it says so (``routes.bye_key``), and this o
 (exit 0), so that a site launcher can stop its site cleanly. A connection that is merely lost
 says nothing, and the gateway waits for it.
 
+In a site's own process (``haptic_bringup.composed ... site_gateway``, with intra-process
+delivery), the 1 kHz streams cross without DDS on this side: what the site's nodes publish is
+taken in the process (``haptic_util.intra_process``) and encoded to the same CDR bytes, and what
+comes from the other site waits in Zenoh (a ring of the newest, ``HANDOVER_DEPTH``) until a
+timer of the site's executor judges it and hands it to the site's nodes, at most
+``LINK_INTAKE_RATE`` a second, as the follower reads the link (``haptic_util.polled_reader``).
+No Python runs in Zenoh's threads for a stream then, and a DDS stranger's stream in the site's
+domain is never read. Frames and reliable crossings go through DDS either way. As a process
+of its own, the gateway is the baseline ``bench/bench_link.py`` measures it against.
+
 Zenoh's own log (its refusals of a TLS peer: another CA, no certificate, plaintext) goes to
 standard output, at ``warn`` unless ``RUST_LOG`` says otherwise. The gateway reports its counts
 on ``/diagnostics`` at 1 Hz and logs what it refused, with the role that sent it, once a second.
@@ -25,6 +35,7 @@ on ``/diagnostics`` at 1 Hz and logs what it refused, with the role that sent it
 from dataclasses import dataclass
 import functools
 import json
+import math
 import os
 import time
 
@@ -36,17 +47,21 @@ from rclpy.validate_full_topic_name import validate_full_topic_name
 import zenoh
 
 from haptic_contract.graph import absolute, TELEOP_COMMAND, TELEOP_FEEDBACK, TOPIC_TYPES
+from haptic_util import intra_process
 from haptic_util.callback_errors import log_callback_error
+from haptic_util.cdr import MessageCodec
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import request_stop, run_nodes, StartupError
 from haptic_util.parameters import declare_parameters, parameter, RealtimeParams
-from haptic_util.qos import FRAME_QOS, LINK_QOS
+from haptic_util.polled_reader import TICK
+from haptic_util.qos import FRAME_QOS, LINK_INTAKE_RATE, LINK_QOS
 from haptic_util.transport import loopback_udp
 from link_emulator.link_stage import emulated_link, ReleaseTimer
 from link_emulator.params import LinkStageParams
 from link_emulator.relay import message_class, Relay
 from site_gateway.inbound import Inbound
-from site_gateway.routes import bye_key, FRAME, other_role, RELIABLE, ROLES, site_routes
+from site_gateway.routes import (bye_key, FRAME, other_role, RELIABLE, ROLES, site_routes,
+                                 STREAM)
 from site_gateway.zenoh_config import (check_endpoints, Credentials, LEASE, publisher_options,
                                        session_config)
 
@@ -66,6 +81,10 @@ ZENOH_RUNTIME = '(rx: (worker_threads: 1), net: (handover: rx), acc: (handover: 
 INSECURE_WARNING = ('INSECURE: plaintext, no authentication and no access control: anyone who '
                     'reaches this endpoint can read the session and command the robot. Use it '
                     'only on a network you control end to end; mutual TLS is the default.')
+# An incoming stream in the site's process: the newest messages Zenoh holds between two
+# handovers (as the link's DDS history holds them), and how many a handover takes at most.
+HANDOVER_DEPTH = LINK_QOS.depth
+HANDOVER_LIMIT = math.ceil(LINK_INTAKE_RATE * TICK)
 RELIABLE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                           reliability=ReliabilityPolicy.RELIABLE)
 
@@ -203,16 +222,15 @@ class GatewayNode(Node):
         self._passed = 0
         on_message = (ReleaseTimer(self._relay, self, self._put).on_message if self._emulated
                       else self._put_now)
+        in_process = intra_process.enabled()
         for index, crossing in enumerate(routes.outgoing):
-            self.create_subscription(message_class(crossing.route.type_name),
-                                     crossing.route.topic, functools.partial(on_message, index),
-                                     _qos(crossing.kind), raw=True)
-        self._into_dds = [self.create_publisher(message_class(c.route.type_name), c.route.topic,
-                                                _qos(c.kind)) for c in routes.incoming]
-        self._listeners = [
-            self.session.declare_subscriber(c.any_role_key(self._prefix),
-                                            functools.partial(self._on_sample, index))
-            for index, c in enumerate(routes.incoming)]
+            self._take(crossing, functools.partial(on_message, index),
+                       in_process and crossing.kind == STREAM)
+        self._into_dds, self._handovers, self._listeners = {}, [], []
+        for index, crossing in enumerate(routes.incoming):
+            self._hand_on(index, crossing, in_process and crossing.kind == STREAM)
+        if self._handovers:
+            self.create_timer(TICK, self._hand_over)
         self._listeners.append(self.session.declare_subscriber(
             bye_key(self._prefix, other_role(self._role)), self._on_bye))
         self._links = self.session.info.declare_link_events_listener(self._on_link,
@@ -227,6 +245,48 @@ class GatewayNode(Node):
             f'out: {[c.topic for c in routes.outgoing]}, in: '
             f'{[c.topic for c in routes.incoming]}; outgoing link: delay {trace}, jitter '
             f'{params.jitter:g} s, loss {params.loss:g}, reorder {params.reorder}')
+
+    def _take(self, crossing, send, in_process: bool) -> None:
+        """Take what this site publishes of ``crossing`` to ``send``, as its CDR bytes."""
+        msg_type = message_class(crossing.route.type_name)
+        if not in_process:
+            self.create_subscription(msg_type, crossing.route.topic, send,
+                                     _qos(crossing.kind), raw=True)
+            return
+        codec = MessageCodec(msg_type)
+        intra_process.stream_subscription(
+            self, codec, crossing.route.topic, lambda values: send(codec.encode(values)),
+            refused=self._inbound.refused, qos=_qos(crossing.kind))
+
+    def _hand_on(self, index: int, crossing, in_process: bool) -> None:
+        """Hand what the other site publishes of ``crossing`` on: in the process, or into DDS."""
+        key = crossing.any_role_key(self._prefix)
+        msg_type = message_class(crossing.route.type_name)
+        if in_process:
+            listener = self.session.declare_subscriber(
+                key, zenoh.handlers.RingChannel(HANDOVER_DEPTH))
+            publisher = intra_process.stream_publisher(self, MessageCodec(msg_type),
+                                                       crossing.route.topic)
+            self._handovers.append((index, listener, publisher))
+        else:
+            self._into_dds[index] = self.create_publisher(msg_type, crossing.route.topic,
+                                                          _qos(crossing.kind))
+            listener = self.session.declare_subscriber(
+                key, functools.partial(self._on_sample, index))
+        self._listeners.append(listener)
+
+    def _hand_over(self) -> None:
+        """Judge what Zenoh holds of each incoming stream; hand it to the site's nodes."""
+        now = time.monotonic()
+        for index, listener, publisher in self._handovers:
+            for _ in range(HANDOVER_LIMIT):
+                sample = listener.try_recv()
+                if sample is None:
+                    break
+                verdict = self._inbound.judge(now, index, str(sample.key_expr),
+                                              sample.payload.to_bytes())
+                if verdict.deliver:
+                    publisher.publish(verdict.values)
 
     def _put(self, route: int, data: bytes) -> None:
         self._outgoing[route].put(data)

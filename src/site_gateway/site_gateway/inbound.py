@@ -11,7 +11,7 @@ callback. So the gateway hands on a message only if:
 - its crossing is within ``max_rate`` (a token bucket with ``BURST`` s of tokens): an
   authenticated peer's flood is shed here, not queued into the site.
 """
-from typing import NamedTuple
+from typing import NamedTuple, Sequence
 
 from haptic_util.cdr import MalformedMessage, MessageCodec
 from haptic_util.tally import Tally
@@ -24,11 +24,12 @@ BURST = 0.05  # [s] of messages at max_rate that may come at once (a jittery lin
 
 
 class Verdict(NamedTuple):
-    """Whether to hand a message on; else the kind of refusal and who sent it."""
+    """Whether to hand a message on, and its leaf values; else the refusal and who sent it."""
 
     deliver: bool
     refusal: str = ''
     sender: str = ''
+    values: Sequence = ()
 
 
 class _Bucket:
@@ -87,11 +88,11 @@ class Inbound:
         if not self._buckets[index].take(now):
             return self._refuse(f'{crossing.topic} over max_rate', sender)
         try:
-            self._codecs[index].decode(data)
+            values = self._codecs[index].decode(data)
         except MalformedMessage as error:
             return self._refuse(f'malformed {crossing.topic}', sender, str(error))
         self.delivered[index] += 1
-        return Verdict(True, sender=sender)
+        return Verdict(True, sender=sender, values=values)
 
     def _refuse(self, kind: str, sender: str, detail: str = '') -> Verdict:
         self.refused.add(kind, detail)
