@@ -265,13 +265,16 @@ def _teleop_chapter(findings: Findings) -> list[str]:
     parts += _stored(findings, 'teleop_scan', lambda rows: [
         teleop_section([{**r, 'source': 'ROS 2'} for r in rows]), '', *figure])
     parts += ['### The link between the sites', '',
-              'The deployed path, DDS to the operator\'s gateway, Zenoh over mutual TLS, the '
-              'remote gateway and DDS, and back, at 1 kHz and no emulated delay, beside its '
-              'floor: the same two processes exchanging the same bytes as UDP datagrams on the '
-              'same loopback, and between them the same two processes over Zenoh sessions of '
-              'their own with the gateways\' settings (no DDS, no gateway process: the least a '
-              'gateway in the sites\' own processes could add), alternated in one run '
-              '(`bench/bench_link.py`).', '']
+              'A 1 kHz ping and its echo between two sites, at no emulated delay, on four '
+              'paths alternated in one run (`bench/bench_link.py`): the floor, the same two '
+              'processes exchanging the same bytes as UDP datagrams on the same loopback; the '
+              'same two processes over Zenoh sessions of their own with the gateways\' '
+              'settings (no DDS, no gateway: the least a gateway could add); the gateways as '
+              'processes of their own, DDS to the operator\'s gateway, Zenoh over mutual TLS, '
+              'the remote gateway and DDS, and back (the baseline); and the deployed path, each '
+              'gateway a node of its site\'s process, the ping and the echo handed to it and '
+              'from it in the process. The echo\'s CPU is its process\'s: with the deployed '
+              'path, the remote site\'s gateway is in it.', '']
     parts += _stored(findings, 'link', lambda stored: [link_section(stored), ''])
     parts += ['### On a busy machine', '',
               'The issue\'s command, `haptic_loop --teleop SCHEME --delay 0.1 --jitter 0.01 '

@@ -435,14 +435,17 @@ def teleop_load_section(rows: list) -> str:
 
 
 def link_section(stored: dict) -> str:
-    """Tabulate the round trip over plain UDP, Zenoh alone and the gateways; the loss; the CPU."""
+    """Tabulate the round trip over plain UDP, Zenoh alone and both gateway layouts; the loss;
+    the CPU."""
     def median(case: str, key: str) -> float:
         return float(np.median([run[key] for run in stored['runs'][case]]))
     summary = stored['summary']
     quantiles = ('p50', 'p99', 'p99.9')
     paths = {'floor': 'plain UDP (the floor)', 'zenoh': 'Zenoh alone, between the end processes',
-             'gateways': 'the gateways (deployed)'}
-    added_by = {'zenoh': 'Zenoh alone', 'gateways': 'the gateways'}
+             'gateways': 'the gateways as processes of their own (the baseline)',
+             'in_process': "the gateways in the sites' processes (deployed)"}
+    added_by = {'zenoh': 'Zenoh alone', 'gateways': 'the gateway processes',
+                'in_process': "the gateways in the sites' processes"}
     rows = [[paths[case], *(f'{median(case, f"{q}_ms"):.3f}' for q in quantiles),
              f'{sum(r["lost"] for r in stored["runs"][case])} of '
              f'{sum(r["sent"] for r in stored["runs"][case])}'] for case in paths]

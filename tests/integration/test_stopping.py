@@ -198,9 +198,9 @@ def test_a_ctrl_c_stops_every_process_of_haptic_loop_within_2_s_with_a_core_hogg
     assert launcher.returncode == 0, out + (tmp_path / 'stderr').read_text()
     stopped = out.split('haptic_loop: stopped (')[1].split(')')[0]
     assert all(part.endswith(': 0') for part in stopped.split(', ')), stopped
-    # The launcher and its children: the composed loop, recording in itself; or both sites and
-    # their two gateways.
-    assert len(processes) == (5 if teleop else 2), processes
+    # The launcher and its children: the composed loop, recording in itself; or both sites, each
+    # with its gateway and its recorder.
+    assert len(processes) == (3 if teleop else 2), processes
     assert max(took.values()) <= STOP_LIMIT, took
 
 
