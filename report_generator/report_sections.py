@@ -435,8 +435,7 @@ def teleop_load_section(rows: list) -> str:
 
 
 def link_section(stored: dict) -> str:
-    """Tabulate the round trip over plain UDP, Zenoh alone and both gateway layouts; the loss;
-    the CPU."""
+    """Tabulate the round trip over UDP, Zenoh alone and both gateway layouts, loss and CPU."""
     def median(case: str, key: str) -> float:
         return float(np.median([run[key] for run in stored['runs'][case]]))
     summary = stored['summary']

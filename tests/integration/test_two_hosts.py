@@ -322,9 +322,9 @@ def test_a_flood_with_the_operator_s_certificate_is_shed_and_the_remote_site_kee
     0.90 and 0.91 of its rate in two runs on a slow 2-core machine (0.55-0.69 in four with the
     robot at normal scheduling too). The flooder stands for another host, so it runs at nice 19:
     on this machine it takes mostly the time the two sites leave (about 19 kHz reached the
-    remote gateway, with a core hogged or not). (The gateway's bucket is per topic, not per publisher: the flood crowds
-    the true operator's commands out with it, and the robot may hold and draw back meanwhile, as
-    on a silent link.)
+    remote gateway, with a core hogged or not). (The gateway's bucket is per topic, not per
+    publisher: the flood crowds the true operator's commands out with it, and the robot may hold
+    and draw back meanwhile, as on a silent link.)
     """
     folder, flood = session['folder'], session['flood']
     assert flood.returncode == 0, flood.stderr[-2000:]

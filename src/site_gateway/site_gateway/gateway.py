@@ -26,8 +26,9 @@ timer of the site's executor judges it and hands it to the site's nodes, at most
 ``LINK_INTAKE_RATE`` a second, as the follower reads the link (``haptic_util.polled_reader``).
 No Python runs in Zenoh's threads for a stream then, and a DDS stranger's stream in the site's
 domain is never read. What a flood brings beyond the ring between two handovers Zenoh drops
-unread, the oldest first, and no count says how much (the counts are of what was judged). Frames and reliable crossings go through DDS either way. As a process
-of its own, the gateway is the baseline ``bench/bench_link.py`` measures it against.
+unread, the oldest first, and no count says how much (the counts are of what was judged).
+Frames and reliable crossings go through DDS either way. As a process of its own, the gateway
+is the baseline ``bench/bench_link.py`` measures it against.
 
 Zenoh's own log (its refusals of a TLS peer: another CA, no certificate, plaintext) goes to
 standard output, at ``warn`` unless ``RUST_LOG`` says otherwise. The gateway reports its counts
