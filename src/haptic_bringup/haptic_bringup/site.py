@@ -6,8 +6,9 @@
 
 The operator's site runs the wand driver and the leader (one process), the remote site the robot
 and the follower (one process; with ``--imaging``, the probe's imager in another), each in its own
-DDS domain on its own machine, with local-only discovery; only the site gateway (``site_gateway``)
-talks to the other site, over one mutual-TLS Zenoh connection. ``--certs`` is the folder of this
+DDS domain on its own machine, with local-only discovery; only the site's gateway
+(``site_gateway``, a node of the site's process) talks to the other site, over one mutual-TLS
+Zenoh connection. ``--certs`` is the folder of this
 site's files from ``haptic_certs`` (``ca.pem``, ``<role>.pem``, ``<role>.key``); ``--insecure``
 runs plaintext instead, and the gateway warns at every start. Both sites must run the same
 ``--scheme``.
@@ -15,8 +16,8 @@ runs plaintext instead, and the gateway warns at every start. Both sites must ru
 real network (none by default).
 
 A site waits for its own nodes and gateway, then runs until Ctrl-C, the end of the operator's
-experiment, or the other site stopping (its gateway says so, and this one's then exits), and
-stops its processes. With ``--record DIR`` its process records itself into ``DIR/<role>``. A
+experiment, or the other site stopping (its gateway says so, and this one's then ends its
+process), and stops its processes. With ``--record DIR`` its process records itself into ``DIR/<role>``. A
 connection that is lost is waited for: the nodes' watchdogs keep the patient safe meanwhile,
 and the session goes on when it returns. On a full ROS 2 install, ``operator_site.launch.py``
 and ``remote_site.launch.py`` do the same.
