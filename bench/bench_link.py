@@ -18,8 +18,7 @@ domain) sends each back at once on every path. The cases alternate within one in
 share the machine's state; each figure is given beside its floor, and as the round trip added
 over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's CPU, and the
 echo's (with its gateway, when it is in the echo's process), is read from outside (psutil) over
-the measured window, in % of one core. No emulated
-delay: the stage passes messages straight on.
+the measured window, in % of one core. No emulated delay: the stage passes messages straight on.
 """
 import argparse
 import os
@@ -330,7 +329,8 @@ def main(argv=None) -> int:
     parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
     parser.add_argument('--runs', type=int, default=1, help='alternated rounds of the cases')
     parser.add_argument('--rate', type=float, default=1000.0, help='[Hz] pings')
-    ros_domain.add_option(parser, help="the operator's side; the echo's is the next")
+    ros_domain.add_option(parser, help="the operator's side; the echo's is the next, and the "
+                          "two sites with their gateways in them the two after")
     result_files.add_option(parser)
     args = parser.parse_args(argv[1:])
     ros_domain.keep_local()
