@@ -32,45 +32,23 @@ workstation is never idle). The load average is printed with each run: the machi
 and only the ratios of runs side by side are figures.
 """
 import argparse
-import os
 import pathlib
 import sys
 import tempfile
 
 from bench import machine, result_files, ros_domain
+from bench.scan_streams import (in_window, LINK, rate, scan, stream_ratios, TARGETS,
+                                total_cpu, WINDOW)
 from bench.teleop_load import loaded
-from bench.teleop_scan import process_cpu
 import numpy as np
-from rosbags.highlevel import AnyReader
 
 from haptic_bringup.bag import typestore_with
-from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
-from haptic_bringup.session import bags, read_frames, read_session_start, read_vectors, reported
+from haptic_bringup.session import read_frames, reported
 
 __all__ = ['label', 'main', 'run', 'summary']
 
-LINK = {'delay': 0.05, 'jitter': 0.005, 'loss': 0.01}  # as the demo's scan
-WINDOW = (3.0, 15.0)  # [s] after the session's start: the press and the sweep
-TARGETS = {'rate': 0.99, 'answered': 0.99, 'p99': 1.1}
-STAMPED = {'/wand/pose': 'pose', '/remote/robot/tcp_pose': 'pose'}
-CROSSED = ('/remote/teleop/command', '/teleop/feedback')  # recorded where they arrived
 OFF, IDLE = 'off', 'idle'  # the baseline; the imager's frame thread under SCHED_IDLE
-
-
-def _in_window(times: np.ndarray, start: float) -> np.ndarray:
-    return times[(times >= start + WINDOW[0]) & (times < start + WINDOW[1])]
-
-
-def _rate(times: np.ndarray) -> float:
-    return len(times) / (WINDOW[1] - WINDOW[0])
-
-
-def _received(bag: pathlib.Path, topic: str) -> np.ndarray:
-    """When the recorder received each message of ``topic`` (s), without decoding it."""
-    with AnyReader(bags(bag)) as reader:
-        connections = [c for c in reader.connections if c.topic == topic]
-        return np.array([t * 1e-9 for _, t, _ in reader.messages(connections=connections)])
 
 
 def imager_parameters(variant: str) -> dict:
@@ -86,51 +64,24 @@ def run(variant: str, priority: int, domain_id: int) -> dict:
     imaging = variant != OFF
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
-        stats = folder / 'loop_stats.npz'
-        overrides = {'wand_driver': {'stats_file': str(stats)}}
+        row, start = scan(folder, domain_id, imaging=imaging, thread_priority=priority,
+                          overrides={'probe_imager': imager_parameters(variant)} if imaging
+                          else {})
+        row.update({'imaging': imaging, 'variant': variant, 'thread_priority': priority})
         if imaging:
-            overrides['probe_imager'] = imager_parameters(variant)
-        config = LoopConfig(teleop='model', link=dict(LINK), record=str(folder / 'bag'),
-                            domain_id=domain_id, run_dir=folder / 'launch', imaging=imaging,
-                            overrides=overrides, thread_priority=priority)
-        with Loop(config) as loop:
-            cpu = process_cpu(loop)
-            if loop.wait(60.0) is None:
-                raise RuntimeError('the scan did not end')
-        typestore = typestore_with(custom_definitions())
-        bag = folder / 'bag'
-        stamped = read_vectors(bag, typestore, STAMPED, stamped=True)
-        received = {topic: _received(bag, topic) for topic in CROSSED}
-        start = read_session_start(bag, typestore)
-        ticks = np.diff(_in_window(stamped['/remote/robot/tcp_pose'][0], start))
-        loop_stats = np.load(stats)
-        row = {'imaging': imaging, 'variant': variant, 'thread_priority': priority,
-               'load': os.getloadavg()[0],
-               'operator_rate_hz': float(loop_stats['rate_hz']),
-               'operator_answered_percent': float(loop_stats['answered_percent']),
-               'operator_round_trip_p99_s': float(loop_stats['latency_p99_s']),
-               'robot_rate_hz': _rate(_in_window(stamped['/remote/robot/tcp_pose'][0], start)),
-               'robot_tick_p99_s': float(np.percentile(ticks, 99)),
-               'commands_hz': _rate(_in_window(received['/remote/teleop/command'], start)),
-               'feedback_hz': _rate(_in_window(received['/teleop/feedback'], start)),
-               'cpu_percent': cpu}
-        if imaging:
-            frames = read_frames(bag, typestore)
+            typestore = typestore_with(custom_definitions())
+            frames = read_frames(folder / 'bag', typestore)
             shown = (frames.stamp >= start + WINDOW[0]) & (frames.stamp < start + WINDOW[1])
             latency = (frames.received - frames.stamp)[shown]
-            said = {key: reported(bag, typestore, key).get('probe_imager', ['nan'])[-1]
+            said = {key: reported(folder / 'bag', typestore, key).get('probe_imager',
+                                                                      ['nan'])[-1]
                     for key in ('pose_to_publication_p99_s', 'frame_cpu_p50_s')}
-            row.update({'frames_hz': _rate(frames.stamp[shown]),
+            row.update({'frames_hz': rate(in_window(frames.stamp, start)),
                         'pose_to_image_p50_s': float(np.percentile(latency, 50)),
                         'pose_to_image_p99_s': float(np.percentile(latency, 99)),
                         'pose_to_publication_p99_s': float(said['pose_to_publication_p99_s']),
                         'frame_cpu_p50_s': float(said['frame_cpu_p50_s'])})
     return row
-
-
-def _cpu(row: dict) -> float:
-    """Return the CPU of all the run's processes, % of one core."""
-    return sum(row['cpu_percent'].values())
 
 
 def label(variant: str, priority: int) -> str:
@@ -158,16 +109,12 @@ def summary(rows: list, variant: str, priority: int) -> dict:
     def median(runs, key):
         return float(np.median([r[key] for r in runs]))
 
-    ratios, ranges = {}, {}
-    for key in ('operator_rate_hz', 'operator_answered_percent', 'operator_round_trip_p99_s',
-                'robot_rate_hz', 'robot_tick_p99_s', 'commands_hz', 'feedback_hz'):
-        each = [a[key] / b[key] for a, b in pairs]
-        ratios[key], ranges[key] = float(np.median(each)), (min(each), max(each))
-    added = float(np.median([_cpu(a) - _cpu(b) for a, b in pairs]))
+    ratios, ranges = stream_ratios(pairs)
+    added = float(np.median([total_cpu(a) - total_cpu(b) for a, b in pairs]))
     frames_hz = median(on, 'frames_hz')
     return {'pairs': len(pairs), 'ratios': ratios, 'ranges': ranges,
-            'cpu_on_percent': float(np.median([_cpu(r) for r in on])),
-            'cpu_off_percent': float(np.median([_cpu(r) for r in off])),
+            'cpu_on_percent': float(np.median([total_cpu(r) for r in on])),
+            'cpu_off_percent': float(np.median([total_cpu(r) for r in off])),
             'cpu_added_percent': added, 'frames_hz': frames_hz,
             'cpu_per_frame_s': added / 100.0 / frames_hz,
             'frame_cpu_p50_s': median(on, 'frame_cpu_p50_s'),
@@ -187,7 +134,7 @@ def _print_row(row: dict) -> None:
           f'{1e3 * row["operator_round_trip_p99_s"]:.2f} ms; robot {row["robot_rate_hz"]:.0f} '
           f'Hz, tick p99 {1e3 * row["robot_tick_p99_s"]:.2f} ms; commands '
           f'{row["commands_hz"]:.0f}/s, feedback {row["feedback_hz"]:.0f}/s; CPU '
-          f'{_cpu(row):.0f} % ('
+          f'{total_cpu(row):.0f} % ('
           + ', '.join(f'{n} {c:.0f}' for n, c in row['cpu_percent'].items())
           + f'){image}; load {row["load"]:.1f}', flush=True)
 
