@@ -1,6 +1,7 @@
 """Each site's gateway in its site's process, against the gateways as processes of their own.
 
-    .venv/bin/python bench/gateway_session.py [--pairs 3] [--hogs 1] [--json PATH]
+    .venv/bin/python bench/gateway_session.py [--pairs 3] [--hogs 1] [--thread-priority 50]
+        [--json PATH]
 
 The model-mediated scan over a 50 ms link (5 ms jitter, 1 % loss), as ``make demo`` runs it
 (``bench.scan_streams``), with the gateways in the sites' processes (``LoopConfig
@@ -9,9 +10,10 @@ alternated in one run (in, apart, then apart, in, ...): the same machine, the sa
 ``bench/bench_link.py`` measures of the link alone, this measures of a whole session: the 1 kHz
 streams, in over apart (targets: rates and answered share >= 0.99, p99 <= 1.1), and the CPU of
 every process of the session, in all and by site (a site: its process, and its gateway's when
-apart). ``--hogs N`` keeps N cores busy with other processes for the whole run. The load average
-is printed with each run: the machine is shared, and only the ratios of runs side by side are
-figures.
+apart). ``--hogs N`` keeps N cores busy with other processes for the whole run;
+``--thread-priority P`` runs the sites' processes (and the gateways') under ``SCHED_FIFO`` P.
+The load average is printed with each run: the machine is shared, and only the ratios of runs
+side by side are figures.
 """
 import argparse
 import pathlib
@@ -28,10 +30,11 @@ __all__ = ['main', 'run', 'summary']
 LAYOUTS = {True: 'in the sites', False: 'apart'}
 
 
-def run(in_process: bool, domain_id: int) -> dict:
+def run(in_process: bool, domain_id: int, priority: int = 0) -> dict:
     """One scan, its figures, with the gateways in the sites' processes or apart."""
     with tempfile.TemporaryDirectory() as tmp:
-        row, _ = scan(pathlib.Path(tmp), domain_id, gateway_in_process=in_process)
+        row, _ = scan(pathlib.Path(tmp), domain_id, gateway_in_process=in_process,
+                      thread_priority=priority or None)
     sites = {role: sum(cpu for name, cpu in row['cpu_percent'].items()
                        if name.startswith(role)) for role in ('operator', 'remote')}
     return {**row, 'gateway_in_process': in_process, 'site_cpu_percent': sites}
@@ -72,17 +75,22 @@ def main(argv=None) -> int:
                         help='groups of runs: the gateways in the sites, and apart')
     parser.add_argument('--hogs', type=int, default=0,
                         help='other processes, each keeping a core busy, for the whole run')
+    parser.add_argument('--thread-priority', type=int, default=0, metavar='P',
+                        help="the sites' real-time priority (0: normal scheduling, the "
+                        "nodes' default)")
     ros_domain.add_option(parser, help="the operator's site; the remote's is the next")
     result_files.add_option(parser)
     args = parser.parse_args(argv)
     ros_domain.keep_local()
-    print(f'machine: {machine.line("ros-jazzy-rclpy", "eclipse-zenoh")}; hogs {args.hogs}')
+    print(f'machine: {machine.line("ros-jazzy-rclpy", "eclipse-zenoh")}; hogs {args.hogs}, '
+          f'thread priority {args.thread_priority}')
 
     def runs() -> list:
         rows = []
         for group in range(args.pairs):
             for layout in ((True, False) if group % 2 == 0 else (False, True)):
-                rows.append({**run(layout, args.domain_id), 'group': group})
+                rows.append({**run(layout, args.domain_id, args.thread_priority),
+                             'group': group})
                 _print_row(rows[-1])
         return rows
     rows = loaded(runs, args.hogs)
@@ -94,7 +102,8 @@ def main(argv=None) -> int:
     print('CPU, % of one core (median): ' + '; '.join(
         f'gateways {layout}: {cpu["total"]:.0f} in all, operator site {cpu["operator"]:.0f}, '
         f'remote site {cpu["remote"]:.0f}' for layout, cpu in result['cpu_percent'].items()))
-    result_files.write(args.json, {'rows': rows, 'summary': result, 'hogs': args.hogs})
+    result_files.write(args.json, {'rows': rows, 'summary': result, 'hogs': args.hogs,
+                                   'thread_priority': args.thread_priority})
     return 0
 
 

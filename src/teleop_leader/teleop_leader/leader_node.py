@@ -150,20 +150,22 @@ class LeaderNode(Node):
         period = (stamp_ns - self._last_stamp_ns) * 1e-9 if self._last_stamp_ns else 1e-3
         self._last_stamp_ns = stamp_ns
         command = self.leader.command(stamp_ns * 1e-9, position, velocity, self._model_shift)
+        now = self._now()
+        if self.params.scheme == Scheme.MODEL:
+            known, plane = self.leader.model(now, position)
+            if known:
+                self._answer(stamp_ns, plane, position)
+            else:
+                self._unknown += 1
+        else:
+            self._answer(stamp_ns, self.leader.force(now, position, velocity,
+                                                     max(period, 1e-6)))
+        # After the hand's answer: sending it to the other site (the gateway's encoding and
+        # put, when the gateway is in this process) never delays what the hand feels.
         if command is None:
             self._withheld += 1
         else:
             self._command_pub.publish(command_fields(command, self.params.robot_frame))
-        now = self._now()
-        if self.params.scheme == Scheme.MODEL:
-            known, plane = self.leader.model(now, position)
-            if not known:
-                self._unknown += 1
-                return
-            self._answer(stamp_ns, plane, position)
-        else:
-            self._answer(stamp_ns, self.leader.force(now, position, velocity,
-                                                     max(period, 1e-6)))
 
     def _answer(self, stamp_ns: int, answer, position=None) -> None:
         """Publish the wrench or model for the pose ``stamp_ns``; None: zero force, no model."""
