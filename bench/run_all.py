@@ -86,6 +86,7 @@ BENCHMARKS = (
     Benchmark('image', 'bench_image.py', ('--frames', '100', '--no-simus'), stored=True),
     Benchmark('imaging_session', 'imaging_session.py', ('--pairs', '1'), stored=True),
     Benchmark('link', 'bench_link.py', ('--seconds', '5'), stored=True),
+    Benchmark('gateway_session', 'gateway_session.py', ('--pairs', '1'), stored=True),
     Benchmark('teleop_load', 'teleop_load.py', ('--schemes', 'model', '--loads', 'hogged',
                                                 '--duration', '8'), stored=True),
     Benchmark('recording_load', 'recording_load.py', ('--layouts', 'composed', '--stops', 'end',

@@ -16,8 +16,9 @@ from report_generator.report_image import (cost_section, frame_time_section, PRE
 from report_generator.report_probe import probe_section
 from report_generator.report_sections import (counts_section, DEFINITIONS, error_time_section,
                                               experiment_section, extreme_section,
-                                              force_effect_section, headline_section,
-                                              identical_modes, interval_table, link_section,
+                                              force_effect_section, gateway_session_section,
+                                              headline_section, identical_modes,
+                                              interval_table, link_section,
                                               loop_section, provenance_section, servo_section,
                                               stiff_wall_section, sweep_section, table_2, table_3,
                                               teleop_load_section, teleop_section,
@@ -276,6 +277,13 @@ def _teleop_chapter(findings: Findings) -> list[str]:
               'from it in the process. The echo\'s CPU is its process\'s: with the deployed '
               'path, the remote site\'s gateway is in it.', '']
     parts += _stored(findings, 'link', lambda stored: [link_section(stored), ''])
+    parts += ['The same question of a whole session: the demo\'s model-mediated scan over a 50 ms '
+              'link with each site\'s gateway in its process (deployed) and with the gateways '
+              'as processes of their own (the baseline), alternated; each ratio is of a run to '
+              'the baseline beside it, targets rates and answered >= 0.99, p99 <= 1.1 '
+              '(`bench/gateway_session.py`).', '']
+    parts += _stored(findings, 'gateway_session', lambda stored: [
+        gateway_session_section(stored), ''])
     parts += ['### On a busy machine', '',
               'The issue\'s command, `haptic_loop --teleop SCHEME --delay 0.1 --jitter 0.01 '
               '--loss 0.01 --duration 20`, with no process of the benchmark\'s own keeping a core '

@@ -24,8 +24,9 @@ from collision_engine.mesh_io import load_mesh
 from haptic_bringup.contacts import contact_intervals, MIN_FORCE
 
 __all__ = ['DEFINITIONS', 'counts_section', 'error_time_section', 'experiment_section',
-           'extreme_section', 'force_effect_section', 'headline_section', 'identical_modes',
-           'interval_table', 'link_section', 'loop_section', 'provenance_section', 'servo_section',
+           'extreme_section', 'force_effect_section', 'gateway_session_section',
+           'headline_section', 'identical_modes', 'interval_table', 'link_section',
+           'loop_section', 'provenance_section', 'servo_section',
            'stiff_wall_section', 'sweep_section', 'table_2', 'table_3', 'teleop_load_section',
            'teleop_section', 'tradeoff_section']
 
@@ -432,6 +433,24 @@ def teleop_load_section(rows: list) -> str:
           {'yes': 'yes', 'NO': '**no**'}.get(verdict(r), verdict(r)), f'{r["contact_s"]:.1f}',
           f'{1e3 * r["net_work_j"]:+.1f}', f'{r["oscillation_percent"]:.1f}',
           f'{r["load_before"]:.1f}'] for r in rows])
+
+
+def gateway_session_section(stored: dict) -> str:
+    """Tabulate the scan's streams and CPU with the gateways in the sites' processes and apart."""
+    summary = stored['summary']
+    names = {'operator_rate_hz': "operator's loop rate", 'operator_answered_percent':
+             'poses answered', 'operator_round_trip_p99_s': "operator's round trip p99",
+             'robot_rate_hz': "robot's rate", 'robot_tick_p99_s': "robot's tick p99",
+             'commands_hz': 'commands reaching the robot', 'feedback_hz':
+             'feedback reaching the operator'}
+    rows = [[name, f'{summary["ratios"][key]:.3f}',
+             '{:.3f}-{:.3f}'.format(*summary['ranges'][key])] for key, name in names.items()]
+    cpu = '; '.join(f'gateways {layout}: {values["total"]:.0f} % in all (operator\'s site '
+                    f'{values["operator"]:.0f} %, remote site {values["remote"]:.0f} %)'
+                    for layout, values in summary['cpu_percent'].items())
+    return (markdown_table(['figure', 'in the sites / apart (median)', 'range'], rows)
+            + f'\n\n{summary["pairs"]} alternated pairs. CPU of the session\'s processes, in % '
+            f'of one core (medians): {cpu}.')
 
 
 def link_section(stored: dict) -> str:

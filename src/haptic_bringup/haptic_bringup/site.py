@@ -17,9 +17,9 @@ real network (none by default).
 
 A site waits for its own nodes and gateway, then runs until Ctrl-C, the end of the operator's
 experiment, or the other site stopping (its gateway says so, and this one's then ends its
-process), and stops its processes. With ``--record DIR`` its process records itself into ``DIR/<role>``. A
-connection that is lost is waited for: the nodes' watchdogs keep the patient safe meanwhile,
-and the session goes on when it returns. On a full ROS 2 install, ``operator_site.launch.py``
+process), and stops its processes. With ``--record DIR`` its process records itself into
+``DIR/<role>``. A connection that is lost is waited for: the nodes' watchdogs keep the patient
+safe meanwhile, and the session goes on when it returns. On a full ROS 2 install, ``operator_site.launch.py``
 and ``remote_site.launch.py`` do the same.
 """
 import argparse
