@@ -19,8 +19,8 @@ A site waits for its own nodes and gateway, then runs until Ctrl-C, the end of t
 experiment, or the other site stopping (its gateway says so, and this one's then ends its
 process), and stops its processes. With ``--record DIR`` its process records itself into
 ``DIR/<role>``. A connection that is lost is waited for: the nodes' watchdogs keep the patient
-safe meanwhile, and the session goes on when it returns. On a full ROS 2 install, ``operator_site.launch.py``
-and ``remote_site.launch.py`` do the same.
+safe meanwhile, and the session goes on when it returns. On a full ROS 2 install,
+``operator_site.launch.py`` and ``remote_site.launch.py`` do the same.
 """
 import argparse
 import dataclasses
