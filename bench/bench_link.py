@@ -344,8 +344,9 @@ def main(argv=None) -> int:
         folder = pathlib.Path(tmp)
         routes = {'to_remote': [f'{PING}:{POSE_TYPE}'], 'to_operator': [f'{PONG}:{POSE_TYPE}']}
         gateways = {child.name.split('_')[0]: child for child in loopback_gateways(
-            folder, sys.executable, loop_environment(args.domain_id, folder / 'log'),
-            loop_environment(args.domain_id + 1, folder / 'log'), routes=routes)}
+            loopback_gateway_files(folder, routes=routes), sys.executable,
+            loop_environment(args.domain_id, folder / 'log'),
+            loop_environment(args.domain_id + 1, folder / 'log'))}
         udp_port = free_port(socket.SOCK_DGRAM)
         direct = f'tls/127.0.0.1:{free_port(socket.SOCK_STREAM)}'
         echo = start_child('echo', [sys.executable, __file__, 'echo', str(udp_port),

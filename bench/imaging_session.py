@@ -37,8 +37,7 @@ import sys
 import tempfile
 
 from bench import machine, result_files, ros_domain
-from bench.scan_streams import (in_window, LINK, rate, scan, stream_ratios, TARGETS,
-                                total_cpu, WINDOW)
+from bench.scan_streams import LINK, rate, scan, stream_ratios, TARGETS, total_cpu, WINDOW
 from bench.teleop_load import loaded
 import numpy as np
 
@@ -76,7 +75,7 @@ def run(variant: str, priority: int, domain_id: int) -> dict:
             said = {key: reported(folder / 'bag', typestore, key).get('probe_imager',
                                                                       ['nan'])[-1]
                     for key in ('pose_to_publication_p99_s', 'frame_cpu_p50_s')}
-            row.update({'frames_hz': rate(in_window(frames.stamp, start)),
+            row.update({'frames_hz': rate(frames.stamp[shown]),
                         'pose_to_image_p50_s': float(np.percentile(latency, 50)),
                         'pose_to_image_p99_s': float(np.percentile(latency, 99)),
                         'pose_to_publication_p99_s': float(said['pose_to_publication_p99_s']),

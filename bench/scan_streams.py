@@ -22,7 +22,7 @@ from haptic_bringup.launcher import Loop, LoopConfig
 from haptic_bringup.recorder import custom_definitions
 from haptic_bringup.session import bags, read_session_start, read_vectors
 
-__all__ = ['LINK', 'STREAM_FIGURES', 'TARGETS', 'WINDOW', 'in_window', 'rate', 'scan',
+__all__ = ['LINK', 'STREAM_FIGURES', 'TARGETS', 'WINDOW', 'rate', 'scan',
            'stream_ratios', 'total_cpu']
 
 LINK = {'delay': 0.05, 'jitter': 0.005, 'loss': 0.01}  # as the demo's scan
@@ -34,7 +34,7 @@ _STAMPED = {'/wand/pose': 'pose', '/remote/robot/tcp_pose': 'pose'}
 _CROSSED = ('/remote/teleop/command', '/teleop/feedback')  # recorded where they arrived
 
 
-def in_window(times: np.ndarray, start: float) -> np.ndarray:
+def _in_window(times: np.ndarray, start: float) -> np.ndarray:
     """Return the ``times`` (s) within ``WINDOW`` of a session that started at ``start``."""
     return times[(times >= start + WINDOW[0]) & (times < start + WINDOW[1])]
 
@@ -67,9 +67,9 @@ def scan(folder: pathlib.Path, domain_id: int, **config) -> tuple:
             raise RuntimeError('the scan did not end')
     typestore = typestore_with(custom_definitions())
     start = read_session_start(bag, typestore)
-    robot = in_window(read_vectors(bag, typestore, _STAMPED, stamped=True)
-                      ['/remote/robot/tcp_pose'][0], start)
-    received = {topic: in_window(_received(bag, topic), start) for topic in _CROSSED}
+    robot = _in_window(read_vectors(bag, typestore, _STAMPED, stamped=True)
+                       ['/remote/robot/tcp_pose'][0], start)
+    received = {topic: _in_window(_received(bag, topic), start) for topic in _CROSSED}
     loop_stats = np.load(stats)
     return {'load': os.getloadavg()[0],
             'operator_rate_hz': float(loop_stats['rate_hz']),

@@ -382,7 +382,7 @@ class Loop:
         The operator's site starts its scan as soon as its own loop closes, robot or not, so it
         starts once the remote site is up (under load, the remote site took seconds longer).
         """
-        from haptic_bringup.site import gateway_argv, loopback_gateway_files  # builds on this
+        from haptic_bringup.site import loopback_gateway_files, loopback_gateways  # builds on this
         config = self.config
         remote_env = loop_environment(config.remote_domain_id, self.run_dir / 'log')
         gateways = loopback_gateway_files(self.run_dir, link=config.link,
@@ -396,9 +396,7 @@ class Loop:
             remote_env))
         self._start_imager(ros_args, remote_env)
         if not config.gateway_in_process:
-            self.children += [start_child(f'{role}_gateway', gateway_argv(
-                config.python, role, gateways[role]), role_env)
-                for role, role_env in (('remote', remote_env), ('operator', env))]
+            self.children += loopback_gateways(gateways, config.python, env, remote_env)
         self._wait_for_discovery(config.remote_domain_id)
         self.children.insert(0, start_child(  # the operator's stops first
             'operator', self._composed(site_nodes(config, 'operator'), site_args('operator')),

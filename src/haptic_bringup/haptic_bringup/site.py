@@ -119,10 +119,8 @@ def loopback_gateway_files(run_dir: pathlib.Path, *, link: Optional[dict] = None
     return files
 
 
-def loopback_gateways(run_dir: pathlib.Path, python: str, env: dict, remote_env: dict, *,
-                      routes: Optional[dict] = None) -> list:
-    """Start both sites' gateways on this machine, each a process of its own."""
-    files = loopback_gateway_files(run_dir, routes=routes)
+def loopback_gateways(files: dict, python: str, env: dict, remote_env: dict) -> list:
+    """Start both sites' gateways, each a process of its own, from ``loopback_gateway_files``."""
     return [start_child(f'{role}_gateway', gateway_argv(python, role, files[role]), role_env)
             for role, role_env in (('remote', remote_env), ('operator', env))]
 
