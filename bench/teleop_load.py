@@ -56,13 +56,25 @@ WARM = ('from collision_engine import load_scene; from haptic_util.paths import 
 
 
 def baseline_tree(ref: str, into: pathlib.Path) -> dict:
-    """Unpack the packages at ``ref`` into ``into``; return the environment that runs them."""
+    """Unpack the packages at ``ref`` into ``into``; return the environment that runs them.
+
+    Their share folders (parameters, scenes) are found through an ament prefix of their own,
+    ahead of the venv's: a package since renamed (``remote_probe``) has none in the venv.
+    """
     archive = subprocess.run(['git', '-C', str(REPOSITORY), 'archive', ref, 'src'],
                              check=True, capture_output=True).stdout
     subprocess.run(['tar', '-x', '-C', str(into)], input=archive, check=True)
+    prefix = into / 'install'
+    index = prefix / 'share' / 'ament_index' / 'resource_index' / 'packages'
+    index.mkdir(parents=True)
+    for package in PACKAGES:
+        (index / package).touch()
+        (prefix / 'share' / package).symlink_to(into / 'src' / package)
     paths = [str(into / 'src' / package) for package in PACKAGES]
-    env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
-        [*paths, *filter(None, [os.environ.get('PYTHONPATH')])])}
+    env = {**os.environ,
+           'PYTHONPATH': os.pathsep.join([*paths, *filter(None, [os.environ.get('PYTHONPATH')])]),
+           'AMENT_PREFIX_PATH': os.pathsep.join(
+               [str(prefix), *filter(None, [os.environ.get('AMENT_PREFIX_PATH')])])}
     subprocess.run([sys.executable, '-c', WARM], env=env, check=True)  # numba's caches there
     return env
 
