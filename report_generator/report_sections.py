@@ -12,6 +12,7 @@ from bench.teleop_load import verdict
 import numpy as np
 from report_generator.report_experiments import Experiment, EXPERIMENTS, PAPER, PAPER_TABLE_3
 from report_generator.report_format import format_length, format_number, markdown_table
+from report_generator.report_image import STREAMS
 from report_generator.report_metrics import (angle_stats, angles_to_normal, FALSE_ERROR,
                                              FELT_FORCE, MAX_ANGLE, Measures, SIGN_FLOOR,
                                              STRONG_FORCE)
@@ -438,13 +439,9 @@ def teleop_load_section(rows: list) -> str:
 def gateway_session_section(stored: dict) -> str:
     """Tabulate the scan's streams and CPU with the gateways in the sites' processes and apart."""
     summary = stored['summary']
-    names = {'operator_rate_hz': "operator's loop rate", 'operator_answered_percent':
-             'poses answered', 'operator_round_trip_p99_s': "operator's round trip p99",
-             'robot_rate_hz': "robot's rate", 'robot_tick_p99_s': "robot's tick p99",
-             'commands_hz': 'commands reaching the robot', 'feedback_hz':
-             'feedback reaching the operator'}
-    rows = [[name, f'{summary["ratios"][key]:.3f}',
-             '{:.3f}-{:.3f}'.format(*summary['ranges'][key])] for key, name in names.items()]
+    rows = [[label, f'{summary["ratios"][key]:.3f}',
+             '{:.3f}-{:.3f}'.format(*summary['ranges'][key])]
+            for key, (label, _) in STREAMS.items()]
     cpu = '; '.join(f'gateways {layout}: {values["total"]:.0f} % in all (operator\'s site '
                     f'{values["operator"]:.0f} %, remote site {values["remote"]:.0f} %)'
                     for layout, values in summary['cpu_percent'].items())
