@@ -53,3 +53,15 @@ def test_a_robot_of_another_stiffness_is_not_commanded_and_an_error_says_why(fol
 def test_a_robot_in_another_frame_is_not_commanded(follower):
     follower.on_impedance(impedance_message('world', stiffness=1500.0, **ROBOT))
     assert follower.follower is None and follower.report().level == ERROR
+
+
+def test_tcp_poses_the_robot_cannot_have_are_refused_and_named(follower):
+    pose = ('base_link', 0.0, 0.0, -0.02, 0.0, 0.0, 0.0, 1.0)
+    follower.on_tcp((0, 0, *pose))
+    assert follower._refused.counts == {'TCP pose before the robot is known': 1}
+    follower.on_impedance(impedance_message('base_link', stiffness=1500.0, **ROBOT))
+    follower.on_tcp((0, 0, *pose))
+    follower.on_tcp((0, 0, 'base_link', 0.0, 0.0, -0.07, 0.0, 0.0, 0.0, 1.0))  # 50 mm at once
+    assert follower._refused.counts['TCP faster than the robot'] == 1
+    assert follower._tcp.position[2] == -0.02
+    assert follower.report().values['refused: TCP faster than the robot'] == 1

@@ -99,12 +99,14 @@ def feedback_fields(feedback: Feedback, frame: str) -> tuple:
 class RobotReport(NamedTuple):
     """What a robot says of itself (``RobotImpedance``).
 
-    Its spring (N/m), its force bound (N), and what a command may ask of it.
+    Its spring (N/m), its force bound (N), what a command may ask of it, and its TCP's top
+    speed (m/s).
     """
 
     stiffness: float
     max_patient_force: float
     limits: CommandLimits
+    max_speed: float
 
 
 def impedance_report(message: RobotImpedance, hand_speed: float) -> tuple[str, RobotReport]:
@@ -116,7 +118,7 @@ def impedance_report(message: RobotImpedance, hand_speed: float) -> tuple[str, R
     limits = CommandLimits(np.array([lower.x, lower.y, lower.z]),
                            np.array([upper.x, upper.y, upper.z]), hand_speed)
     return message.header.frame_id, RobotReport(message.stiffness, message.max_patient_force,
-                                                limits)
+                                                limits, message.max_speed)
 
 
 def impedance_message(frame: str, *, stiffness: float, max_speed: float, workspace_lower,

@@ -4,8 +4,10 @@ Takes the operator's commands (through the link), the robot's TCP pose and its F
 at ``rate`` commands the robot a target that the patient's safety allows (``Follower``). Sends
 ``teleop/feedback`` back over the link at ``feedback_rate``: the measured force, the energy books
 and the estimated contact plane. A TCP pose or wrench older than ``sensor_timeout`` feeds back no
-force. ``scene_file`` is the patient's surface as this site sees it (a depth camera's, here the
-phantom's mesh), for the model out of contact.
+force. A TCP pose the robot cannot have, outside its workspace or farther from the last one
+than its top speed allows, is refused (``TcpGate``): a stranger on the robot's network could
+otherwise teach the contact model what it likes. ``scene_file`` is the patient's surface as
+this site sees it (a depth camera's, here the phantom's mesh), for the model out of contact.
 
 It follows only once the robot has said what it is (``robot/impedance``, latched): the force
 bound holds only for the robot's own stiffness, so a robot whose stiffness is not this node's
@@ -41,6 +43,7 @@ from haptic_util.tally import Tally
 from robot_site.assembly import admission_config, follower, follower_config, follower_safety
 from robot_site.follower import Follower
 from robot_site.params import FollowerParams
+from robot_site.tcp_gate import TcpGate
 from teleop_protocol.admission import Refusal
 
 __all__ = ['FollowerNode', 'main', 'take_command']
@@ -69,8 +72,8 @@ class FollowerNode(Node):
         self.follower: Follower | None = None  # once the robot has said what it is
         self._robot_problem = (WARN, 'waiting for the robot\'s robot/impedance')
         self._period = 1.0 / params.rate
-        self._tcp = self._tcp_velocity = None
-        self._tcp_time = self._force_time = -math.inf
+        self._tcp: TcpGate | None = None  # once the robot has said what it is
+        self._force_time = -math.inf
         self._force = np.zeros(3)
         self._refused = Tally()
         self._sent = 0
@@ -121,6 +124,8 @@ class FollowerNode(Node):
         elif self.follower is None:
             self.follower = follower(self.params, report.limits, self._surface,
                                      safety=self._safety)
+            self._tcp = self._tcp or TcpGate(report.limits.workspace_lower,
+                                             report.limits.workspace_upper, report.max_speed)
             self.get_logger().info(f'the robot is as expected ({report.stiffness:g} N/m): '
                                    'following')
         else:
@@ -145,11 +150,12 @@ class FollowerNode(Node):
                                'the working limit')
 
     def on_tcp(self, fields: Sequence) -> None:
-        now = self._now()
-        position = np.array(fields[POSE_POSITION], dtype=np.float64)
-        if self._tcp is not None and now > self._tcp_time:
-            self._tcp_velocity = (position - self._tcp) / (now - self._tcp_time)
-        self._tcp, self._tcp_time = position, now
+        if self._tcp is None:
+            self._refused.add('TCP pose before the robot is known', self._robot_problem[1])
+            return
+        refusal = self._tcp.take(self._now(), fields[POSE_POSITION])
+        if refusal is not None:
+            self._refused.add(refusal.kind, refusal.detail)
 
     def on_wrench(self, fields: Sequence) -> None:
         self._force = np.array(fields[WRENCH_FORCE], dtype=np.float64)
@@ -159,19 +165,19 @@ class FollowerNode(Node):
 
     def tick(self) -> None:
         now = self._now()
-        if self._tcp is None or self.follower is None:
+        tcp = self._tcp
+        if self.follower is None or tcp is None or tcp.position is None:
             return  # the robot has not spoken yet, or is not the one expected
         fresh = (now - self._force_time <= self.params.sensor_timeout
-                 and now - self._tcp_time <= self.params.sensor_timeout)
+                 and now - tcp.time <= self.params.sensor_timeout)
         force = self._force if fresh else np.full(3, np.nan)
-        velocity = self._tcp_velocity if self._tcp_velocity is not None else np.zeros(3)
-        target = self.follower.target(now, self._tcp, velocity, force, self._period)
+        target = self.follower.target(now, tcp.position, tcp.velocity, force, self._period)
         sec, nanosec = divmod(clock_ns(self.get_clock()), 1_000_000_000)
         self._target_pub.publish((sec, nanosec, self.params.frame_id,
                                   *target.tolist(), *_IDENTITY))
 
     def send_feedback(self) -> None:
-        if self._tcp is None or self.follower is None:
+        if self.follower is None or self._tcp is None or self._tcp.position is None:
             return
         feedback = self.follower.feedback(clock_ns(self.get_clock()) * 1e-9)
         self._feedback_pub.publish(feedback_fields(feedback, self.params.frame_id))
