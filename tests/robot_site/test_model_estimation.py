@@ -119,3 +119,48 @@ def test_a_contact_that_begins_tilted_by_noise_starts_from_the_surfaces_normal()
         angles.append(math.degrees(math.acos(estimate.normal[2])))
     assert angles[0] > 5.0  # from the first force: still tilted
     assert angles[1] < 1e-9
+
+
+def forged_scan(config, attack=(2.0, 5.0), duration=8.0, forged=0.7, offset=0.05):
+    """Press a known skin while most TCP positions the estimator gets in ``attack`` (s) lie
+    ``offset`` m deeper (a stranger's, interleaved with the robot's), the velocity differenced
+    from what it gets, as the follower's node does.
+
+    Return the planes' farthest offset from the skin during the attack, and the last estimate.
+    """
+    robot = ImpedanceRobot(ImpedanceRobotConfig(initial_position=SKIN.point),
+                           environment=KelvinVoigt(800.0, 10.0))
+    sensor, estimator = ForceTorqueSensor(), ContactModelEstimator(config)
+    rng = np.random.default_rng(7)
+    seen, farthest, estimate = None, 0.0, None
+    for k in range(round(duration / TICK)):
+        time = k * TICK
+        state = robot.read(time)
+        position = state.position.copy()
+        if attack[0] <= time < attack[1] and rng.random() < forged:
+            position -= offset * NORMAL
+        velocity = np.zeros(3) if seen is None else (position - seen) / TICK
+        seen = position
+        estimate = estimator.update(time, sensor.measure(time, state.external_force).force,
+                                    position, velocity)
+        if estimate is not None and attack[0] <= time < attack[1]:
+            farthest = max(farthest, abs((estimate.point - SKIN.point) @ NORMAL))
+        robot.command(SKIN.point - (0.02 + 0.004 * math.sin(2 * math.pi * time)) * NORMAL)
+    return farthest, estimate
+
+
+def test_forged_tcp_positions_cannot_run_the_plane_off_and_it_recovers_after_them():
+    """Unguarded (the baseline), the fit's stiffness falls to nothing and the plane runs off
+    and is still wrong 3 s after the forgeries end; guarded, it lies no farther from the skin
+    than the forged TCP's depth and ``max_indentation``, and has the skin again."""
+    farthest, estimate = forged_scan(EstimatorConfig(max_indentation=1e6))
+    print(f'\nunguarded: the plane up to {farthest * 1e3:.0f} mm off the skin; after: '
+          f'{estimate.stiffness:.0f} N/m')
+    assert farthest > 0.2
+    assert estimate.stiffness != pytest.approx(800.0, rel=0.05)
+    farthest, estimate = forged_scan(EstimatorConfig())
+    print(f'guarded: up to {farthest * 1e3:.0f} mm; after: {estimate.stiffness:.0f} N/m')
+    deepest_seen = 0.024 + 0.05  # [m] under the skin: the press, and the forgery's offset
+    assert farthest <= deepest_seen + EstimatorConfig().max_indentation
+    assert estimate.stiffness == pytest.approx(800.0, rel=0.02)
+    assert (estimate.point - SKIN.point) @ NORMAL == pytest.approx(0.0, abs=2e-4)
