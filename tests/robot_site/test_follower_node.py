@@ -1,4 +1,6 @@
 """The follower node follows only a robot that says it is the one its force bound was set for."""
+import math
+
 import pytest
 import rclpy
 from rclpy.context import Context
@@ -65,3 +67,10 @@ def test_tcp_poses_the_robot_cannot_have_are_refused_and_named(follower):
     assert follower._refused.counts['TCP faster than the robot'] == 1
     assert follower._tcp.position[2] == -0.02
     assert follower.report().values['refused: TCP faster than the robot'] == 1
+
+
+@pytest.mark.parametrize('speed', [0.0, math.nan])
+def test_a_robot_with_no_top_speed_is_not_commanded(follower, speed):
+    follower.on_impedance(impedance_message('base_link', stiffness=1500.0,
+                                            **{**ROBOT, 'max_speed': speed}))
+    assert follower.follower is None and 'top speed' in follower.report().message

@@ -116,6 +116,9 @@ class FollowerNode(Node):
         elif not abs(report.stiffness - expected) <= STIFFNESS_TOLERANCE * expected:
             problem = (f'the robot\'s stiffness is {report.stiffness:g} N/m, not '
                        f'robot_stiffness {expected:g} N/m: the force bound would not hold')
+        elif not (math.isfinite(report.max_speed) and report.max_speed > 0.0):
+            problem = (f'the robot reports a top speed of {report.max_speed:g} m/s: its TCP '
+                       'poses could not be checked')
         else:
             problem = None
         if problem is not None:
