@@ -1,6 +1,7 @@
 """The round trip the two site gateways add, against plain UDP between the same two processes.
 
-    .venv/bin/python bench/bench_link.py [--seconds 60] [--runs 1] [--rate 1000] [--json PATH]
+    .venv/bin/python bench/bench_link.py [--seconds 60] [--runs 1] [--rate 1000] [--threads]
+                                         [--json PATH]
 
 Why: a command that crosses to the remote site and the feedback that comes back take the path
 that is deployed: DDS in the operator's domain, the operator's gateway, Zenoh over mutual TLS,
@@ -289,6 +290,18 @@ def cpu_seconds(pid: int) -> float:
     return times.user + times.system
 
 
+def thread_cpu_seconds(pid: int) -> dict:
+    """Return each thread's CPU time (s) so far, by 'name tid' (the name from /proc)."""
+    seconds = {}
+    for thread in psutil.Process(pid).threads():
+        try:
+            name = pathlib.Path(f'/proc/{pid}/task/{thread.id}/comm').read_text().strip()
+        except OSError:
+            continue  # it ended
+        seconds[f'{name} {thread.id}'] = thread.user_time + thread.system_time
+    return seconds
+
+
 def connect(end, pinger: Pinger, first: int) -> int:
     """Ping from ``first`` until pongs come back, then for ``WARM_UP`` s more; the next number.
 
@@ -305,16 +318,26 @@ def connect(end, pinger: Pinger, first: int) -> int:
 
 def measure(case: str, end, pinger: Pinger, args, pids: dict, first: int) -> dict:
     before = {name: cpu_seconds(pid) for name, pid in pids.items()}
+    threads_before = {name: thread_cpu_seconds(pid) for name, pid in pids.items()}
     start = time.monotonic()
     sequences = pinger.run(end, args.rate, args.seconds, first)
     wall = time.monotonic() - start - DRAIN
     figures = pinger.figures(sequences)
     figures['cpu_pct'] = {name: 100.0 * (cpu_seconds(pid) - before[name]) / wall
                           for name, pid in pids.items()}
+    figures['thread_cpu_pct'] = {
+        name: {thread: 100.0 * (seconds - threads_before[name].get(thread, 0.0)) / wall
+               for thread, seconds in thread_cpu_seconds(pid).items()}
+        for name, pid in pids.items()}
     print(f'{case:<9} ' + ' '.join(f'{figures[f"p{q:g}_ms"]:8.3f}' for q in PERCENTILES)
           + f' {figures["lost"]:5d}/{figures["sent"]:<6d} '
           + ', '.join(f'{name} {cpu:.1f} %' for name, cpu in figures['cpu_pct'].items()),
           flush=True)
+    if args.threads:
+        for name, threads in figures['thread_cpu_pct'].items():
+            busy = sorted(threads.items(), key=lambda item: -item[1])
+            print(f'    {name} by thread: ' + ', '.join(
+                f'{thread} {cpu:.1f} %' for thread, cpu in busy if cpu >= 0.5), flush=True)
     return figures
 
 
@@ -329,6 +352,8 @@ def main(argv=None) -> int:
     parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
     parser.add_argument('--runs', type=int, default=1, help='alternated rounds of the cases')
     parser.add_argument('--rate', type=float, default=1000.0, help='[Hz] pings')
+    parser.add_argument('--threads', action='store_true',
+                        help="print each process's CPU by thread too (always in --json)")
     ros_domain.add_option(parser, help="the operator's side; the echo's is the next, and the "
                           "two sites with their gateways in them the two after")
     result_files.add_option(parser)
