@@ -42,8 +42,6 @@ REPOSITORY = pathlib.Path(__file__).resolve().parents[1]
 # The code before the fix (main before 'passive' was merged), which shares this tree's messages:
 # the issue's 0139399 does not (the safety issue added fields), so it cannot run with this venv.
 BASELINE = 'd242b42'
-PACKAGES = ('haptic_util', 'collision_engine', 'force_renderer', 'haptic_wand_driver',
-            'haptic_bringup', 'remote_probe', 'site_gateway')
 DELAY, JITTER, LOSS, DURATION = 0.1, 0.01, 0.01, 20.0  # the issue's command
 LATE = 0.010  # [s] between two poses: longer than an answer's lifetime
 MIN_CONTACT = 5.0  # [s] in contact: the scan presses for about 12 s
@@ -58,19 +56,22 @@ WARM = ('from collision_engine import load_scene; from haptic_util.paths import 
 def baseline_tree(ref: str, into: pathlib.Path) -> dict:
     """Unpack the packages at ``ref`` into ``into``; return the environment that runs them.
 
-    Their share folders (parameters, scenes) are found through an ament prefix of their own,
-    ahead of the venv's: a package since renamed (``remote_probe``) has none in the venv.
+    Its Python packages (the messages are this venv's) come first on the path; their share
+    folders (parameters, scenes) are found through an ament prefix of their own, ahead of the
+    venv's: a package since renamed (``remote_probe``) has none in the venv.
     """
     archive = subprocess.run(['git', '-C', str(REPOSITORY), 'archive', ref, 'src'],
                              check=True, capture_output=True).stdout
     subprocess.run(['tar', '-x', '-C', str(into)], input=archive, check=True)
+    packages = sorted(folder.name for folder in (into / 'src').iterdir()
+                      if (folder / folder.name / '__init__.py').exists())
     prefix = into / 'install'
     index = prefix / 'share' / 'ament_index' / 'resource_index' / 'packages'
     index.mkdir(parents=True)
-    for package in PACKAGES:
+    for package in packages:
         (index / package).touch()
         (prefix / 'share' / package).symlink_to(into / 'src' / package)
-    paths = [str(into / 'src' / package) for package in PACKAGES]
+    paths = [str(into / 'src' / package) for package in packages]
     env = {**os.environ,
            'PYTHONPATH': os.pathsep.join([*paths, *filter(None, [os.environ.get('PYTHONPATH')])]),
            'AMENT_PREFIX_PATH': os.pathsep.join(
