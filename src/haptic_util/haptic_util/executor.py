@@ -70,9 +70,8 @@ from haptic_util import intra_process, shared_memory
 from haptic_util.callback_errors import callback_errors, log_callback_error
 from haptic_util.priority import run_realtime, THREAD_PRIORITY
 
-__all__ = ['EXECUTORS', 'align_timers', 'make_executor', 'spin', 'run_nodes', 'run_process',
-           'end_process', 'request_stop', 'hold_stop_signals', 'STOP_SIGNALS', 'callback_errors',
-           'StartupError']
+__all__ = ['EXECUTORS', 'make_executor', 'spin', 'run_nodes', 'run_process', 'end_process',
+           'request_stop', 'hold_stop_signals', 'STOP_SIGNALS', 'callback_errors', 'StartupError']
 
 SPIN_SLICE = 0.05  # [s] longest time signals wait to be handled
 SHUTDOWN_TIMEOUT = 1.0  # [s] for the executor to finish a callback in progress
@@ -216,7 +215,6 @@ def _run(start: Callable[[list, list], None], executor: str) -> int:
         _flags['starting'] = False
         _freeze_what_start_made()
         _run_realtime(nodes)
-        align_timers(nodes)
         spinner = make_executor(executor, contexts[0] if contexts else None)
         for node in nodes:
             spinner.add_node(node)
@@ -282,20 +280,6 @@ def _keep_participants(contexts: list) -> None:
         for publisher in list(keeper.publishers):  # its parameter events: nothing to say
             keeper.destroy_publisher(publisher)
         _keepers.append(keeper)
-
-
-def align_timers(nodes: Iterable[Node]) -> None:
-    """Start the nodes' running timers at one instant, so that those of one period fire together.
-
-    A timer keeps the phase it started at, and the EventsExecutor wakes its timer thread, then
-    itself, for each firing: a composed site's 1 kHz timers (the robot's, the follower's, the
-    gateway's handover), started as their nodes were made, woke it apart. Three 1 kHz timers in
-    one process took 9.0-10.0 % of a core apart and 3.7-3.9 % together, one alone 3.5 %.
-    """
-    for node in nodes:
-        for timer in node.timers:
-            if not timer.is_canceled():  # one made not to start stays so
-                timer.reset()
 
 
 def _freeze_what_start_made() -> None:
