@@ -168,8 +168,8 @@ class FollowerNode(Node):
 
     def tick(self) -> None:
         now = self._now()
-        tcp = self._tcp
-        if self.follower is None or tcp is None or tcp.position is None:
+        tcp = self._tcp  # made with the follower
+        if self.follower is None or tcp.position is None:
             return  # the robot has not spoken yet, or is not the one expected
         fresh = (now - self._force_time <= self.params.sensor_timeout
                  and now - tcp.time <= self.params.sensor_timeout)
@@ -180,7 +180,7 @@ class FollowerNode(Node):
                                   *target.tolist(), *_IDENTITY))
 
     def send_feedback(self) -> None:
-        if self.follower is None or self._tcp is None or self._tcp.position is None:
+        if self.follower is None or self._tcp.position is None:
             return
         feedback = self.follower.feedback(clock_ns(self.get_clock()) * 1e-9)
         self._feedback_pub.publish(feedback_fields(feedback, self.params.frame_id))
