@@ -18,10 +18,12 @@ from haptic_wand_driver.node import WandDriverNode
 
 
 @pytest.fixture
-def driver(request):
+def driver(request, tmp_path):
     context = Context()
     rclpy.init(context=context, domain_id=98)
     extra = getattr(request, 'param', {})
+    if extra.get('stats_file') == 'PER_TEST':  # a record in this test's own folder
+        extra = {**extra, 'stats_file': str(tmp_path / 'stats.npz')}
     node = WandDriverNode(context=context, parameter_overrides=[
         rclpy.parameter.Parameter(name, value=value) for name, value in
         {'experiment': 'hold', 'wait_for_wrench': False, 'min_subscribers': 0, **extra}.items()])
@@ -124,3 +126,42 @@ def test_a_held_wrench_no_answer_follows_stops_at_its_lifetime_with_the_hold_on(
     force = driver.device.applied()[0]
     pushing = force[2] / 2.0 * 80  # of the 80 servo periods of those 20 ms
     assert 36 <= round(pushing) <= 37  # 9 ms on, to its lifetime; the period at its edge: either
+
+
+@pytest.mark.parametrize('driver', [{'rendering': 'remote', 'passivity': False,
+                                     'wrench_timeout': 0.5, 'stats_file': 'PER_TEST'}],
+                         indirect=True)
+def test_the_record_maps_each_force_edge_with_the_clock_offset_of_its_own_time(
+        driver, monkeypatch):
+    """The system clock steps 0.19 s forward while a force is on; a zero wrench ends it later."""
+    clock = ROSClock()
+    clock._set_ros_time_is_active(True)
+    start = time.monotonic() + 0.1  # the wand has been read at the monotonic clock
+    device = [start]  # the device's clock [s], which no step of the system clock moves
+    monkeypatch.setattr(driver, 'get_clock', lambda: clock)
+    monkeypatch.setattr(driver, '_device_time', lambda: device[0])
+    ros = [START]
+
+    def tick_after(seconds: float, step_ns: int = 0) -> None:
+        device[0] += seconds
+        ros[0] += round(seconds * 1e9) + step_ns
+        clock.set_ros_time_override(Time(nanoseconds=ros[0]))
+        driver.tick()
+
+    def wrench(force_z: float) -> None:
+        driver.on_wrench([*divmod(ros[0], 1_000_000_000), 'world', 0.0, 0.0, force_z, 0.0,
+                          0.0, 0.0])
+
+    tick_after(0.0)  # the session starts
+    wrench(2.0)
+    for step_ns in (0, 190_000_000, 0):
+        tick_after(0.001, step_ns)
+    wrench(0.0)
+    tick_after(0.001)
+    record = driver._force_edges()
+    on_device, off_device = (t for t, _ in driver.device.force_edges)
+    # To the float seconds of the offset: 0.24 µs at this epoch.
+    assert record['force_on_ns'] == pytest.approx([START + (on_device - start) * 1e9], abs=500)
+    assert record['force_off_ns'] == pytest.approx(
+        [START + (off_device - start) * 1e9 + 190_000_000], abs=500)
+    assert record['clock_steps'] == 1

@@ -257,7 +257,8 @@ def test_faults_mid_contact_zero_the_force_within_10_ms_and_the_loop_recovers(pr
               f'seen from '
               f'outside: stopped by {1e3 * outside[:, 1].max():.2f} ms at the latest, its tick '
               f'starting {1e3 * outside[:, 0].max():.2f} ms after the signal at the latest; '
-              f'sides joined anew after a silent restart: {len(REJOINS)}')
+              f'sides joined anew after a silent restart: {len(REJOINS)}; steps of the '
+              f'system clock the driver saw: {record["clock_steps"]}')
         assert delays.max() <= TIME_TO_ZERO, f'{label}: {delays}'
         assert outside[:, 0].max() <= TIME_TO_ZERO, f'{label}, outside: {outside}'
         assert len(trials) == TRIALS[label]

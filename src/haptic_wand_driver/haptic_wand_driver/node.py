@@ -33,6 +33,7 @@ from haptic_util.tally import Tally
 from haptic_wand_driver.answer_deadline import AnswerDeadline
 from haptic_wand_driver.assembly import local_renderer, make_wand, port_passivity
 from haptic_wand_driver.device import LocalRenderingUnsupported
+from haptic_wand_driver.device_clock_map import DeviceClockMap
 from haptic_wand_driver.local_rendering import LocalRenderer
 from haptic_wand_driver.loop_stats import LoopStats
 from haptic_wand_driver.params import WandDriverParams
@@ -72,6 +73,7 @@ class WandDriverNode(Node):
         self._record = (pathlib.Path(f'{params.stats_file}.part') if params.stats_file
                         else None)
         self.stats = LoopStats(record=self._record)
+        self._clock_map = DeviceClockMap()  # maps the device's record of its force to ROS time
         # The observer always runs (its books are the port's energy figures); the controller acts
         # only when enabled.
         self.passivity = port_passivity(params)
@@ -146,6 +148,9 @@ class WandDriverNode(Node):
         elif self._phase is Phase.RUNNING:
             device_now = self._device_time()
             state = self._state = self.device.read(device_now)
+            if self._record is not None:
+                self._clock_map.observe(device_now, self._ros_minus_device(),
+                                        self._ros_minus_device_estimate)
             if self.renderer is None:
                 self._apply(now, state)
             self.stats.sent(now_ns)
@@ -179,8 +184,8 @@ class WandDriverNode(Node):
     def _ros_minus_device_estimate(self, reads: int = 100) -> float:
         """Return ROS time minus the device's clock [s] as precisely as it can be read.
 
-        For a record, not a deadline: the midpoint of the narrowest of ``reads`` brackets of
-        ROS time between two readings of the device's clock.
+        For the record (``DeviceClockMap``), not a deadline: the midpoint of the narrowest of
+        ``reads`` brackets of ROS time between two readings of the device's clock.
         """
         width, estimate = math.inf, 0.0
         for _ in range(reads):
@@ -353,13 +358,18 @@ class WandDriverNode(Node):
         return super().destroy_node()
 
     def _force_edges(self) -> dict:
-        """Return the device's own record of its force switching on and off, ROS time [ns]."""
+        """Return the device's own record of its force switching on and off, ROS time [ns].
+
+        Each instant is mapped with the offset of its own stretch between steps of the system
+        clock (``DeviceClockMap``); ``clock_steps`` says how many there were.
+        """
         edges = getattr(self.device, 'force_edges', [])
-        ros_minus_device = self._ros_minus_device_estimate()
-        on = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if pushing]
-        off = [round(1e9 * (t + ros_minus_device)) for t, pushing in edges if not pushing]
-        return {'force_on_ns': np.array(on, dtype=np.int64),
-                'force_off_ns': np.array(off, dtype=np.int64)}
+        self._clock_map.observe(self._device_time(), self._ros_minus_device(),
+                                self._ros_minus_device_estimate)
+        times = self._clock_map.to_ros_ns([t for t, _ in edges])
+        pushing = np.array([p for _, p in edges], dtype=bool)
+        return {'force_on_ns': times[pushing], 'force_off_ns': times[~pushing],
+                'clock_steps': np.int64(self._clock_map.steps)}
 
 
 def main(args=None) -> int:
