@@ -1,10 +1,11 @@
 """The shared argument checks: what they accept, what they refuse, and the arrays they return."""
+import math
 
 import numpy as np
 import pytest
 
 from haptic_contract.checks import (finite_components, finite_number, finite_vector,
-                                    read_only_vector)
+                                    read_only_vector, within_box)
 
 
 @pytest.mark.parametrize('value', [np.array([1.0, -2.0, 3.5]), (1.0, -2.0, 3.5), [1, -2, 3.5],
@@ -52,3 +53,16 @@ def test_checked_number_refuses_naming_the_field(value, options):
 def test_checked_number_returns_a_float():
     assert finite_number(np.float32(0.5), 'rate', minimum=0.0) == 0.5
     assert type(finite_number(3, 'rate')) is float
+
+
+@pytest.mark.parametrize('point, margin, inside', [
+    ((0.0, 0.0, 0.0), 0.0, True),
+    ((0.1, -0.1, 0.05), 0.0, True),  # on the walls
+    ((0.1001, 0.0, 0.0), 0.0, False),
+    ((0.1001, 0.0, 0.0), 2e-3, True),
+    ((0.0, -0.1021, 0.0), 2e-3, False),
+    ((0.0, 0.0, math.nan), 1.0, False),
+    (np.array([0.0, 0.0, 0.06]), 0.0, False),
+])
+def test_within_box_takes_the_walls_and_the_margin_and_refuses_nan(point, margin, inside):
+    assert within_box(point, (-0.1, -0.1, -0.05), (0.1, 0.1, 0.05), margin) is inside

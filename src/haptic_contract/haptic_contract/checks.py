@@ -15,7 +15,7 @@ import numpy as np
 
 __all__ = ['finite_components', 'finite_number', 'finite_vector', 'floats3',
            'nonzero_components', 'per_axis', 'read_only_vector', 'unit_vector', 'vector3',
-           'whole_number']
+           'whole_number', 'within_box']
 
 _FLOAT64 = np.dtype(np.float64)
 
@@ -149,3 +149,12 @@ def floats3(vector) -> tuple[float, float, float]:
     """
     x, y, z = vector
     return float(x), float(y), float(z)
+
+
+def within_box(point, lower, upper, margin: float = 0.0) -> bool:
+    """Whether each component of ``point`` lies within [lower - margin, upper + margin].
+
+    The one test of a box (a workspace, a wand's joint ranges), so that a margin is the only
+    way two of them differ; walls count as inside. A NaN component is outside.
+    """
+    return all(low - margin <= x <= high + margin for low, x, high in zip(lower, point, upper))

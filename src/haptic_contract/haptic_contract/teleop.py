@@ -16,6 +16,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from haptic_contract.checks import within_box
+
 __all__ = ['Command', 'CommandLimits', 'Feedback', 'HAND_SPEED', 'Refusal', 'RemotePlane',
            'SCHEMES', 'Scheme', 'command_refusal', 'feedback_refusal', 'new_session']
 
@@ -145,8 +147,7 @@ def command_refusal(command: Command, limits: CommandLimits) -> Refusal | None:
     values = (command.stamp, *command.position, *command.velocity, command.energy_in)
     if not all(map(math.isfinite, values)):
         return Refusal('not finite', _numbers(values))
-    if not all(low <= x <= high for low, x, high in zip(
-            limits.workspace_lower, command.position, limits.workspace_upper)):
+    if not within_box(command.position, limits.workspace_lower, limits.workspace_upper):
         return Refusal('outside the workspace', _numbers(command.position))
     speed = math.hypot(*command.velocity)
     if speed > limits.max_speed:

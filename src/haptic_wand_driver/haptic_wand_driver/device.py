@@ -46,7 +46,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from haptic_contract.checks import (finite_components, finite_number, finite_vector,
-                                    read_only_vector)
+                                    read_only_vector, within_box)
 from haptic_contract.wand import quaternion_from_roll_yaw, roll_axis
 
 __all__ = [
@@ -117,8 +117,7 @@ class Workspace:
 
     def contains(self, coordinates: np.ndarray) -> bool:
         """Whether joint coordinates (5,) (x, y, z [m], roll, yaw [rad]) lie inside."""
-        lower, upper = self.coordinate_bounds
-        return bool(np.all(lower <= coordinates) and np.all(coordinates <= upper))
+        return within_box(coordinates, *self.coordinate_bounds)
 
 
 @dataclass(frozen=True, eq=False)

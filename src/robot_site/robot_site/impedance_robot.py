@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from haptic_contract.checks import (finite_components, finite_number, finite_vector,
-                                    nonzero_components, unit_vector)
+                                    nonzero_components, unit_vector, within_box)
 from haptic_util.substeps import substeps_due
 
 __all__ = ['Environment', 'ImpedanceRobot', 'ImpedanceRobotConfig', 'RobotState']
@@ -98,8 +98,7 @@ class ImpedanceRobotConfig:
 
     def contains(self, position: np.ndarray) -> bool:
         """Whether ``position`` (3,) m lies in the workspace box, walls included."""
-        return bool(np.all(position >= self.workspace_lower)
-                    and np.all(position <= self.workspace_upper))
+        return within_box(position, self.workspace_lower, self.workspace_upper)
 
 
 @dataclass(frozen=True, eq=False)

@@ -11,6 +11,7 @@ by a stream that then stops lets the true poses in again.
 """
 import numpy as np
 
+from haptic_contract.checks import floats3, within_box
 from haptic_contract.teleop import Refusal
 
 __all__ = ['TcpGate', 'TCP_TOLERANCE']
@@ -30,8 +31,7 @@ class TcpGate:
     """
 
     def __init__(self, workspace_lower, workspace_upper, max_speed: float) -> None:
-        self._lower = np.asarray(workspace_lower, dtype=np.float64) - TCP_TOLERANCE
-        self._upper = np.asarray(workspace_upper, dtype=np.float64) + TCP_TOLERANCE
+        self._lower, self._upper = floats3(workspace_lower), floats3(workspace_upper)
         self._max_speed = float(max_speed)
         self.position: np.ndarray | None = None  # [m] the last taken
         self.velocity = np.zeros(3)  # [m/s] between the last two taken
@@ -42,7 +42,7 @@ class TcpGate:
         position = np.asarray(position, dtype=np.float64)
         if not np.all(np.isfinite(position)):
             return Refusal('TCP not finite', str(position))
-        if np.any(position < self._lower) or np.any(position > self._upper):
+        if not within_box(position, self._lower, self._upper, TCP_TOLERANCE):
             return Refusal('TCP outside the workspace', _millimetres(position))
         if self.position is not None:
             elapsed = max(now - self.time, 0.0)
