@@ -1,7 +1,7 @@
 """The round trip the two site gateways add, against plain UDP between the same two processes.
 
     .venv/bin/python bench/bench_link.py [--seconds 60] [--runs 1] [--rate 1000] [--threads]
-                                         [--json PATH]
+                                         [--answer-every 1] [--json PATH]
 
 Why: a command that crosses to the remote site and the feedback that comes back take the path
 that is deployed: DDS in the operator's domain, the operator's gateway, Zenoh over mutual TLS,
@@ -20,6 +20,8 @@ share the machine's state; each figure is given beside its floor, and as the rou
 over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's CPU, and the
 echo's (with its gateway, when it is in the echo's process), is read from outside (psutil) over
 the measured window, in % of one core. No emulated delay: the stage passes messages straight on.
+With ``--answer-every 10`` the echo answers every tenth ping only, on every path: the rates a
+session puts through the remote site's gateway (1 kHz commands in, 100 Hz feedback out).
 """
 import argparse
 import os
@@ -75,6 +77,11 @@ def ping(sequence: int) -> bytes:
     return serialize_message(message)
 
 
+def answered(data: bytes, every: int) -> bool:
+    """Whether the echo answers the ping ``data`` (its CDR bytes): every ``every``-th."""
+    return SEQUENCE.unpack_from(data, 4)[0] % every == 0
+
+
 def udp_socket() -> socket.socket:
     """Return a UDP socket whose receive buffer holds what DDS's deep history would."""
     udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -107,21 +114,31 @@ class Echo(Node):
     def __init__(self, udp_port: int, certs: pathlib.Path, endpoint: str) -> None:
         super().__init__('bench_link_echo')
         declare_parameters(self, RealtimeParams)
+        self._every = self.declare_parameter('answer_every', 1).value
         self._pong = self.create_publisher(PoseStamped, PONG, LINK_QOS)
-        self.create_subscription(PoseStamped, PING, self._pong.publish, LINK_QOS, raw=True)
+        self.create_subscription(PoseStamped, PING, self._on_dds, LINK_QOS, raw=True)
         config, pong_key, ping_key = direct_session('remote', certs, endpoint)
         self.session = open_session(config, self.get_name())
-        pong = self.session.declare_publisher(pong_key, **publisher_options(STREAM))
-        self._listener = self.session.declare_subscriber(
-            ping_key, lambda sample: pong.put(sample.payload.to_bytes()))
+        self._zenoh_pong = self.session.declare_publisher(pong_key, **publisher_options(STREAM))
+        self._listener = self.session.declare_subscriber(ping_key, self._on_zenoh)
         self._socket = udp_socket()
         self._socket.bind(('127.0.0.1', udp_port))
         threading.Thread(target=self._echo_udp, daemon=True).start()
 
+    def _on_dds(self, data: bytes) -> None:
+        if answered(data, self._every):
+            self._pong.publish(data)
+
+    def _on_zenoh(self, sample) -> None:
+        data = sample.payload.to_bytes()
+        if answered(data, self._every):
+            self._zenoh_pong.put(data)
+
     def _echo_udp(self) -> None:
         while True:
             data, sender = self._socket.recvfrom(65536)
-            self._socket.sendto(data, sender)
+            if answered(data, self._every):
+                self._socket.sendto(data, sender)
 
 
 class SiteEcho(Node):
@@ -130,15 +147,19 @@ class SiteEcho(Node):
     def __init__(self) -> None:
         super().__init__('bench_link_site_echo')
         declare_parameters(self, RealtimeParams)
+        every = self.declare_parameter('answer_every', 1).value
         codec = MessageCodec(PoseStamped)
         pong = intra_process.stream_publisher(self, codec, PONG)
-        intra_process.stream_subscription(self, codec, PING, pong.publish, refused=Tally())
+        intra_process.stream_subscription(
+            self, codec, PING, lambda values: values[0] % every == 0 and pong.publish(values),
+            refused=Tally())
 
 
 class Pinger:
     """This process's end: pings sent at a rate, each pong's round trip from its send time."""
 
-    def __init__(self) -> None:
+    def __init__(self, every: int = 1) -> None:
+        self.every = every  # the echo answers every ``every``-th ping
         self.sent, self.round_trips = {}, {}  # sequence -> send time; sequence -> round trip
 
     def on_pong(self, data: bytes) -> None:
@@ -170,10 +191,11 @@ class Pinger:
         return range(first, first + count)
 
     def figures(self, sequences: range) -> dict:
-        trips = np.array([self.round_trips[s] for s in sequences if s in self.round_trips])
+        answered = [s for s in sequences if s % self.every == 0]
+        trips = np.array([self.round_trips[s] for s in answered if s in self.round_trips])
         values = np.percentile(trips, PERCENTILES) * 1e3 if len(trips) else [float('nan')] * 3
         return {**{f'p{q:g}_ms': float(v) for q, v in zip(PERCENTILES, values)},
-                'sent': len(sequences), 'lost': len(sequences) - len(trips)}
+                'sent': len(answered), 'lost': len(answered) - len(trips)}
 
 
 class DdsEnd:
@@ -352,17 +374,23 @@ def main(argv=None) -> int:
     parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
     parser.add_argument('--runs', type=int, default=1, help='alternated rounds of the cases')
     parser.add_argument('--rate', type=float, default=1000.0, help='[Hz] pings')
+    parser.add_argument('--answer-every', type=int, default=1,
+                        help='the echo answers every N-th ping (10: the rates of a session at '
+                        'the remote gateway); the round trips are of those')
     parser.add_argument('--threads', action='store_true',
                         help="print each process's CPU by thread too (always in --json)")
     ros_domain.add_option(parser, help="the operator's side; the echo's is the next, and the "
                           "two sites with their gateways in them the two after")
     result_files.add_option(parser)
     args = parser.parse_args(argv[1:])
+    if args.answer_every < 1:
+        parser.error(f'--answer-every must be at least 1, got {args.answer_every}')
     ros_domain.keep_local()
     print(f'machine: {machine.line("ros-jazzy-rclpy", "eclipse-zenoh")}; load average '
           f'{os.getloadavg()[0]:.2f}')
     print(f'{args.rate:g} Hz pings for {args.seconds:g} s per case, {args.runs} alternated '
-          f'round(s); round trip in ms; CPU in % of one core over the window')
+          f'round(s), every {args.answer_every} answered; round trip in ms; CPU in % of one '
+          f'core over the window')
     print(f'{"case":<9} {"p50":>8} {"p99":>8} {"p99.9":>8} {"lost/sent":>12} CPU')
     results = {case: [] for case in CASES}
     with tempfile.TemporaryDirectory() as tmp:
@@ -375,14 +403,16 @@ def main(argv=None) -> int:
         udp_port = free_port(socket.SOCK_DGRAM)
         direct = f'tls/127.0.0.1:{free_port(socket.SOCK_STREAM)}'
         echo = start_child('echo', [sys.executable, __file__, 'echo', str(udp_port),
-                                    str(folder / 'certs'), direct, '--ros-args'],
+                                    str(folder / 'certs'), direct, '--ros-args', '-p',
+                                    f'bench_link_echo:answer_every:={args.answer_every}'],
                            loop_environment(args.domain_id + 1, folder / 'log'))
         in_process = loopback_gateway_files(folder / 'in_process', routes=routes)
         site_echo = start_child('site_echo', [
             sys.executable, __file__, 'site-echo', '--ros-args', *gateway_remap('remote'),
-            '--params-file', str(in_process['remote'])],
+            '--params-file', str(in_process['remote']), '-p',
+            f'bench_link_site_echo:answer_every:={args.answer_every}'],
             loop_environment(args.domain_id + 3, folder / 'log'))
-        pinger = Pinger()
+        pinger = Pinger(args.answer_every)
         gateway_pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
         watched = {'floor': {'echo': echo.pid}, 'zenoh': {'echo': echo.pid},
                    'gateways': {**gateway_pids, 'echo': echo.pid},
@@ -419,6 +449,7 @@ def main(argv=None) -> int:
         + '; the echo ' + ', '.join(
             f'{cpu:.1f} % ({case})' for case, cpu in summary['echo_cpu_pct'].items()))
     result_files.write(args.json, {'rate_hz': args.rate, 'seconds': args.seconds,
+                                   'answer_every': args.answer_every,
                                    'runs': results, 'summary': summary})
     return 0
 
