@@ -160,8 +160,12 @@ def test_the_record_maps_each_force_edge_with_the_clock_offset_of_its_own_time(
     tick_after(0.001)
     record = driver._force_edges()
     on_device, off_device = (t for t, _ in driver.device.force_edges)
-    # To the float seconds of the offset: 0.24 µs at this epoch.
-    assert record['force_on_ns'] == pytest.approx([START + (on_device - start) * 1e9], abs=500)
-    assert record['force_off_ns'] == pytest.approx(
-        [START + (off_device - start) * 1e9 + 190_000_000], abs=500)
+    # The truth in integer nanoseconds. The driver reads the offset in float seconds: ROS
+    # time's nanoseconds as a float (256 ns apart at this epoch), scaled, then less the
+    # device's clock, each rounding: 0.53 µs at most in 200000 random draws of that arithmetic
+    # (448 ns seen in this test).
+    on_ns, off_ns = (START + round((t - start) * 1e9) for t in (on_device, off_device))
+    assert abs(int(record['force_on_ns'][0]) - on_ns) <= 1000
+    assert abs(int(record['force_off_ns'][0]) - (off_ns + 190_000_000)) <= 1000
+    assert record['force_on_ns'].size == record['force_off_ns'].size == 1
     assert record['clock_steps'] == 1
