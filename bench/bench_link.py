@@ -77,9 +77,14 @@ def ping(sequence: int) -> bytes:
     return serialize_message(message)
 
 
-def answered(data: bytes, every: int) -> bool:
-    """Whether the echo answers the ping ``data`` (its CDR bytes): every ``every``-th."""
-    return SEQUENCE.unpack_from(data, 4)[0] % every == 0
+def answered(sequence: int, every: int) -> bool:
+    """Whether the echo answers ping ``sequence``: every ``every``-th."""
+    return sequence % every == 0
+
+
+def answered_bytes(data: bytes, every: int) -> bool:
+    """Whether the echo answers the ping ``data`` (its CDR bytes)."""
+    return answered(SEQUENCE.unpack_from(data, 4)[0], every)
 
 
 def udp_socket() -> socket.socket:
@@ -126,18 +131,18 @@ class Echo(Node):
         threading.Thread(target=self._echo_udp, daemon=True).start()
 
     def _on_dds(self, data: bytes) -> None:
-        if answered(data, self._every):
+        if answered_bytes(data, self._every):
             self._pong.publish(data)
 
     def _on_zenoh(self, sample) -> None:
         data = sample.payload.to_bytes()
-        if answered(data, self._every):
+        if answered_bytes(data, self._every):
             self._zenoh_pong.put(data)
 
     def _echo_udp(self) -> None:
         while True:
             data, sender = self._socket.recvfrom(65536)
-            if answered(data, self._every):
+            if answered_bytes(data, self._every):
                 self._socket.sendto(data, sender)
 
 
@@ -151,7 +156,7 @@ class SiteEcho(Node):
         codec = MessageCodec(PoseStamped)
         pong = intra_process.stream_publisher(self, codec, PONG)
         intra_process.stream_subscription(
-            self, codec, PING, lambda values: values[0] % every == 0 and pong.publish(values),
+            self, codec, PING, lambda values: answered(values[0], every) and pong.publish(values),
             refused=Tally())
 
 
@@ -191,11 +196,11 @@ class Pinger:
         return range(first, first + count)
 
     def figures(self, sequences: range) -> dict:
-        answered = [s for s in sequences if s % self.every == 0]
-        trips = np.array([self.round_trips[s] for s in answered if s in self.round_trips])
+        answered_pings = [s for s in sequences if answered(s, self.every)]
+        trips = np.array([self.round_trips[s] for s in answered_pings if s in self.round_trips])
         values = np.percentile(trips, PERCENTILES) * 1e3 if len(trips) else [float('nan')] * 3
         return {**{f'p{q:g}_ms': float(v) for q, v in zip(PERCENTILES, values)},
-                'sent': len(answered), 'lost': len(answered) - len(trips)}
+                'sent': len(answered_pings), 'lost': len(answered_pings) - len(trips)}
 
 
 class DdsEnd:
