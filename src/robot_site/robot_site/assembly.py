@@ -14,7 +14,7 @@ from haptic_contract.teleop import CommandLimits
 from robot_site.follower import Follower, FollowerConfig
 from robot_site.ft_sensor import ForceTorqueSensor, ForceTorqueSensorConfig
 from robot_site.impedance_robot import Environment, ImpedanceRobot, ImpedanceRobotConfig
-from robot_site.model_estimation import ContactModelEstimator
+from robot_site.model_estimation import ContactModelEstimator, EstimatorConfig
 from robot_site.params import envelope, FollowerParams, SimulatedRobotParams
 from robot_site.safety import PatientSafety, SafetyConfig
 from robot_site.tissue import HuntCrossley, Surface, Tissue
@@ -87,5 +87,6 @@ def follower(params: FollowerParams, limits: CommandLimits, surface: Callable | 
     """
     return Follower(follower_config(params),
                     follower_safety(params) if safety is None else safety, limits,
-                    ContactModelEstimator(), surface=surface,
+                    ContactModelEstimator(EstimatorConfig(force_noise=params.force_noise)),
+                    surface=surface,
                     admission=Admission(admission_config(params)))

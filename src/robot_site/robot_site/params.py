@@ -4,6 +4,7 @@ from dataclasses import dataclass
 from haptic_contract.teleop import HAND_SPEED, Scheme, SCHEMES
 from haptic_util.parameters import parameter, RealtimeParams
 from robot_site.force_envelope import EnvelopeConfig
+from robot_site.model_estimation import EstimatorConfig
 from robot_site.safety import SafetyConfig
 from teleop_protocol.admission import AdmissionConfig
 
@@ -94,6 +95,9 @@ class FollowerParams(PatientBoundParams, RealtimeParams):
     drift_rate: float = parameter(2.0, 'tdpa: drift compensation rate', unit='1/s', low=0.0)
     sensor_timeout: float = parameter(0.05, 'no F/T wrench or TCP pose for this long: no force '
                                       'is fed back', unit='s', low=0.001)
+    force_noise: float = parameter(EstimatorConfig.force_noise, 'the F/T sensor\'s noise RMS '
+                                   'per axis: a contact\'s plane is sent once its stiffness is '
+                                   'known above it', unit='N', low=0.0)
     max_command_speed: float = parameter(HAND_SPEED, 'a command asking a speed above this is '
                                          'refused: no hand moves a wand faster', unit='m/s',
                                          low=0.01)
