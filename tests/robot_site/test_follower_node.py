@@ -1,5 +1,6 @@
 """The follower node follows only a robot that says it is the one its force bound was set for."""
 import math
+import time
 
 import pytest
 import rclpy
@@ -74,3 +75,22 @@ def test_a_robot_with_no_top_speed_is_not_commanded(follower, speed):
     follower.on_impedance(impedance_message('base_link', stiffness=1500.0,
                                             **{**ROBOT, 'max_speed': speed}))
     assert follower.follower is None and 'top speed' in follower.report().message
+
+
+def test_the_tcp_poses_are_checked_against_the_robot_s_latest_limits(follower):
+    """A robot that reports a smaller workspace, then a lower top speed: the poses are checked
+    against those, as its commands are (before, the gate kept the first report's limits)."""
+    def pose(z):
+        follower.on_tcp((0, 0, 'base_link', 0.0, 0.0, z, 0.0, 0.0, 0.0, 1.0))
+    follower.on_impedance(impedance_message('base_link', stiffness=1500.0, **ROBOT))
+    pose(0.0)
+    follower.on_impedance(impedance_message('base_link', stiffness=1500.0, **{
+        **ROBOT, 'workspace_upper': (0.4, 0.4, -0.0025)}))
+    pose(0.001)  # 3.5 mm above the new box: beyond the 2 mm a pose's noise is given
+    assert follower._refused.counts == {'TCP outside the workspace': 1}
+    follower.on_impedance(impedance_message('base_link', stiffness=1500.0, **{
+        **ROBOT, 'max_speed': 0.01}))
+    time.sleep(0.05)  # 12.5 mm at the first top speed, 0.5 mm at the new one (2 mm given)
+    pose(-0.008)
+    assert follower._refused.counts['TCP faster than the robot'] == 1
+    assert follower._tcp.position[2] == 0.0

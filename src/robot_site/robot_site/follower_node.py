@@ -124,11 +124,15 @@ class FollowerNode(Node):
         if problem is not None:
             self.follower, self._robot_problem = None, (ERROR, problem)
             self.get_logger().error(f'not commanding the robot: {problem}')
-        elif self.follower is None:
+            return
+        limits = (report.limits.workspace_lower, report.limits.workspace_upper, report.max_speed)
+        if self._tcp is None:
+            self._tcp = TcpGate(*limits)
+        else:
+            self._tcp.bound(*limits)  # its last pose kept: the robot is where it was
+        if self.follower is None:
             self.follower = follower(self.params, report.limits, self._surface,
                                      safety=self._safety)
-            self._tcp = self._tcp or TcpGate(report.limits.workspace_lower,
-                                             report.limits.workspace_upper, report.max_speed)
             self.get_logger().info(f'the robot is as expected ({report.stiffness:g} N/m): '
                                    'following')
         else:

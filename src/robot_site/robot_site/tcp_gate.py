@@ -31,11 +31,15 @@ class TcpGate:
     """
 
     def __init__(self, workspace_lower, workspace_upper, max_speed: float) -> None:
-        self._lower, self._upper = floats3(workspace_lower), floats3(workspace_upper)
-        self._max_speed = float(max_speed)
+        self.bound(workspace_lower, workspace_upper, max_speed)
         self.position: np.ndarray | None = None  # [m] the last taken
         self.velocity = np.zeros(3)  # [m/s] between the last two taken
         self.time = -np.inf  # [s] when the last was taken
+
+    def bound(self, workspace_lower, workspace_upper, max_speed: float) -> None:
+        """Check the poses to come against these limits: the robot's latest report."""
+        self._lower, self._upper = floats3(workspace_lower), floats3(workspace_upper)
+        self._max_speed = float(max_speed)
 
     def take(self, now: float, position) -> Refusal | None:
         """Take ``position`` (3,) m arrived at ``now`` (s); return None, or why it was refused."""
