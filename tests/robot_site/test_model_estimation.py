@@ -134,9 +134,8 @@ def approach(config, seed, speed):
     Return the farthest any plane given lay from the tissue's tangent plane where the TCP
     pressed, and how long after the force first reached ``contact_force`` the first came (s).
     """
-    surface = PlaneSurface(SKIN.point, NORMAL)
     robot = ImpedanceRobot(ImpedanceRobotConfig(initial_position=SKIN.point + 0.005 * NORMAL),
-                           environment=Tissue(ABDOMEN, surface))
+                           environment=Tissue(ABDOMEN, SKIN))
     sensor = ForceTorqueSensor(ForceTorqueSensorConfig(seed=seed))
     estimator = ContactModelEstimator(config)
     farthest, touched, first = 0.0, None, None
@@ -149,7 +148,7 @@ def approach(config, seed, speed):
         estimate = estimator.update(time, force, state.position, state.velocity, lambda: NORMAL)
         if estimate is not None:
             first = time if first is None else first
-            depth = surface.penetration(state.position)[0]
+            depth = SKIN.penetration(state.position)[0]
             tangent = -depth * (1.0 - 1.0 / ABDOMEN.exponent)  # where it crosses zero force
             farthest = max(farthest, abs((estimate.point - SKIN.point) @ NORMAL - tangent))
         robot.command(SKIN.point + (0.005 - min(speed * time, 0.01)) * NORMAL)
