@@ -96,8 +96,8 @@ class FollowerParams(PatientBoundParams, RealtimeParams):
     sensor_timeout: float = parameter(0.05, 'no F/T wrench or TCP pose for this long: no force '
                                       'is fed back', unit='s', low=0.001)
     force_noise: float = parameter(EstimatorConfig.force_noise, 'the F/T sensor\'s noise RMS '
-                                   'per axis: a contact\'s plane is sent once its stiffness is '
-                                   'known above it', unit='N', low=0.0)
+                                   'per axis: in a contact, the estimated plane is sent once the '
+                                   'fit knows the stiffness through it', unit='N', low=0.0)
     max_command_speed: float = parameter(HAND_SPEED, 'a command asking a speed above this is '
                                          'refused: no hand moves a wand faster', unit='m/s',
                                          low=0.01)
