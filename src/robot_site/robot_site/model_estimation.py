@@ -35,10 +35,10 @@ from its covariance and the sensor's noise, within ``stiffness_confidence`` of i
 lies at −b / k, and at a contact's start, a fraction of a millimetre in, the noise moves k
 freely. Given at once, that plane lay up to 39 mm from the tissue's tangent in 40 seeded
 approaches at 1 and 4 cm/s (1.4 mm once known, 13-51 ms after the touch), and 12-13 mm above
-the skin in runs of the session with a core busy. Until then the follower sends the surface as
-it sees it. A contact ends below ``contact_end_force``,
-under the force that begins one, so that the noise does not end and begin contacts at the
-threshold, each from a new origin of s.
+the skin in runs of the attacked session (a CI run; here with a core busy). Until then the
+follower sends the surface as it sees it. A contact ends below ``contact_end_force``, under the
+force that begins one, so that the noise does not end and begin contacts at the threshold, each
+from a new origin of s.
 
 A plane farther from the pressing probe than ``max_indentation`` is no estimate of a patient:
 the fit starts again from its prior, as at a new contact. Fed TCP poses 50 mm off the real
