@@ -27,24 +27,34 @@ class KelvinVoigt:
         return max(0.0, self.stiffness * depth - self.damping * velocity @ normal) * normal
 
 
+def pressed(environment, target, duration, *, seed=0, start=SKIN.point):
+    """The impedance robot, from ``start``, commanded to ``target(time)`` at each tick, with
+    the wrist's sensor (0.05 N RMS noise drawn from ``seed``, 200 Hz).
+
+    Yield each tick's time (s), the robot's state and the sensor's force, before it is
+    commanded.
+    """
+    robot = ImpedanceRobot(ImpedanceRobotConfig(initial_position=start), environment=environment)
+    sensor = ForceTorqueSensor(ForceTorqueSensorConfig(seed=seed))
+    for k in range(round(duration / TICK)):
+        time = k * TICK
+        state = robot.read(time)
+        yield time, state, sensor.measure(time, state.external_force).force
+        robot.command(target(time))
+
+
 def scan(environment, duration, depth=lambda t: 0.02 + 0.004 * math.sin(2 * math.pi * t)):
     """Press the skin, breathing in and out at 1 Hz and sliding along it at 2 cm/s.
 
     Return the last estimate and the depths the TCP went through in the last half.
     """
-    robot = ImpedanceRobot(ImpedanceRobotConfig(initial_position=SKIN.point),
-                           environment=environment)
-    sensor = ForceTorqueSensor()  # 0.05 N RMS noise, 200 Hz
     estimator = ContactModelEstimator()
     depths = []
-    steps = round(duration / TICK)
-    for k in range(steps):
-        time = k * TICK
-        state = robot.read(time)
-        estimate = estimator.update(time, sensor.measure(time, state.external_force).force,
-                                    state.position, state.velocity)
-        robot.command(SKIN.point - depth(time) * NORMAL + [0.02 * time, 0.0, 0.0])
-        if k >= steps // 2:
+    for time, state, force in pressed(
+            environment, lambda t: SKIN.point - depth(t) * NORMAL + [0.02 * t, 0.0, 0.0],
+            duration):
+        estimate = estimator.update(time, force, state.position, state.velocity)
+        if time >= duration / 2:
             depths.append(SKIN.penetration(state.position)[0])
     return estimate, np.array(depths)
 
@@ -134,15 +144,11 @@ def approach(config, seed, speed):
     Return the farthest any plane given lay from the tissue's tangent plane where the TCP
     pressed, and how long after the force first reached ``contact_force`` the first came (s).
     """
-    robot = ImpedanceRobot(ImpedanceRobotConfig(initial_position=SKIN.point + 0.005 * NORMAL),
-                           environment=Tissue(ABDOMEN, SKIN))
-    sensor = ForceTorqueSensor(ForceTorqueSensorConfig(seed=seed))
     estimator = ContactModelEstimator(config)
     farthest, touched, first = 0.0, None, None
-    for k in range(round((0.01 / speed + 0.2) / TICK)):
-        time = k * TICK
-        state = robot.read(time)
-        force = sensor.measure(time, state.external_force).force
+    for time, state, force in pressed(
+            Tissue(ABDOMEN, SKIN), lambda t: SKIN.point + (0.005 - min(speed * t, 0.01)) * NORMAL,
+            0.01 / speed + 0.2, seed=seed, start=SKIN.point + 0.005 * NORMAL):
         if touched is None and np.linalg.norm(force) >= config.contact_force:
             touched = time
         estimate = estimator.update(time, force, state.position, state.velocity, lambda: NORMAL)
@@ -151,7 +157,6 @@ def approach(config, seed, speed):
             depth = SKIN.penetration(state.position)[0]
             tangent = -depth * (1.0 - 1.0 / ABDOMEN.exponent)  # where it crosses zero force
             farthest = max(farthest, abs((estimate.point - SKIN.point) @ NORMAL - tangent))
-        robot.command(SKIN.point + (0.005 - min(speed * time, 0.01)) * NORMAL)
     return farthest, first - touched
 
 
@@ -180,24 +185,20 @@ def forged_scan(config, attack=(2.0, 5.0), duration=8.0, forged=0.7, offset=0.05
 
     Return the planes' farthest offset from the skin during the attack, and the last estimate.
     """
-    robot = ImpedanceRobot(ImpedanceRobotConfig(initial_position=SKIN.point),
-                           environment=KelvinVoigt(800.0, 10.0))
-    sensor, estimator = ForceTorqueSensor(), ContactModelEstimator(config)
+    estimator = ContactModelEstimator(config)
     rng = np.random.default_rng(7)
     seen, farthest, estimate = None, 0.0, None
-    for k in range(round(duration / TICK)):
-        time = k * TICK
-        state = robot.read(time)
+    for time, state, force in pressed(
+            KelvinVoigt(800.0, 10.0),
+            lambda t: SKIN.point - (0.02 + 0.004 * math.sin(2 * math.pi * t)) * NORMAL, duration):
         position = state.position.copy()
         if attack[0] <= time < attack[1] and rng.random() < forged:
             position -= offset * NORMAL
         velocity = np.zeros(3) if seen is None else (position - seen) / TICK
         seen = position
-        estimate = estimator.update(time, sensor.measure(time, state.external_force).force,
-                                    position, velocity)
+        estimate = estimator.update(time, force, position, velocity)
         if estimate is not None and attack[0] <= time < attack[1]:
             farthest = max(farthest, abs((estimate.point - SKIN.point) @ NORMAL))
-        robot.command(SKIN.point - (0.02 + 0.004 * math.sin(2 * math.pi * time)) * NORMAL)
     return farthest, estimate
 
 

@@ -172,7 +172,7 @@ class FollowerNode(Node):
 
     def tick(self) -> None:
         now = self._now()
-        tcp = self._tcp  # made with the follower
+        tcp = self._tcp  # made with the follower, or before it
         if self.follower is None or tcp.position is None:
             return  # the robot has not spoken yet, or is not the one expected
         fresh = (now - self._force_time <= self.params.sensor_timeout
