@@ -13,7 +13,13 @@ access control, the streams' publisher options): what Zenoh itself takes, with n
 gateway process on the path; the least a gateway in the sites' own processes could add. And
 over the gateways as nodes of the sites' own processes (``site_gateway`` composed with a ping
 node here and an echo node there, their streams handed over in each process): the path a
-session deploys, against the gateways as processes of their own, its baseline. This
+session deploys, against the gateways as processes of their own, its baseline. The echo in its
+site's process is modelled on the follower: it ticks at 1 kHz, and takes the pings in its tick
+(``in_tick``), as the follower takes commands; beside it, the same echo that takes them as the
+gateway's own 1 ms timer hands them over (the handover before the follower took its commands in
+its tick), and, for the gateway's share of its site's CPU, the same ticking echo alone, no
+gateway, nothing to answer (``tick_alone``): each in-process gateway's CPU is its process's
+less that one's, in the same round. This
 process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in the next DDS
 domain) sends each back at once on every path. The cases alternate within one invocation, so they
 share the machine's state; each figure is given beside its floor, and as the round trip added
@@ -51,6 +57,7 @@ from haptic_util import intra_process
 from haptic_util.cdr import MessageCodec
 from haptic_util.executor import run_nodes
 from haptic_util.parameters import declare_parameters, RealtimeParams
+from haptic_util.polled_reader import TICK
 from haptic_util.qos import LINK_QOS
 from haptic_util.tally import Tally
 from site_gateway.gateway import GatewayNode, open_session
@@ -60,7 +67,8 @@ from site_gateway.zenoh_config import Credentials, publisher_options, session_co
 PING, PONG = 'bench/ping', 'bench/pong'
 POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
 DIRECT_PREFIX = 'bench'  # the direct case's Zenoh keys (its sessions reach no gateway's)
-CASES = ('floor', 'zenoh', 'gateways', 'in_process')
+CASES = ('floor', 'zenoh', 'gateways', 'in_process_timer', 'in_process')
+IN_PROCESS = {'in_process_timer': False, 'in_process': True}  # case -> echo takes in its tick
 SEQUENCE = struct.Struct('<i')  # the ping's number, in its header's stamp.sec (after CDR's 4)
 WARM_UP = 1.0  # [s] of pongs coming back before a window is measured
 DRAIN = 0.5  # [s] after a window, for the last pongs
@@ -147,17 +155,22 @@ class Echo(Node):
 
 
 class SiteEcho(Node):
-    """The remote end in its site's process: each ping its gateway hands over, handed back."""
+    """The remote end in its site's process: each ping its gateway hands over, handed back.
+
+    It ticks at 1 kHz, as the follower does; with ``in_tick`` it takes the pings in that tick.
+    """
 
     def __init__(self) -> None:
         super().__init__('bench_link_site_echo')
         declare_parameters(self, RealtimeParams)
         every = self.declare_parameter('answer_every', 1).value
+        in_tick = self.declare_parameter('in_tick', True).value
         codec = MessageCodec(PoseStamped)
         pong = intra_process.stream_publisher(self, codec, PONG)
-        intra_process.stream_subscription(
+        pings = intra_process.link_subscription(
             self, codec, PING, lambda values: answered(values[0], every) and pong.publish(values),
-            refused=Tally())
+            refused=Tally(), in_tick=in_tick)
+        self.create_timer(TICK, pings.take if in_tick else lambda: None)
 
 
 class Pinger:
@@ -372,9 +385,10 @@ def main(argv=None) -> int:
     argv = sys.argv if argv is None else argv
     if len(argv) > 1 and argv[1] == 'echo':
         return run_nodes([lambda: Echo(int(argv[2]), pathlib.Path(argv[3]), argv[4])], argv)
-    if len(argv) > 1 and argv[1] == 'site-echo':
+    if len(argv) > 1 and argv[1] in ('site-echo', 'tick-alone'):
         intra_process.enable()
-        return run_nodes([GatewayNode, SiteEcho], argv)
+        nodes = [GatewayNode, SiteEcho] if argv[1] == 'site-echo' else [SiteEcho]
+        return run_nodes(nodes, argv)
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seconds', type=float, default=60.0, help='measured window per case')
     parser.add_argument('--runs', type=int, default=1, help='alternated rounds of the cases')
@@ -384,8 +398,9 @@ def main(argv=None) -> int:
                         'the remote gateway); the round trips are of those')
     parser.add_argument('--threads', action='store_true',
                         help="print each process's CPU by thread too (always in --json)")
-    ros_domain.add_option(parser, help="the operator's side; the echo's is the next, and the "
-                          "two sites with their gateways in them the two after")
+    ros_domain.add_option(parser, help="the operator's side; the echo's is the next, the two "
+                          'pairs of sites with their gateways in them the four after, and the '
+                          'ticking echo alone the next')
     result_files.add_option(parser)
     args = parser.parse_args(argv[1:])
     if args.answer_every < 1:
@@ -411,23 +426,32 @@ def main(argv=None) -> int:
                                     str(folder / 'certs'), direct, '--ros-args', '-p',
                                     f'bench_link_echo:answer_every:={args.answer_every}'],
                            loop_environment(args.domain_id + 1, folder / 'log'))
-        in_process = loopback_gateway_files(folder / 'in_process', routes=routes)
-        site_echo = start_child('site_echo', [
-            sys.executable, __file__, 'site-echo', '--ros-args', *gateway_remap('remote'),
-            '--params-file', str(in_process['remote']), '-p',
-            f'bench_link_site_echo:answer_every:={args.answer_every}'],
-            loop_environment(args.domain_id + 3, folder / 'log'))
+        in_process, site_echoes = {}, {}
+        for number, (case, in_tick) in enumerate(IN_PROCESS.items()):
+            in_process[case] = loopback_gateway_files(folder / case, routes=routes)
+            site_echoes[case] = start_child(case, [
+                sys.executable, __file__, 'site-echo', '--ros-args', *gateway_remap('remote'),
+                '--params-file', str(in_process[case]['remote']), '-p',
+                f'bench_link_site_echo:answer_every:={args.answer_every}', '-p',
+                f'bench_link_site_echo:in_tick:={in_tick}'],
+                loop_environment(args.domain_id + 3 + 2 * number, folder / 'log'))
+        tick_alone = start_child('tick_alone', [sys.executable, __file__, 'tick-alone'],
+                                 loop_environment(args.domain_id + 2 + 2 * len(IN_PROCESS),
+                                                  folder / 'log'))
         pinger = Pinger(args.answer_every)
         gateway_pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
         watched = {'floor': {'echo': echo.pid}, 'zenoh': {'echo': echo.pid},
                    'gateways': {**gateway_pids, 'echo': echo.pid},
-                   'in_process': {'echo': site_echo.pid}}
+                   **{case: {'echo': child.pid, 'tick alone': tick_alone.pid}
+                      for case, child in site_echoes.items()}}
         ends = {}  # made one by one inside the try: one that fails still stops the others
         try:
             ends['floor'] = UdpEnd(udp_port, pinger)
             ends['zenoh'] = ZenohEnd(folder / 'certs', direct, pinger)
             ends['gateways'] = DdsEnd(args.domain_id, pinger)
-            ends['in_process'] = SiteEnd(args.domain_id + 2, in_process['operator'], pinger)
+            for number, case in enumerate(IN_PROCESS):
+                ends[case] = SiteEnd(args.domain_id + 2 + 2 * number, in_process[case]['operator'],
+                                     pinger)
             first = -3_000_000
             for case in CASES:
                 first = connect(ends[case], pinger, first)
@@ -440,10 +464,11 @@ def main(argv=None) -> int:
         finally:
             for end in ends.values():
                 end.close()
-            stop_children([*gateways.values(), echo, site_echo])
+            stop_children([*gateways.values(), echo, *site_echoes.values(), tick_alone])
     summary = summarize(results)
     print(f'load average after: {os.getloadavg()[0]:.2f}')
     for case, what in (('zenoh', 'Zenoh alone'), ('gateways', 'the gateways'),
+                       ('in_process_timer', "the gateways in the sites' processes, by timer"),
                        ('in_process', "the gateways in the sites' processes")):
         print(f'added by {what} over the floor (median of rounds): ' + ', '.join(
             f'p{q:g} {summary[case]["added_ms"][f"p{q:g}"]:.3f} ms '
@@ -453,6 +478,9 @@ def main(argv=None) -> int:
         f'{name} {cpu:.1f} %' for name, cpu in summary['gateway_cpu_pct'].items())
         + '; the echo ' + ', '.join(
             f'{cpu:.1f} % ({case})' for case, cpu in summary['echo_cpu_pct'].items()))
+    print("the remote gateway in its site's process, over the ticking echo alone (median of "
+          'rounds): ' + ', '.join(f'{cpu:.1f} % ({case})' for case, cpu in
+                                  summary['in_process_gateway_cpu_pct'].items()))
     result_files.write(args.json, {'rate_hz': args.rate, 'seconds': args.seconds,
                                    'answer_every': args.answer_every,
                                    'runs': results, 'summary': summary})
@@ -461,6 +489,9 @@ def main(argv=None) -> int:
 
 def summarize(results: dict) -> dict:
     """Return what Zenoh alone and the gateways add over the floor; each gateway's CPU, the echo's.
+
+    The remote gateway's CPU in its site's process is the echo's process's less the ticking echo
+    alone's, round by round.
 
     What each adds is the round trip's added quantiles, their ratios, and the loss.
     """
@@ -480,6 +511,9 @@ def summarize(results: dict) -> dict:
                                 if name.endswith('gateway')},
             'echo_cpu_pct': {case: median(case, lambda run: run['cpu_pct']['echo'])
                              for case in CASES},
+            'in_process_gateway_cpu_pct': {
+                case: median(case, lambda run: run['cpu_pct']['echo']
+                             - run['cpu_pct']['tick alone']) for case in IN_PROCESS},
             'floor_lost': sum(run['lost'] for run in results['floor'])}
 
 

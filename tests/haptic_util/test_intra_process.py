@@ -75,6 +75,63 @@ def test_a_subscription_made_before_its_publisher_stops_taking_the_topic_over_dd
     assert publisher.get_subscription_count() == 1 and subscription.get_publisher_count() == 1
 
 
+def test_what_comes_from_outside_is_taken_in_the_tick_of_the_node_that_reads_it(context, bus):
+    """The gateway's source is called by the follower's tick alone, and serves every reader."""
+    arrived, got = [], {'follower': [], 'recorder': []}
+    gateway = node(context, 'gateway')
+    publisher = stream_publisher(gateway, POSE, 'teleop/command')
+
+    def source():
+        while arrived:
+            publisher.publish(arrived.pop(0))
+    publisher.set_source(source)
+    assert not publisher.taken_in_tick  # so far the gateway must hand over by itself
+    follower, recorder = node(context, 'follower'), node(context, 'recorder')
+    commands = stream_subscription(follower, POSE, 'teleop/command', got['follower'].append,
+                                   refused=Tally(), max_rate=4000.0, in_tick=True)
+    stream_subscription(recorder, POSE, 'teleop/command', got['recorder'].append,
+                        refused=Tally(), max_rate=4000.0)
+    assert publisher.taken_in_tick
+    assert [list(n.timers) for n in (gateway, follower, recorder)] == [[], [], []]
+    arrived.extend([VALUES, VALUES[:1] + (346,) + VALUES[2:]])
+    assert got == {'follower': [], 'recorder': []}  # nothing until the tick takes it
+    commands.take()
+    assert [values[1] for values in got['follower']] == [345, 346]
+    assert got['recorder'] == got['follower']
+
+
+@pytest.mark.parametrize('in_process', [True, False], ids=['in_process', 'over_dds'])
+def test_a_subscription_taken_in_its_tick_takes_over_dds_only_when_its_node_takes(
+        context, in_process):
+    """No timer of its own: what DDS brings waits in the reader's history for ``take``."""
+    if in_process:
+        intra_process.enable()
+    try:
+        got = []
+        follower = node(context, 'follower')
+        commands = stream_subscription(follower, POSE, 'teleop/command', got.append,
+                                       refused=Tally(), max_rate=4000.0, in_tick=True)
+        assert list(follower.timers) == [] and list(follower.subscriptions) == []
+        operator = node(context, 'operator')
+        publisher = operator.create_publisher(PoseStamped, 'teleop/command', HAPTIC_STREAM_QOS)
+        assert spin_until([follower, operator], lambda: commands.get_publisher_count() == 1)
+        publisher.publish(POSE.encode(VALUES))
+        deadline = time.monotonic() + MATCH_TIMEOUT
+        while not got and time.monotonic() < deadline:
+            spin_until([follower, operator], lambda: False, timeout=0.01)
+            assert got == []  # spinning takes nothing
+            commands.take()
+        assert got == [list(VALUES)]
+    finally:
+        intra_process.close()
+
+
+def test_a_subscription_taken_in_its_tick_is_polled(context):
+    with pytest.raises(ValueError, match='give max_rate'):
+        stream_subscription(node(context, 'follower'), POSE, 'teleop/command', print,
+                            refused=Tally(), in_tick=True)
+
+
 def test_messages_are_delivered_in_the_order_they_were_published(context, bus):
     seen = []
     pose_out = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')

@@ -57,6 +57,14 @@ def test_its_subscription_is_on_a_hidden_node_that_no_executor_of_the_owner_spin
     assert list(owner.timers) == []
 
 
+def test_a_reader_its_owner_takes_in_its_own_tick_has_no_timer(context):
+    owner = Node('follower', context=context)
+    reader = PolledReader(owner, PoseStamped, 'teleop/pose', lambda data: None, QOS, 4000.0,
+                          timed=False)
+    assert list(owner.timers) == [] and reader.take() == 0
+    reader.destroy()
+
+
 def test_a_node_renamed_on_the_command_line_keeps_its_name_to_itself():
     context = Context()
     rclpy.init(context=context, domain_id=session_domain_id(),

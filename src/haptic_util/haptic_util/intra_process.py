@@ -24,6 +24,13 @@ its codec, and a publisher skips the write while nobody reads it. Streams use th
 A topic that comes from the network (the link's) may be read at a bounded rate instead
 (``max_rate``, ``haptic_util.polled_reader``), so that a flood on it is shed by DDS.
 
+What comes into the process from outside it without DDS (the site's gateway, from the other site)
+is published by a publisher with a *source* (``StreamPublisher.set_source``): a callable that
+publishes what has arrived. A subscription made ``in_tick`` takes its topic in its node's own
+tick (``StreamSubscription.take``): from the source, or from its polled DDS reader. The follower
+reads the link so, in the tick it runs anyway, and the gateway needs no 1 kHz timer of its own
+for that topic.
+
 A publisher learns its DDS readers from the matched events its node's executor delivers, not
 by asking DDS on every message (about 1.3 µs a call, six streams a tick): like any ROS 2
 node, it must be spun.
@@ -80,17 +87,30 @@ class _Topic:
         self.publishers: list = []
         self.subscriptions: list = []
         self.reader = None  # (its DDS reader, what destroys it) while nobody here publishes
+        self.source = None  # what publishes what came from outside, when a tick takes it
 
     def take_over_dds(self, node: Node, codec: MessageCodec, topic: str, *, refused: Tally,
-                      qos: QoSProfile, max_rate: float | None) -> None:
+                      qos: QoSProfile, max_rate: float | None, timed: bool) -> None:
         """Take the topic over DDS for every subscription of the process, unless it does.
 
-        The first subscription's node reads it, with that subscription's QoS and rate, and
-        counts what is malformed in its ``refused``.
+        The first subscription's node reads it, with that subscription's QoS and rate (and,
+        polled, by its own timer or in its tick), and counts what is malformed in ``refused``.
         """
         if self.reader is None and not self.publishers:
             self.reader = _dds_reader(node, codec, topic, self.deliver, refused=refused,
-                                      qos=qos, max_rate=max_rate)
+                                      qos=qos, max_rate=max_rate, timed=timed)
+
+    @property
+    def taken_in_tick(self) -> bool:
+        return any(subscription.in_tick for subscription in self.subscriptions)
+
+    def take(self) -> None:
+        """Take what came from outside: from the source, or a DDS reader no timer takes from."""
+        if self.source is not None:
+            self.source()
+        elif self.reader is not None and isinstance(self.reader[0], PolledReader) \
+                and not self.reader[0].timed:
+            self.reader[0].take()
 
     def deliver(self, values: Sequence) -> None:
         _pending.extend((subscription, values) for subscription in self.subscriptions)
@@ -155,6 +175,19 @@ class StreamPublisher:
         """Return how many subscriptions match: of this process, and over DDS."""
         return len(self._local) + self._dds.get_subscription_count()
 
+    def set_source(self, source: Callable[[], None]) -> None:
+        """Publish what comes from outside the process when a subscription takes it in its tick.
+
+        ``source()`` publishes what has arrived since it was last called, by this publisher.
+        """
+        if self._topic is not None:
+            self._topic.source = source
+
+    @property
+    def taken_in_tick(self) -> bool:
+        """Whether a subscription of this process takes the topic in its node's tick."""
+        return self._topic is not None and self._topic.taken_in_tick
+
     def _matched(self, info) -> None:
         self._readers = info.current_count
 
@@ -165,21 +198,35 @@ class StreamSubscription:
     Bytes over DDS that are no message of the type are counted in ``refused``, with the reason,
     and dropped: they never reach the callback, nor raise into the executor (an exception there
     ends its spin, and restarting it stalled a site for hundreds of milliseconds).
+
+    Made ``in_tick`` (polled: ``max_rate`` given), it takes nothing by itself: its node calls
+    ``take`` in its own tick.
     """
 
     def __init__(self, node: Node, codec: MessageCodec, topic: str,
                  callback: Callable[[Sequence], None], *, refused: Tally,
-                 qos: QoSProfile = HAPTIC_STREAM_QOS, max_rate: float | None = None) -> None:
+                 qos: QoSProfile = HAPTIC_STREAM_QOS, max_rate: float | None = None,
+                 in_tick: bool = False) -> None:
+        if in_tick and max_rate is None:
+            raise ValueError(f'{topic}: a subscription taken in its tick is polled: give max_rate')
         self.callback = callback
+        self.in_tick = in_tick
         self._topic = _topic(node, codec.message_class, topic)
         self._dds = None  # its own DDS reader, while intra-process delivery is off
         if self._topic is not None:
             self._topic.subscriptions.append(self)
             self._topic.take_over_dds(node, codec, topic, refused=refused, qos=qos,
-                                      max_rate=max_rate)
+                                      max_rate=max_rate, timed=not in_tick)
         else:
             self._dds, _ = _dds_reader(node, codec, topic, callback, refused=refused, qos=qos,
-                                       max_rate=max_rate)
+                                       max_rate=max_rate, timed=not in_tick)
+
+    def take(self) -> None:
+        """Take what came from outside the process since the last tick (``in_tick``)."""
+        if self._topic is not None:
+            self._topic.take()
+        elif self.in_tick:
+            self._dds.take()
 
     def get_publisher_count(self) -> int:
         """Return how many publishers match: of this process, and over DDS."""
@@ -190,13 +237,13 @@ class StreamSubscription:
 
 def _dds_reader(node: Node, codec: MessageCodec, topic: str,
                 deliver: Callable[[Sequence], None], *, refused: Tally, qos: QoSProfile,
-                max_rate: float | None) -> tuple:
+                max_rate: float | None, timed: bool) -> tuple:
     """Return a DDS reader of ``topic`` for ``node`` (executor-taken or polled), its destroyer."""
     take = _decoding(codec, topic, refused, deliver)
     if max_rate is None:
         subscription = node.create_subscription(codec.message_class, topic, take, qos, raw=True)
         return subscription, lambda: node.destroy_subscription(subscription)
-    reader = PolledReader(node, codec.message_class, topic, take, qos, max_rate)
+    reader = PolledReader(node, codec.message_class, topic, take, qos, max_rate, timed=timed)
     _polled.append(reader)
 
     def destroy() -> None:
@@ -243,28 +290,30 @@ def stream_publisher(node: Node, codec: MessageCodec, topic: str) -> StreamPubli
 
 def stream_subscription(node: Node, codec: MessageCodec, topic: str,
                         callback: Callable[[Sequence], None], *, refused: Tally,
-                        qos: QoSProfile = HAPTIC_STREAM_QOS,
-                        max_rate: float | None = None) -> StreamSubscription:
+                        qos: QoSProfile = HAPTIC_STREAM_QOS, max_rate: float | None = None,
+                        in_tick: bool = False) -> StreamSubscription:
     """Return a subscription of a 1 kHz stream: ``callback`` gets each message's leaf values.
 
     Malformed messages are counted in the node's ``refused`` tally, which its report logs.
     ``qos`` must match the publishers' (the haptic streams'); a deeper history is the one
     choice left to the reader. With ``max_rate`` (Hz), what comes over DDS is taken at most
-    that fast (``haptic_util.polled_reader``): for what any network peer may publish.
+    that fast (``haptic_util.polled_reader``): for what any network peer may publish; and
+    with ``in_tick``, only when the node calls the subscription's ``take``.
     """
     return StreamSubscription(node, codec, topic, callback, refused=refused, qos=qos,
-                              max_rate=max_rate)
+                              max_rate=max_rate, in_tick=in_tick)
 
 
 def link_subscription(node: Node, codec: MessageCodec, topic: str,
-                      callback: Callable[[Sequence], None], *,
-                      refused: Tally) -> StreamSubscription:
+                      callback: Callable[[Sequence], None], *, refused: Tally,
+                      in_tick: bool = False) -> StreamSubscription:
     """Return a subscription of a stream that comes over the link to the robot's site.
 
     Anything on the site's network may publish it too: it is read with the link's history, at
     most ``LINK_INTAKE_RATE`` messages a second from all publishers together, so that a flood
     leaves the robot its rate. (The operator's site takes its 100 Hz feedback as it comes: a
-    timer polling it at 1 kHz would cost more than it reads.)
+    timer polling it at 1 kHz would cost more than it reads.) A node that ticks at 1 kHz
+    takes it in its tick (``in_tick``, then ``take`` each tick).
     """
     return stream_subscription(node, codec, topic, callback, refused=refused, qos=LINK_QOS,
-                               max_rate=LINK_INTAKE_RATE)
+                               max_rate=LINK_INTAKE_RATE, in_tick=in_tick)

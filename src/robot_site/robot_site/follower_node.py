@@ -13,7 +13,8 @@ It follows only once the robot has said what it is (``robot/impedance``, latched
 bound holds only for the robot's own stiffness, so a robot whose stiffness is not this node's
 ``robot_stiffness`` is not commanded at all (an error says so), and commands are checked against
 its workspace. Every refused command is counted and logged once a second with its reason.
-Commands are taken at most ``LINK_INTAKE_RATE`` a second, whoever sends them.
+Commands are taken in its tick, at most ``LINK_INTAKE_RATE`` a second (at the default 1 kHz
+tick), whoever sends them.
 """
 import math
 from typing import Sequence
@@ -79,7 +80,8 @@ class FollowerNode(Node):
         self._sent = 0
         self._target_pub = stream_publisher(self, POSE, ROBOT_TARGET_POSE)
         self._feedback_pub = stream_publisher(self, FEEDBACK, TELEOP_FEEDBACK)
-        link_subscription(self, COMMAND, TELEOP_COMMAND, self.on_command, refused=self._refused)
+        self._commands = link_subscription(self, COMMAND, TELEOP_COMMAND, self.on_command,
+                                           refused=self._refused, in_tick=True)
         for codec, topic, callback in ((POSE, ROBOT_TCP_POSE, self.on_tcp),
                                        (WRENCH, ROBOT_FT_WRENCH, self.on_wrench)):
             stream_subscription(self, codec, topic, callback, refused=self._refused)
@@ -171,6 +173,7 @@ class FollowerNode(Node):
             self._refused.add('F/T wrench not finite')
 
     def tick(self) -> None:
+        self._commands.take()  # the link is read here, in the tick, not by a timer of its own
         now = self._now()
         tcp = self._tcp  # made with the follower, or before it
         if self.follower is None or tcp.position is None:

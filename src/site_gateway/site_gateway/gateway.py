@@ -21,11 +21,12 @@ says nothing, and the gateway waits for it.
 In a site's own process (``haptic_bringup.composed ... site_gateway``, with intra-process
 delivery), the 1 kHz streams cross without DDS on this side: what the site's nodes publish is
 taken in the process (``haptic_util.intra_process``) and encoded to the same CDR bytes, and what
-comes from the other site waits in Zenoh (a ring of the newest, ``HANDOVER_DEPTH``) until a
-timer of the site's executor judges it and hands it to the site's nodes, at most
-``LINK_INTAKE_RATE`` a second, as the follower reads the link (``haptic_util.polled_reader``).
-No Python runs in Zenoh's threads for a stream then, and a DDS stranger's stream in the site's
-domain is never read. What a flood brings beyond the ring between two handovers Zenoh drops
+comes from the other site waits in Zenoh (a ring of the newest, ``HANDOVER_DEPTH``) until it is
+judged and handed to the site's nodes, at most ``LINK_INTAKE_RATE`` a second, as the follower
+reads the link (``haptic_util.polled_reader``): in the tick of a node that takes the stream in
+its own (the follower, the commands), else by a 1 ms timer of the gateway's. No Python runs in
+Zenoh's threads for a stream then, and a DDS stranger's stream in the site's domain is never
+read. What a flood brings beyond the ring between two handovers Zenoh drops
 unread, the oldest first, and no count says how much (the counts are of what was judged).
 Frames and reliable crossings go through DDS either way. As a process of its own, the gateway
 is the baseline ``bench/bench_link.py`` measures it against.
@@ -231,8 +232,8 @@ class GatewayNode(Node):
         self._into_dds, self._handovers, self._listeners = {}, [], []
         for index, crossing in enumerate(routes.incoming):
             self._hand_on(index, crossing, in_process and crossing.kind == STREAM)
-        if self._handovers:
-            self.create_timer(TICK, self._hand_over)
+        self._handover_timer = self.create_timer(TICK, self._hand_over_untaken) \
+            if self._handovers else None
         self._listeners.append(self.session.declare_subscriber(
             bye_key(self._prefix, other_role(self._role)), self._on_bye))
         self._links = self.session.info.declare_link_events_listener(self._on_link,
@@ -269,7 +270,9 @@ class GatewayNode(Node):
                 key, zenoh.handlers.RingChannel(HANDOVER_DEPTH))
             publisher = intra_process.stream_publisher(self, MessageCodec(msg_type),
                                                        crossing.route.topic)
-            self._handovers.append((index, listener, publisher))
+            handover = (index, listener, publisher)
+            publisher.set_source(functools.partial(self._hand_over, handover))
+            self._handovers.append(handover)
         else:
             self._into_dds[index] = self.create_publisher(msg_type, crossing.route.topic,
                                                           _qos(crossing.kind))
@@ -277,18 +280,29 @@ class GatewayNode(Node):
                 key, functools.partial(self._on_sample, index))
         self._listeners.append(listener)
 
-    def _hand_over(self) -> None:
-        """Judge what Zenoh holds of each incoming stream; hand it to the site's nodes."""
+    def _hand_over_untaken(self) -> None:
+        """Hand over the streams no node takes in its tick; end when every one is so taken.
+
+        Which are taken is known once the process's nodes are made, before its first tick.
+        """
+        untaken = [handover for handover in self._handovers if not handover[2].taken_in_tick]
+        if not untaken:
+            self._handover_timer.cancel()
+        for handover in untaken:
+            self._hand_over(handover)
+
+    def _hand_over(self, handover: tuple) -> None:
+        """Judge what Zenoh holds of an incoming stream; hand it to the site's nodes."""
+        index, listener, publisher = handover
         now = time.monotonic()
-        for index, listener, publisher in self._handovers:
-            for _ in range(HANDOVER_LIMIT):
-                sample = listener.try_recv()
-                if sample is None:
-                    break
-                verdict = self._inbound.judge(now, index, str(sample.key_expr),
-                                              sample.payload.to_bytes())
-                if verdict.deliver:
-                    publisher.publish(verdict.values)
+        for _ in range(HANDOVER_LIMIT):
+            sample = listener.try_recv()
+            if sample is None:
+                break
+            verdict = self._inbound.judge(now, index, str(sample.key_expr),
+                                          sample.payload.to_bytes())
+            if verdict.deliver:
+                publisher.publish(verdict.values)
 
     def _put(self, route: int, data: bytes) -> None:
         self._outgoing[route].put(data)
