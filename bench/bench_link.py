@@ -126,8 +126,8 @@ class Echo(Node):
 
     def __init__(self, udp_port: int, certs: pathlib.Path, endpoint: str) -> None:
         super().__init__('bench_link_echo')
-        declare_parameters(self, RealtimeParams)
         self._every = self.declare_parameter('answer_every', 1).value
+        declare_parameters(self, RealtimeParams)  # after its own: they are not unknown to it
         self._pong = self.create_publisher(PoseStamped, PONG, LINK_QOS)
         self.create_subscription(PoseStamped, PING, self._on_dds, LINK_QOS, raw=True)
         config, pong_key, ping_key = direct_session('remote', certs, endpoint)
@@ -162,9 +162,9 @@ class SiteEcho(Node):
 
     def __init__(self) -> None:
         super().__init__('bench_link_site_echo')
-        declare_parameters(self, RealtimeParams)
         every = self.declare_parameter('answer_every', 1).value
         in_tick = self.declare_parameter('in_tick', True).value
+        declare_parameters(self, RealtimeParams)
         codec = MessageCodec(PoseStamped)
         pong = intra_process.stream_publisher(self, codec, PONG)
         pings = intra_process.link_subscription(
