@@ -126,10 +126,14 @@ def test_a_subscription_taken_in_its_tick_takes_over_dds_only_when_its_node_take
         intra_process.close()
 
 
-def test_a_subscription_taken_in_its_tick_is_polled(context):
+def test_a_subscription_taken_in_its_tick_is_polled_and_only_it_is_taken(context):
     with pytest.raises(ValueError, match='give max_rate'):
         stream_subscription(node(context, 'follower'), POSE, 'teleop/command', print,
                             refused=Tally(), in_tick=True)
+    pushed = stream_subscription(node(context, 'leader'), POSE, 'teleop/feedback', print,
+                                 refused=Tally(), max_rate=4000.0)
+    with pytest.raises(ValueError, match='not made in_tick'):
+        pushed.take()
 
 
 def test_messages_are_delivered_in_the_order_they_were_published(context, bus):

@@ -222,10 +222,13 @@ class StreamSubscription:
                                        max_rate=max_rate, timed=not in_tick)
 
     def take(self) -> None:
-        """Take what came from outside the process since the last tick (``in_tick``)."""
+        """Take what came from outside the process since the last tick (made ``in_tick``)."""
+        if not self.in_tick:
+            raise ValueError('take: this subscription was not made in_tick; its messages come '
+                             'by themselves')
         if self._topic is not None:
             self._topic.take()
-        elif self.in_tick:
+        else:
             self._dds.take()
 
     def get_publisher_count(self) -> int:
