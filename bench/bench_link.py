@@ -242,13 +242,17 @@ class SiteEnd(DdsEnd):
     """This process as the operator's site: a ping node and the gateway, on one executor.
 
     The pings are handed to the gateway in the process as a site's nodes hand it their streams
-    (their values: decoding each costs this end some microseconds), the pongs handed back.
+    (their values: decoding each costs this end some microseconds), the pongs handed back. The
+    topics are remapped under ``case``: this process holds one such end per case, and streams
+    are handed over by topic name in a process, so each end's pings reach its own gateway only.
     """
 
-    def __init__(self, domain: int, gateway_params: pathlib.Path, pinger: Pinger) -> None:
+    def __init__(self, domain: int, gateway_params: pathlib.Path, pinger: Pinger,
+                 case: str) -> None:
         self.context = Context()
         rclpy.init(context=self.context, domain_id=domain, args=[
-            '--ros-args', *gateway_remap('operator'), '--params-file', str(gateway_params)])
+            '--ros-args', *gateway_remap('operator'), '--params-file', str(gateway_params),
+            *[arg for topic in (PING, PONG) for arg in ('-r', f'{topic}:={case}/{topic}')]])
         intra_process.enable()
         self.gateway = GatewayNode(context=self.context)
         self.node = Node('bench_link_site_pinger', context=self.context)
@@ -451,7 +455,7 @@ def main(argv=None) -> int:
             ends['gateways'] = DdsEnd(args.domain_id, pinger)
             for number, case in enumerate(IN_PROCESS):
                 ends[case] = SiteEnd(args.domain_id + 2 + 2 * number, in_process[case]['operator'],
-                                     pinger)
+                                     pinger, case)
             first = -3_000_000
             for case in CASES:
                 first = connect(ends[case], pinger, first)
