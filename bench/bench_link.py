@@ -3,31 +3,31 @@
     .venv/bin/python bench/bench_link.py [--seconds 60] [--runs 1] [--rate 1000] [--threads]
                                          [--answer-every 1] [--json PATH]
 
-Why: a command that crosses to the remote site and the feedback that comes back take the path
-that is deployed: DDS in the operator's domain, the operator's gateway, Zenoh over mutual TLS,
-the remote gateway, DDS in the remote domain, and back. Its floor is the same two end processes
-exchanging the same bytes (a stamped PoseStamped's CDR) as UDP datagrams on the same loopback:
-what any transport between them must at least take. Between the two, the same end processes
-exchange them over a Zenoh session of their own each, with the gateways' settings (mutual TLS,
-access control, the streams' publisher options): what Zenoh itself takes, with no DDS and no
-gateway process on the path; the least a gateway in the sites' own processes could add. And
-over the gateways as nodes of the sites' own processes (``site_gateway`` composed with a ping
-node here and an echo node there, their streams handed over in each process): the path a
-session deploys, against the gateways as processes of their own, its baseline. The echo in its
-site's process is modelled on the follower: it ticks at 1 kHz, and takes the pings in its tick
-(``in_tick``), as the follower takes commands; beside it, the same echo that takes them as the
-gateway's own 1 ms timer hands them over (the handover before the follower took its commands in
-its tick), and, for the gateway's share of its site's CPU, the same ticking echo alone, no
-gateway, nothing to answer (``tick_alone``): each in-process gateway's CPU is its process's
-less that one's, in the same round. This
-process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in the next DDS
-domain) sends each back at once on every path. The cases alternate within one invocation, so they
-share the machine's state; each figure is given beside its floor, and as the round trip added
-over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's CPU, and the
-echo's (with its gateway, when it is in the echo's process), is read from outside (psutil) over
-the measured window, in % of one core. No emulated delay: the stage passes messages straight on.
-With ``--answer-every 10`` the echo answers every tenth ping only, on every path: the rates a
-session puts through the remote site's gateway (1 kHz commands in, 100 Hz feedback out).
+Why: a command that crosses to the remote site and the feedback that comes back take the path that
+is deployed: DDS in the operator's domain, the operator's gateway, Zenoh over mutual TLS, the
+remote gateway, DDS in the remote domain, and back. Its floor is the same two end processes
+exchanging the same bytes (a stamped PoseStamped's CDR) as UDP datagrams on the same loopback: what
+any transport between them must at least take. Between the two, the same end processes exchange
+them over a Zenoh session of their own each, with the gateways' settings (mutual TLS, access
+control, the streams' publisher options): what Zenoh itself takes, with no DDS and no gateway
+process on the path; the least a gateway in the sites' own processes could add. And over the
+gateways as nodes of the sites' own processes (``site_gateway`` composed with a ping node here and
+an echo node there, their streams handed over in each process): the path a session deploys, against
+the gateways as processes of their own, its baseline. The echo in its site's process is modelled on
+the follower: it ticks at 1 kHz, and takes the pings in its tick (``in_tick``), as the follower
+takes commands, and this end takes the pongs in its own 1 ms tick, as the leader takes feedback at
+each wand pose; beside them, the same ends that take them as the gateways' own 1 ms timers hand
+them over (the handover before the follower and the leader took the link in their ticks), and, for
+the gateway's share of its site's CPU, the same ticking echo alone, no gateway, nothing to answer
+(``tick_alone``): each in-process gateway's CPU is its process's less that one's, in the same
+round. This process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in
+the next DDS domain) sends each back at once on every path. The cases alternate within one
+invocation, so they share the machine's state; each figure is given beside its floor, and as the
+round trip added over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's
+CPU, and the echo's (with its gateway, when it is in the echo's process), is read from outside
+(psutil) over the measured window, in % of one core. No emulated delay: the stage passes messages
+straight on. With ``--answer-every 10`` the echo answers every tenth ping only, on every path: the
+rates a session puts through the remote site's gateway (1 kHz commands in, 100 Hz feedback out).
 """
 import argparse
 import os
@@ -242,13 +242,15 @@ class SiteEnd(DdsEnd):
     """This process as the operator's site: a ping node and the gateway, on one executor.
 
     The pings are handed to the gateway in the process as a site's nodes hand it their streams
-    (their values: decoding each costs this end some microseconds), the pongs handed back. The
-    topics are remapped under ``case``: this process holds one such end per case, and streams
-    are handed over by topic name in a process, so each end's pings reach its own gateway only.
+    (their values: decoding each costs this end some microseconds), the pongs handed back: with
+    ``in_tick``, taken in this end's 1 ms tick, as the leader takes feedback at each wand pose;
+    else as the gateway's 1 ms timer hands them over. The topics are remapped under ``case``:
+    this process holds one such end per case, and streams are handed over by topic name in a
+    process, so each end's pings reach its own gateway only.
     """
 
     def __init__(self, domain: int, gateway_params: pathlib.Path, pinger: Pinger,
-                 case: str) -> None:
+                 case: str, in_tick: bool) -> None:
         self.context = Context()
         rclpy.init(context=self.context, domain_id=domain, args=[
             '--ros-args', *gateway_remap('operator'), '--params-file', str(gateway_params),
@@ -258,13 +260,21 @@ class SiteEnd(DdsEnd):
         self.node = Node('bench_link_site_pinger', context=self.context)
         codec = MessageCodec(PoseStamped)
         publisher = intra_process.stream_publisher(self.node, codec, PING)
-        intra_process.stream_subscription(self.node, codec, PONG,
-                                          lambda values: pinger.on_sequence(values[0]),
-                                          refused=Tally())
+        pongs = intra_process.link_subscription(self.node, codec, PONG,
+                                                lambda values: pinger.on_sequence(values[0]),
+                                                refused=Tally(), in_tick=in_tick)
+        self._take = pongs.take if in_tick else lambda: None
         self.executor = EventsExecutor(context=self.context)
         for node in (self.gateway, self.node):
             self.executor.add_node(node)
         self.send = lambda data: publisher.publish(codec.decode(data))
+
+    def wait(self, seconds: float) -> None:
+        """Spin for ``seconds``, taking the pongs at each tick (the pings go out at ticks)."""
+        deadline = time.perf_counter() + seconds
+        while (left := deadline - time.perf_counter()) > 0.0:
+            super().wait(min(left, TICK))
+            self._take()
 
     def close(self) -> None:
         self.gateway.destroy_node()
@@ -455,7 +465,7 @@ def main(argv=None) -> int:
             ends['gateways'] = DdsEnd(args.domain_id, pinger)
             for number, case in enumerate(IN_PROCESS):
                 ends[case] = SiteEnd(args.domain_id + 2 + 2 * number, in_process[case]['operator'],
-                                     pinger, case)
+                                     pinger, case, IN_PROCESS[case])
             first = -3_000_000
             for case in CASES:
                 first = connect(ends[case], pinger, first)

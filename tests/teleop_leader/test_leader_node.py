@@ -4,19 +4,26 @@ Within one process the driver's twist reaches the leader before its pose (``intr
 delivers in publishing order); over DDS the two may arrive either way round. No pose is answered
 before the robot is found, so the driver's probe of the loop waits for it.
 """
+import time
+
 import numpy as np
 import pytest
 import rclpy
 from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
 
+from haptic_contract.graph import TELEOP_FEEDBACK
 from haptic_contract.teleop import Feedback
-from haptic_contract.teleop_fields import feedback_fields
+from haptic_contract.teleop_fields import FEEDBACK, feedback_fields
+from haptic_util.qos import LINK_QOS
 from teleop_leader.leader_node import LeaderNode
 
 STAMP = (100, 500)
 WAND = (0.01, 0.02, 0.03)  # [m] the pose's position
 TCP = np.array([0.3, -0.1, 0.2])  # [m] the robot's, in its first feedback
 PROBE = (99, 0)  # the stamp of the driver's probe before the robot is found
+MATCH_TIMEOUT = 10.0  # [s]
 
 
 def pose(stamp=STAMP, frame='world'):
@@ -113,3 +120,29 @@ def test_the_robot_s_target_moves_out_as_far_as_the_device_renders_the_planes(le
     [command] = leader._command_pub.messages
     assert np.allclose(command[5:8], TCP + [0.0, 0.0, 0.012])
     assert leader._refused.total() == 2
+
+
+def test_the_feedback_is_taken_at_a_wand_pose_and_never_by_itself(leader):
+    """Over DDS as in a process: the robot's feedback waits in the reader until the next pose."""
+    site = Node('robot_site', context=leader.context)
+    feedback = site.create_publisher(FEEDBACK.message_class, TELEOP_FEEDBACK, LINK_QOS)
+    executor = SingleThreadedExecutor(context=leader.context)
+    for node in (leader, site):
+        executor.add_node(node)
+    deadline = time.monotonic() + MATCH_TIMEOUT
+    while feedback.get_subscription_count() == 0 and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.01)
+    leader.on_twist(twist(PROBE))
+    leader.on_pose(pose(PROBE))  # the wand is known: the first feedback starts the session
+    feedback.publish(FEEDBACK.encode(feedback_fields(
+        Feedback(leader._now(), 0.0, 0.0, np.zeros(3), TCP, 0.0, None, session=7, sequence=1),
+        'base_link')))
+    deadline = time.monotonic() + 0.5
+    while time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.01)
+    assert leader.leader is None  # spun, not taken
+    leader.on_twist(twist())
+    leader.on_pose(pose())
+    assert leader.leader is not None and np.allclose(leader.leader.map.to_robot(WAND), TCP)
+    executor.shutdown()
+    site.destroy_node()

@@ -314,9 +314,9 @@ def link_subscription(node: Node, codec: MessageCodec, topic: str,
 
     Anything on the site's network may publish it too: it is read with the link's history, at
     most ``LINK_INTAKE_RATE`` messages a second from all publishers together, so that a flood
-    leaves the robot its rate. (The operator's site takes its 100 Hz feedback as it comes: a
-    timer polling it at 1 kHz would cost more than it reads.) A node that ticks at 1 kHz
-    takes it in its tick (``in_tick``, then ``take`` each tick).
+    leaves the site's loop its rate. A node that ticks at 1 kHz takes it in its tick
+    (``in_tick``, then ``take`` each tick: the follower its commands, the leader its feedback
+    at each wand pose); else a 1 ms timer of its own takes it.
     """
     return stream_subscription(node, codec, topic, callback, refused=refused, qos=LINK_QOS,
                                max_rate=LINK_INTAKE_RATE, in_tick=in_tick)

@@ -12,6 +12,11 @@ before the robot was found pressed from an anchor it had already left (the first
 far above it, and the patient was pressed 5.1 N instead of 7.2). ``teleop/clutch`` (Bool, true:
 engaged) re-centres the wand without moving the robot. With ``model``, ``wand/model_shift`` (how
 far out the device renders the planes) moves the robot's target out as far.
+
+The feedback is taken in that tick, before the answer (``link_subscription``, ``in_tick``): at
+most ``LINK_INTAKE_RATE`` a second, so a flood of feedback on the site's network leaves the
+wand's loop its rate, and in the site's process the gateway hands it over in the leader's tick
+rather than by a 1 ms timer of its own.
 """
 import math
 from typing import Sequence
@@ -30,9 +35,9 @@ from haptic_contract.teleop import feedback_refusal, Scheme
 from haptic_contract.teleop_fields import COMMAND, command_fields, FEEDBACK, feedback_from_fields
 from haptic_util.diagnostics import Diagnostics, OK, Report, WARN
 from haptic_util.executor import run_nodes, StartupError
-from haptic_util.intra_process import stream_publisher, stream_subscription
+from haptic_util.intra_process import link_subscription, stream_publisher, stream_subscription
 from haptic_util.parameters import declare_parameters
-from haptic_util.qos import LATCHED_QOS, LINK_QOS
+from haptic_util.qos import LATCHED_QOS
 from haptic_util.stamps import clock_ns
 from haptic_util.tally import Tally
 from teleop_leader.leader import Leader, LeaderConfig
@@ -83,8 +88,8 @@ class LeaderNode(Node):
             streams.append((VECTOR, WAND_MODEL_SHIFT, self.on_model_shift))
         for codec, topic, callback in streams:
             stream_subscription(self, codec, topic, callback, refused=self._refused)
-        stream_subscription(self, FEEDBACK, TELEOP_FEEDBACK, self.on_feedback,
-                            refused=self._refused, qos=LINK_QOS)
+        self._feedback = link_subscription(self, FEEDBACK, TELEOP_FEEDBACK, self.on_feedback,
+                                           refused=self._refused, in_tick=True)
         self.create_subscription(Bool, TELEOP_CLUTCH, self.on_clutch, LATCHED_QOS)
         self.diagnostics = Diagnostics(self, self.report, 1.0)
         self.get_logger().info(f'{params.scheme} scheme: force x{params.force_scale:g}, '
@@ -140,6 +145,7 @@ class LeaderNode(Node):
         stamp_ns, position = self._pending
         velocity = np.array(self._twist[1], dtype=np.float64)
         self._answered_ns = stamp_ns
+        self._feedback.take()  # what came over the link since the last pose
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
             self._refused.add('wand pose or twist not finite')
             self._answer(stamp_ns, None)
