@@ -123,7 +123,8 @@ def test_the_robot_s_target_moves_out_as_far_as_the_device_renders_the_planes(le
 
 
 def test_the_feedback_is_taken_at_a_wand_pose_and_never_by_itself(leader):
-    """Over DDS as in a process: the robot's feedback waits in the reader until the next pose."""
+    """The robot's feedback, over DDS here, waits in the reader until the next pose (in a site's
+    process, the gateway's handover waits so: ``tests/site_gateway/test_handover.py``)."""
     site = Node('robot_site', context=leader.context)
     feedback = site.create_publisher(FEEDBACK.message_class, TELEOP_FEEDBACK, LINK_QOS)
     executor = SingleThreadedExecutor(context=leader.context)
@@ -132,6 +133,7 @@ def test_the_feedback_is_taken_at_a_wand_pose_and_never_by_itself(leader):
     deadline = time.monotonic() + MATCH_TIMEOUT
     while feedback.get_subscription_count() == 0 and time.monotonic() < deadline:
         executor.spin_once(timeout_sec=0.01)
+    assert feedback.get_subscription_count() == 1
     leader.on_twist(twist(PROBE))
     leader.on_pose(pose(PROBE))  # the wand is known: the first feedback starts the session
     feedback.publish(FEEDBACK.encode(feedback_fields(
