@@ -16,6 +16,7 @@ from rclpy.node import Node
 from haptic_contract.graph import TELEOP_FEEDBACK
 from haptic_contract.teleop import Feedback
 from haptic_contract.teleop_fields import FEEDBACK, feedback_fields
+from haptic_util import intra_process
 from haptic_util.qos import LINK_QOS
 from teleop_leader.leader_node import LeaderNode
 
@@ -63,6 +64,7 @@ def leader(request):
     node._command_pub = Sent()
     yield node
     node.destroy_node()
+    intra_process.close()  # its polled feedback reader, which outlives the node till then
     rclpy.try_shutdown(context=context)
 
 
@@ -133,7 +135,7 @@ def test_the_feedback_is_taken_at_a_wand_pose_and_never_by_itself(leader):
     deadline = time.monotonic() + MATCH_TIMEOUT
     while feedback.get_subscription_count() == 0 and time.monotonic() < deadline:
         executor.spin_once(timeout_sec=0.01)
-    assert feedback.get_subscription_count() == 1
+    assert feedback.get_subscription_count() >= 1  # the leader's own, in this participant
     leader.on_twist(twist(PROBE))
     leader.on_pose(pose(PROBE))  # the wand is known: the first feedback starts the session
     feedback.publish(FEEDBACK.encode(feedback_fields(
