@@ -24,7 +24,8 @@ taken in the process (``haptic_util.intra_process``) and encoded to the same CDR
 comes from the other site waits in Zenoh (a ring of the newest, ``HANDOVER_DEPTH``) until it is
 judged and handed to the site's nodes, at most ``LINK_INTAKE_RATE`` a second, as the follower
 reads the link (``haptic_util.polled_reader``): in the tick of a node that takes the stream in
-its own (the follower, the commands), else by a 1 ms timer of the gateway's. No Python runs in
+its own (the follower its commands, the leader its feedback), else by a 1 ms timer of the
+gateway's. No Python runs in
 Zenoh's threads for a stream then, and a DDS stranger's stream in the site's domain is never
 read. What a flood brings beyond the ring between two handovers Zenoh drops
 unread, the oldest first, and no count says how much (the counts are of what was judged).
