@@ -17,6 +17,7 @@ from haptic_contract.graph import TELEOP_FEEDBACK
 from haptic_contract.teleop import Feedback
 from haptic_contract.teleop_fields import FEEDBACK, feedback_fields
 from haptic_util import intra_process
+from haptic_util.diagnostics import WARN
 from haptic_util.qos import LINK_QOS
 from teleop_leader.leader_node import LeaderNode
 
@@ -150,3 +151,18 @@ def test_the_feedback_is_taken_at_a_wand_pose_and_never_by_itself(leader):
     assert leader.leader is not None and np.allclose(leader.leader.map.to_robot(WAND), TCP)
     executor.shutdown()
     site.destroy_node()
+
+
+def test_the_report_names_the_wand_when_it_is_the_wand_that_is_silent(leader):
+    """With the wand silent the feedback is not read, so the link looks silent too: the report
+    says which one stopped."""
+    robot_found(leader)
+    assert leader.report().message.startswith('link live')
+    time.sleep(1.5 * leader.config.link_timeout)
+    report = leader.report()
+    assert report.message.startswith('the wand is silent')
+    assert report.level == WARN and not report.values['wand_live']
+    leader.on_twist(twist())
+    leader.on_pose(pose())  # the wand again, but no feedback since
+    report = leader.report()
+    assert report.message.startswith('link silent') and report.values['wand_live']

@@ -73,6 +73,7 @@ class LeaderNode(Node):
         self._twist = None  # (stamp ns, velocity) of the latest twist
         self._model_shift = np.zeros(3)  # [m] the device's, beyond the planes sent
         self._answered_ns = None  # the stamp of the pose answered last
+        self._answered_at = None  # [s] when it was, on this node's clock
         self._last_stamp_ns = None
         self._clutch = False
         self._refused = Tally()
@@ -144,7 +145,7 @@ class LeaderNode(Node):
             return
         stamp_ns, position = self._pending
         velocity = np.array(self._twist[1], dtype=np.float64)
-        self._answered_ns = stamp_ns
+        self._answered_ns, self._answered_at = stamp_ns, self._now()
         self._feedback.take()  # what came over the link since the last pose
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
             self._refused.add('wand pose or twist not finite')
@@ -200,10 +201,13 @@ class LeaderNode(Node):
 
     def report(self) -> Report:
         self._refused.log_new(lambda line: self.get_logger().warn(f'refused: {line}'))
-        leader = self.leader
-        live = leader is not None and leader.live(self._now())
+        leader, now = self.leader, self._now()
+        live = leader is not None and leader.live(now)
+        # The feedback is read at the wand's poses: with the wand silent, so is the link.
+        wand_live = self._answered_at is not None and \
+            now - self._answered_at <= self.config.link_timeout
         round_trip = leader.round_trip.round_trip if leader is not None else None
-        values = {'published': self._answers, 'link_live': live,
+        values = {'published': self._answers, 'wand_live': wand_live, 'link_live': live,
                   'round_trip_s': math.nan if round_trip is None else round_trip,
                   'clutched': leader is not None and leader.map.clutched,
                   'withheld': self._withheld, 'unanswered': self._unknown,
@@ -211,10 +215,14 @@ class LeaderNode(Node):
                   **{f'refused: {kind}': n for kind, n in self._refused.counts.items()}}
         if leader is not None:
             values['operator_energy_out_j'] = leader.passivity.books.energy_out
-        message = ('waiting for the robot' if leader is None else
-                   f'link {"live" if live else "silent"}, round trip '
-                   f'{1e3 * values["round_trip_s"]:.1f} ms')
-        return Report(OK if live else WARN, message, values)
+        if leader is None:
+            message = 'waiting for the robot'
+        elif not wand_live:
+            message = 'the wand is silent: the link is read at its poses'
+        else:
+            message = (f'link {"live" if live else "silent"}, round trip '
+                       f'{1e3 * values["round_trip_s"]:.1f} ms')
+        return Report(OK if live and wand_live else WARN, message, values)
 
     def destroy_node(self) -> bool:
         self.diagnostics.final()
