@@ -20,7 +20,10 @@ each wand pose; beside them, the same ends that take them as the gateways' own 1
 them over (the handover before the follower and the leader took the link in their ticks), and, for
 the gateway's share of its site's CPU, the same ticking echo alone, no gateway, nothing to answer
 (``tick_alone``): each in-process gateway's CPU is its process's less that one's, in the same
-round. This process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in
+round. Taken in ticks, a round trip waits for them whatever carries it; so the ticking paths are
+also given over a floor in ticks (``floor_in_tick``): UDP between the ticking echo alone, which
+answers the UDP pings in its tick, and this end, which takes the pongs at its own 1 ms ticks,
+with no gateway on the path: what the gateways add beyond the nodes' ticks. This process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in
 the next DDS domain) sends each back at once on every path. The cases alternate within one
 invocation, so they share the machine's state; each figure is given beside its floor, and as the
 round trip added over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's
@@ -67,8 +70,9 @@ from site_gateway.zenoh_config import Credentials, publisher_options, session_co
 PING, PONG = 'bench/ping', 'bench/pong'
 POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
 DIRECT_PREFIX = 'bench'  # the direct case's Zenoh keys (its sessions reach no gateway's)
-CASES = ('floor', 'zenoh', 'gateways', 'in_process_timer', 'in_process')
+CASES = ('floor', 'floor_in_tick', 'zenoh', 'gateways', 'in_process_timer', 'in_process')
 IN_PROCESS = {'in_process_timer': False, 'in_process': True}  # case -> ends take in their ticks
+TICKED = ('in_process_timer', 'in_process')  # the cases whose round trips wait for 1 ms ticks
 SEQUENCE = struct.Struct('<i')  # the ping's number, in its header's stamp.sec (after CDR's 4)
 WARM_UP = 1.0  # [s] of pongs coming back before a window is measured
 DRAIN = 0.5  # [s] after a window, for the last pongs
@@ -158,19 +162,38 @@ class SiteEcho(Node):
     """The remote end in its site's process: each ping its gateway hands over, handed back.
 
     It ticks at 1 kHz, as the follower does; with ``in_tick`` it takes the pings in that tick.
+    In every tick it also answers the UDP pings its socket (``udp_port``) holds: the ticking
+    echo alone is so the floor of the ticking paths (``floor_in_tick``), and every ticking echo
+    does the same work but for its gateway's.
     """
 
     def __init__(self) -> None:
         super().__init__('bench_link_site_echo')
-        every = self.declare_parameter('answer_every', 1).value
+        self._every = self.declare_parameter('answer_every', 1).value
         in_tick = self.declare_parameter('in_tick', True).value
+        udp_port = self.declare_parameter('udp_port', 0).value
         declare_parameters(self, RealtimeParams)
         codec = MessageCodec(PoseStamped)
         pong = intra_process.stream_publisher(self, codec, PONG)
         pings = intra_process.link_subscription(
-            self, codec, PING, lambda values: answered(values[0], every) and pong.publish(values),
+            self, codec, PING,
+            lambda values: answered(values[0], self._every) and pong.publish(values),
             refused=Tally(), in_tick=in_tick)
-        self.create_timer(TICK, pings.take if in_tick else lambda: None)
+        self._take = pings.take if in_tick else lambda: None
+        self._socket = udp_socket()
+        self._socket.setblocking(False)
+        self._socket.bind(('127.0.0.1', udp_port))
+        self.create_timer(TICK, self._tick)
+
+    def _tick(self) -> None:
+        self._take()
+        while True:
+            try:
+                data, sender = self._socket.recvfrom(65536)
+            except BlockingIOError:
+                return
+            if answered_bytes(data, self._every):
+                self._socket.sendto(data, sender)
 
 
 class Pinger:
@@ -283,23 +306,42 @@ class SiteEnd(DdsEnd):
 
 
 class UdpEnd:
-    """This process's UDP socket to the echo's: the floor."""
+    """This process's UDP socket to the echo's: the floor.
 
-    def __init__(self, port: int, pinger: Pinger) -> None:
+    The pongs are taken as they come, by a thread; with ``in_tick``, at this end's 1 ms ticks
+    instead, as the site ends take theirs (the floor of the ticking paths).
+    """
+
+    def __init__(self, port: int, pinger: Pinger, in_tick: bool = False) -> None:
         self.socket = udp_socket()
         self.socket.bind(('127.0.0.1', 0))
-        self.socket.settimeout(0.1)
         self._echo = ('127.0.0.1', port)
-        self._pinger, self._running = pinger, True
-        self._thread = threading.Thread(target=self._receive, daemon=True)
-        self._thread.start()
+        self._pinger, self._running, self._thread = pinger, True, None
+        if in_tick:
+            self.socket.setblocking(False)
+        else:
+            self.socket.settimeout(0.1)
+            self._thread = threading.Thread(target=self._receive, daemon=True)
+            self._thread.start()
 
     def send(self, data: bytes) -> None:
         self.socket.sendto(data, self._echo)  # unconnected: an echo not up yet is no error
 
-    @staticmethod
-    def wait(seconds: float) -> None:
-        time.sleep(seconds)  # the pongs are taken by the receiving thread
+    def wait(self, seconds: float) -> None:
+        if self._thread is not None:
+            time.sleep(seconds)  # the pongs are taken by the receiving thread
+            return
+        deadline = time.perf_counter() + seconds
+        while (left := deadline - time.perf_counter()) > 0.0:
+            time.sleep(min(left, TICK))
+            self._take()
+
+    def _take(self) -> None:
+        while True:
+            try:
+                self._pinger.on_pong(self.socket.recv(65536))
+            except BlockingIOError:
+                return
 
     def _receive(self) -> None:
         while self._running:
@@ -310,7 +352,8 @@ class UdpEnd:
 
     def close(self) -> None:
         self._running = False
-        self._thread.join()
+        if self._thread is not None:
+            self._thread.join()
         self.socket.close()
 
 
@@ -449,18 +492,25 @@ def main(argv=None) -> int:
                 f'bench_link_site_echo:answer_every:={args.answer_every}', '-p',
                 f'bench_link_site_echo:in_tick:={in_tick}'],
                 loop_environment(args.domain_id + 3 + 2 * number, folder / 'log'))
-        tick_alone = start_child('tick_alone', [sys.executable, __file__, 'tick-alone'],
+        tick_port = free_port(socket.SOCK_DGRAM)
+        tick_alone = start_child('tick_alone', [sys.executable, __file__, 'tick-alone',
+                                                '--ros-args', '-p',
+                                                f'bench_link_site_echo:udp_port:={tick_port}',
+                                                '-p', 'bench_link_site_echo:answer_every:='
+                                                f'{args.answer_every}'],
                                  loop_environment(args.domain_id + 2 + 2 * len(IN_PROCESS),
                                                   folder / 'log'))
         pinger = Pinger(args.answer_every)
         gateway_pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
-        watched = {'floor': {'echo': echo.pid}, 'zenoh': {'echo': echo.pid},
+        watched = {'floor': {'echo': echo.pid}, 'floor_in_tick': {'echo': tick_alone.pid},
+                   'zenoh': {'echo': echo.pid},
                    'gateways': {**gateway_pids, 'echo': echo.pid},
                    **{case: {'echo': child.pid, 'tick alone': tick_alone.pid}
                       for case, child in site_echoes.items()}}
         ends = {}  # made one by one inside the try: one that fails still stops the others
         try:
             ends['floor'] = UdpEnd(udp_port, pinger)
+            ends['floor_in_tick'] = UdpEnd(tick_port, pinger, in_tick=True)
             ends['zenoh'] = ZenohEnd(folder / 'certs', direct, pinger)
             ends['gateways'] = DdsEnd(args.domain_id, pinger)
             for number, case in enumerate(IN_PROCESS):
@@ -481,13 +531,17 @@ def main(argv=None) -> int:
             stop_children([*gateways.values(), echo, *site_echoes.values(), tick_alone])
     summary = summarize(results)
     print(f'load average after: {os.getloadavg()[0]:.2f}')
-    for case, what in (('zenoh', 'Zenoh alone'), ('gateways', 'the gateways'),
-                       ('in_process_timer', "the gateways in the sites' processes, by timer"),
-                       ('in_process', "the gateways in the sites' processes")):
-        print(f'added by {what} over the floor (median of rounds): ' + ', '.join(
-            f'p{q:g} {summary[case]["added_ms"][f"p{q:g}"]:.3f} ms '
-            f'({summary[case]["ratio"][f"p{q:g}"]:.1f} x)' for q in PERCENTILES)
-            + f'; lost {summary[case]["lost"]} of {summary[case]["sent"]}')
+    paths = {'floor_in_tick': 'UDP between the ticking ends', 'zenoh': 'Zenoh alone',
+             'gateways': 'the gateways',
+             'in_process_timer': "the gateways in the sites' processes, by timer",
+             'in_process': "the gateways in the sites' processes"}
+    added = [(what, 'the floor', summary[case]) for case, what in paths.items()]
+    added += [(paths[case], 'the floor in ticks', summary['over_floor_in_tick'][case])
+              for case in TICKED]
+    for what, floor, over in added:
+        print(f'added by {what} over {floor} (median of rounds): ' + ', '.join(
+            f'p{q:g} {over["added_ms"][f"p{q:g}"]:.3f} ms ({over["ratio"][f"p{q:g}"]:.1f} x)'
+            for q in PERCENTILES) + f'; lost {over["lost"]} of {over["sent"]}')
     print('CPU (median of rounds): ' + ', '.join(
         f'{name} {cpu:.1f} %' for name, cpu in summary['gateway_cpu_pct'].items())
         + '; the echo ' + ', '.join(
@@ -504,6 +558,8 @@ def main(argv=None) -> int:
 def summarize(results: dict) -> dict:
     """Return what Zenoh alone and the gateways add over the floor; each gateway's CPU, the echo's.
 
+    The ticking paths are also given over the floor in ticks (``over_floor_in_tick``).
+
     The remote gateway's CPU in its site's process is the echo's process's less the ticking echo
     alone's, round by round.
 
@@ -512,14 +568,15 @@ def summarize(results: dict) -> dict:
     def median(case: str, key) -> float:
         return float(np.median([key(run) for run in results[case]]))
 
-    def over_floor(case: str) -> dict:
+    def over(case: str, floor: str = 'floor') -> dict:
         keys = {f'p{q:g}': (lambda run, q=q: run[f'p{q:g}_ms']) for q in PERCENTILES}
-        return {'added_ms': {q: median(case, key) - median('floor', key)
+        return {'added_ms': {q: median(case, key) - median(floor, key)
                              for q, key in keys.items()},
-                'ratio': {q: median(case, key) / median('floor', key) for q, key in keys.items()},
+                'ratio': {q: median(case, key) / median(floor, key) for q, key in keys.items()},
                 'lost': sum(run['lost'] for run in results[case]),
                 'sent': sum(run['sent'] for run in results[case])}
-    return {**{case: over_floor(case) for case in CASES[1:]},
+    return {**{case: over(case) for case in CASES[1:]},
+            'over_floor_in_tick': {case: over(case, 'floor_in_tick') for case in TICKED},
             'gateway_cpu_pct': {name: median('gateways', lambda run, n=name: run['cpu_pct'][n])
                                 for name in results['gateways'][0]['cpu_pct']
                                 if name.endswith('gateway')},
