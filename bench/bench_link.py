@@ -19,18 +19,20 @@ takes commands, and this end takes the pongs in its own 1 ms tick, as the leader
 each wand pose; beside them, the same ends that take them as the gateways' own 1 ms timers hand
 them over (the handover before the follower and the leader took the link in their ticks), and, for
 the gateway's share of its site's CPU, the same ticking echo alone, no gateway, nothing to answer
-(``tick_alone``): each in-process gateway's CPU is its process's less that one's, in the same
-round. Taken in ticks, a round trip waits for them whatever carries it; so the ticking paths are
-also given over a floor in ticks (``floor_in_tick``): UDP between the ticking echo alone, which
-answers the UDP pings in its tick, and this end, which takes the pongs at its own 1 ms ticks,
-with no gateway on the path: what the gateways add beyond the nodes' ticks. This process sends ``--rate`` numbered pings; an echo process (``bench_link.py echo``, in
-the next DDS domain) sends each back at once on every path. The cases alternate within one
-invocation, so they share the machine's state; each figure is given beside its floor, and as the
-round trip added over it. A ping with no pong 0.5 s after the window ends is lost. Each gateway's
-CPU, and the echo's (with its gateway, when it is in the echo's process), is read from outside
-(psutil) over the measured window, in % of one core. No emulated delay: the stage passes messages
-straight on. With ``--answer-every 10`` the echo answers every tenth ping only, on every path: the
-rates a session puts through the remote site's gateway (1 kHz commands in, 100 Hz feedback out).
+while they are measured (``tick_alone``): each in-process gateway's CPU is its process's less that
+one's, in the same round. Taken in ticks, a round trip waits for them whatever carries it; so the
+ticking paths are also given over a floor in ticks (``floor_in_tick``): UDP between the ticking
+echo alone, which answers the UDP pings in its tick (every ticking echo reads its socket so), and
+this end, which takes the pongs at its own 1 ms ticks, with no gateway on the path: what the
+gateways add beyond the nodes' ticks. This process sends ``--rate`` numbered pings; an echo
+process (``bench_link.py echo``, in the next DDS domain) sends each back at once on every path.
+The cases alternate within one invocation, so they share the machine's state; each figure is
+given beside its floor, and as the round trip added over it. A ping with no pong 0.5 s after the
+window ends is lost. Each gateway's CPU, and the echo's (with its gateway, when it is in the
+echo's process), is read from outside (psutil) over the measured window, in % of one core. No
+emulated delay: the stage passes messages straight on. With ``--answer-every 10`` the echo
+answers every tenth ping only, on every path: the rates a session puts through the remote site's
+gateway (1 kHz commands in, 100 Hz feedback out).
 """
 import argparse
 import os
