@@ -266,16 +266,20 @@ def _teleop_chapter(findings: Findings) -> list[str]:
     parts += _stored(findings, 'teleop_scan', lambda rows: [
         teleop_section([{**r, 'source': 'ROS 2'} for r in rows]), '', *figure])
     parts += ['### The link between the sites', '',
-              'A 1 kHz ping and its echo between two sites, at no emulated delay, on four '
-              'paths alternated in one run (`bench/bench_link.py`): the floor, the same two '
+              'A 1 kHz ping and its echo between two sites, at no emulated delay, on the '
+              'paths below alternated in one run (`bench/bench_link.py`): the floor, the same two '
               'processes exchanging the same bytes as UDP datagrams on the same loopback; the '
+              'floor in ticks, UDP between ends that take it in 1 ms ticks as the deployed ends '
+              'do (a round trip there waits for the ticks, whatever carries it); the '
               'same two processes over Zenoh sessions of their own with the gateways\' '
               'settings (no DDS, no gateway: the least a gateway could add); the gateways as '
               'processes of their own, DDS to the operator\'s gateway, Zenoh over mutual TLS, '
               'the remote gateway and DDS, and back (the baseline); and the deployed path, each '
               'gateway a node of its site\'s process, the ping and the echo handed to it and '
-              'from it in the process. The echo\'s CPU is its process\'s: with the deployed '
-              'path, the remote site\'s gateway is in it.', '']
+              'from it in the process, the echo taking the pings in its 1 ms tick as the '
+              'follower takes commands and the ping end the pongs in its own, as the leader '
+              'takes feedback. The echo\'s CPU is its process\'s: with the deployed path, the '
+              'remote site\'s gateway is in it.', '']
     parts += _stored(findings, 'link', lambda stored: [link_section(stored), ''])
     parts += ['The same question of a whole session: the demo\'s model-mediated scan over a 50 ms '
               'link with each site\'s gateway in its process (deployed) and with the gateways '

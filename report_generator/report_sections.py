@@ -456,20 +456,29 @@ def link_section(stored: dict) -> str:
         return float(np.median([run[key] for run in stored['runs'][case]]))
     summary = stored['summary']
     quantiles = ('p50', 'p99', 'p99.9')
-    paths = {'floor': 'plain UDP (the floor)', 'zenoh': 'Zenoh alone, between the end processes',
+    paths = {'floor': 'plain UDP (the floor)',
+             'floor_in_tick': 'plain UDP between ends that take it in 1 ms ticks (the floor in '
+                              'ticks)',
+             'zenoh': 'Zenoh alone, between the end processes',
              'gateways': 'the gateways as processes of their own (the baseline)',
-             'in_process': "the gateways in the sites' processes (deployed)"}
-    added_by = {'zenoh': 'Zenoh alone', 'gateways': 'the gateway processes',
-                'in_process': "the gateways in the sites' processes"}
+             'in_process': "the gateways in the sites' processes, taken in the ends' ticks "
+                           '(deployed)'}
+    added_by = [('Zenoh alone', summary['zenoh']),
+                ('the gateway processes', summary['gateways']),
+                ("the gateways in the sites' processes", summary['in_process']),
+                ("the gateways in the sites' processes, over the floor in ticks",
+                 summary['over_floor_in_tick']['in_process'])]
     rows = [[paths[case], *(f'{median(case, f"{q}_ms"):.3f}' for q in quantiles),
              f'{sum(r["lost"] for r in stored["runs"][case])} of '
              f'{sum(r["sent"] for r in stored["runs"][case])}'] for case in paths]
-    for case, what in added_by.items():
-        added = (f'{summary[case]["added_ms"][q]:+.3f} ({summary[case]["ratio"][q]:.1f} ×)'
-                 for q in quantiles)
+    for what, over in added_by:
+        added = (f'{over["added_ms"][q]:+.3f} ({over["ratio"][q]:.1f} ×)' for q in quantiles)
         rows.append([f'added by {what}', *added, ''])
     cpu = ', '.join(f'{name} {value:.1f} %' for name, value in summary['gateway_cpu_pct'].items())
     echo = ', '.join(f'{value:.1f} % ({case})' for case, value in summary['echo_cpu_pct'].items())
+    in_site = ', '.join(f'{value:.1f} % ({case})'
+                        for case, value in summary['in_process_gateway_cpu_pct'].items())
     return (markdown_table(['path', 'round trip p50 (ms)', 'p99 (ms)', 'p99.9 (ms)', 'lost'],
                            rows)
-            + f'\n\nCPU over the window, in % of one core: {cpu}; the echo {echo}.')
+            + f'\n\nCPU over the window, in % of one core: {cpu}; the echo {echo}; the remote '
+            f'gateway in its site\'s process, over the same ticking echo alone: {in_site}.')
