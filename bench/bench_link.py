@@ -270,7 +270,53 @@ class DdsEnd:
         rclpy.try_shutdown(context=self.context)
 
 
-class SiteEnd(DdsEnd):
+class TickingEnd(DdsEnd):
+    """This process as the operator's site: its executor spun in 1 ms ticks, ``_take`` at each.
+
+    ``_take`` (set by each kind of end) takes the pongs that came.
+    """
+
+    def wait(self, seconds: float) -> None:
+        """Spin for ``seconds``, taking the pongs at each tick (the pings go out at ticks)."""
+        deadline = time.perf_counter() + seconds
+        while (left := deadline - time.perf_counter()) > 0.0:
+            super().wait(min(left, TICK))
+            self._take()
+
+
+class UdpTickEnd(TickingEnd):
+    """The floor in ticks: the operator's site with no gateway, its pings and pongs UDP's.
+
+    Its ping node ticks as ``SiteEnd``'s does, and takes the pongs its socket holds at each
+    tick: its CPU is that of a ticking site with nothing but the floor's transport.
+    """
+
+    def __init__(self, domain: int, port: int, pinger: Pinger) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain)
+        self.node = Node('bench_link_udp_pinger', context=self.context)
+        self.executor = EventsExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.socket = udp_socket()
+        self.socket.bind(('127.0.0.1', 0))
+        self.socket.setblocking(False)
+        echo = ('127.0.0.1', port)
+        self.send = lambda data: self.socket.sendto(data, echo)
+        self._pinger = pinger
+
+    def _take(self) -> None:
+        while True:
+            try:
+                self._pinger.on_pong(self.socket.recv(65536))
+            except BlockingIOError:
+                return
+
+    def close(self) -> None:
+        self.socket.close()
+        super().close()
+
+
+class SiteEnd(TickingEnd):
     """This process as the operator's site: a ping node and the gateway, on one executor.
 
     The pings are handed to the gateway in the process as a site's nodes hand it their streams
@@ -301,13 +347,6 @@ class SiteEnd(DdsEnd):
             self.executor.add_node(node)
         self.send = lambda data: publisher.publish(codec.decode(data))
 
-    def wait(self, seconds: float) -> None:
-        """Spin for ``seconds``, taking the pongs at each tick (the pings go out at ticks)."""
-        deadline = time.perf_counter() + seconds
-        while (left := deadline - time.perf_counter()) > 0.0:
-            super().wait(min(left, TICK))
-            self._take()
-
     def close(self) -> None:
         self.gateway.destroy_node()
         intra_process.close()
@@ -315,42 +354,23 @@ class SiteEnd(DdsEnd):
 
 
 class UdpEnd:
-    """This process's UDP socket to the echo's: the floor.
+    """This process's UDP socket to the echo's: the floor."""
 
-    The pongs are taken as they come, by a thread; with ``in_tick``, at this end's 1 ms ticks
-    instead, as the site ends take theirs (the floor of the ticking paths).
-    """
-
-    def __init__(self, port: int, pinger: Pinger, in_tick: bool = False) -> None:
+    def __init__(self, port: int, pinger: Pinger) -> None:
         self.socket = udp_socket()
         self.socket.bind(('127.0.0.1', 0))
+        self.socket.settimeout(0.1)
         self._echo = ('127.0.0.1', port)
-        self._pinger, self._running, self._thread = pinger, True, None
-        if in_tick:
-            self.socket.setblocking(False)
-        else:
-            self.socket.settimeout(0.1)
-            self._thread = threading.Thread(target=self._receive, daemon=True)
-            self._thread.start()
+        self._pinger, self._running = pinger, True
+        self._thread = threading.Thread(target=self._receive, daemon=True)
+        self._thread.start()
 
     def send(self, data: bytes) -> None:
         self.socket.sendto(data, self._echo)  # unconnected: an echo not up yet is no error
 
-    def wait(self, seconds: float) -> None:
-        if self._thread is not None:
-            time.sleep(seconds)  # the pongs are taken by the receiving thread
-            return
-        deadline = time.perf_counter() + seconds
-        while (left := deadline - time.perf_counter()) > 0.0:
-            time.sleep(min(left, TICK))
-            self._take()
-
-    def _take(self) -> None:
-        while True:
-            try:
-                self._pinger.on_pong(self.socket.recv(65536))
-            except BlockingIOError:
-                return
+    @staticmethod
+    def wait(seconds: float) -> None:
+        time.sleep(seconds)  # the pongs are taken by the receiving thread
 
     def _receive(self) -> None:
         while self._running:
@@ -361,8 +381,7 @@ class UdpEnd:
 
     def close(self) -> None:
         self._running = False
-        if self._thread is not None:
-            self._thread.join()
+        self._thread.join()
         self.socket.close()
 
 
@@ -511,15 +530,19 @@ def main(argv=None) -> int:
                                                   folder / 'log'))
         pinger = Pinger(args.answer_every)
         gateway_pids = {f'{role} gateway': child.pid for role, child in gateways.items()}
-        watched = {'floor': {'echo': echo.pid}, 'floor_in_tick': {'echo': tick_alone.pid},
+        # This process: each window's end is its busy one, the others' idle the same in each.
+        site = {'operator site': os.getpid()}
+        watched = {'floor': {'echo': echo.pid},
+                   'floor_in_tick': {'echo': tick_alone.pid, **site},
                    'zenoh': {'echo': echo.pid},
                    'gateways': {**gateway_pids, 'echo': echo.pid},
-                   **{case: {'echo': child.pid, 'tick alone': tick_alone.pid}
+                   **{case: {'echo': child.pid, 'tick alone': tick_alone.pid, **site}
                       for case, child in site_echoes.items()}}
         ends = {}  # made one by one inside the try: one that fails still stops the others
         try:
             ends['floor'] = UdpEnd(udp_port, pinger)
-            ends['floor_in_tick'] = UdpEnd(tick_port, pinger, in_tick=True)
+            ends['floor_in_tick'] = UdpTickEnd(args.domain_id + 3 + 2 * len(IN_PROCESS),
+                                               tick_port, pinger)
             ends['zenoh'] = ZenohEnd(folder / 'certs', direct, pinger)
             ends['gateways'] = DdsEnd(args.domain_id, pinger)
             for number, case in enumerate(IN_PROCESS):
@@ -558,6 +581,10 @@ def main(argv=None) -> int:
     print("the remote gateway in its site's process, over the ticking echo alone (median of "
           'rounds): ' + ', '.join(f'{cpu:.1f} % ({case})' for case, cpu in
                                   summary['in_process_gateway_cpu_pct'].items()))
+    print("the operator's gateway in its site's process (this one), over its floor in ticks "
+          '(median of rounds): ' + ', '.join(
+              f'{cpu:.1f} % ({case})' for case, cpu in
+              summary['operator_in_process_gateway_cpu_pct'].items()))
     result_files.write(args.json, {'rate_hz': args.rate, 'seconds': args.seconds,
                                    'answer_every': args.answer_every,
                                    'runs': results, 'summary': summary})
@@ -570,7 +597,8 @@ def summarize(results: dict) -> dict:
     The ticking paths are also given over the floor in ticks (``over_floor_in_tick``).
 
     The remote gateway's CPU in its site's process is the echo's process's less the ticking echo
-    alone's, round by round.
+    alone's, round by round; the operator's, this process's less its own in the floor in ticks
+    (its end ticking as much, with UDP for the gateway) in the same round.
 
     What each adds is the round trip's added quantiles, their ratios, and the loss.
     """
@@ -594,6 +622,11 @@ def summarize(results: dict) -> dict:
             'in_process_gateway_cpu_pct': {
                 case: median(case, lambda run: run['cpu_pct']['echo']
                              - run['cpu_pct']['tick alone']) for case in IN_PROCESS},
+            'operator_in_process_gateway_cpu_pct': {
+                case: float(np.median([
+                    run['cpu_pct']['operator site'] - floor['cpu_pct']['operator site']
+                    for run, floor in zip(results[case], results['floor_in_tick'])]))
+                for case in IN_PROCESS},
             'floor_lost': sum(run['lost'] for run in results['floor'])}
 
 

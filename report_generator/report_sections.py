@@ -476,9 +476,13 @@ def link_section(stored: dict) -> str:
         rows.append([f'added by {what}', *added, ''])
     cpu = ', '.join(f'{name} {value:.1f} %' for name, value in summary['gateway_cpu_pct'].items())
     echo = ', '.join(f'{value:.1f} % ({case})' for case, value in summary['echo_cpu_pct'].items())
-    in_site = ', '.join(f'{value:.1f} % ({case})'
-                        for case, value in summary['in_process_gateway_cpu_pct'].items())
+    in_site = '; '.join(
+        f'{role} ' + ', '.join(f'{value:.1f} % ({case})' for case, value in summary[key].items())
+        for role, key in (('remote', 'in_process_gateway_cpu_pct'),
+                          ('operator', 'operator_in_process_gateway_cpu_pct')))
     return (markdown_table(['path', 'round trip p50 (ms)', 'p99 (ms)', 'p99.9 (ms)', 'lost'],
                            rows)
-            + f'\n\nCPU over the window, in % of one core: {cpu}; the echo {echo}; the remote '
-            f'gateway in its site\'s process, over the same ticking echo alone: {in_site}.')
+            + f'\n\nCPU over the window, in % of one core: {cpu}; the echo {echo}. Each gateway '
+            f'in its site\'s process, over the same site ticking without it (the remote one: the '
+            f'ticking echo alone, in the same window; the operator\'s: the ping end in the floor '
+            f'in ticks, in the same round): {in_site}.')
