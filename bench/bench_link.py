@@ -73,8 +73,9 @@ PING, PONG = 'bench/ping', 'bench/pong'
 POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
 DIRECT_PREFIX = 'bench'  # the direct case's Zenoh keys (its sessions reach no gateway's)
 CASES = ('floor', 'floor_in_tick', 'zenoh', 'gateways', 'in_process_timer', 'in_process')
-IN_PROCESS = {'in_process_timer': False, 'in_process': True}  # case -> ends take in their ticks
-TICKED = ('in_process_timer', 'in_process')  # the cases whose round trips wait for 1 ms ticks
+# The gateways in the sites' processes: case -> whether the ends take the link in their ticks
+# (else the gateways' 1 ms timers hand it over). Both wait for 1 ms ticks.
+IN_PROCESS = {'in_process_timer': False, 'in_process': True}
 SEQUENCE = struct.Struct('<i')  # the ping's number, in its header's stamp.sec (after CDR's 4)
 WARM_UP = 1.0  # [s] of pongs coming back before a window is measured
 DRAIN = 0.5  # [s] after a window, for the last pongs
@@ -484,8 +485,9 @@ def main(argv=None) -> int:
     parser.add_argument('--threads', action='store_true',
                         help="print each process's CPU by thread too (always in --json)")
     ros_domain.add_option(parser, help="the operator's side; the echo's is the next, the two "
-                          'pairs of sites with their gateways in them the four after, and the '
-                          'ticking echo alone the next')
+                          'pairs of sites with their gateways in them the four after, the '
+                          "ticking echo alone the next, and this end of the floor in ticks' the "
+                          'next')
     result_files.add_option(parser)
     args = parser.parse_args(argv[1:])
     if args.answer_every < 1:
@@ -569,7 +571,7 @@ def main(argv=None) -> int:
              'in_process': "the gateways in the sites' processes"}
     added = [(what, 'the floor', summary[case]) for case, what in paths.items()]
     added += [(paths[case], 'the floor in ticks', summary['over_floor_in_tick'][case])
-              for case in TICKED]
+              for case in IN_PROCESS]
     for what, floor, over in added:
         print(f'added by {what} over {floor} (median of rounds): ' + ', '.join(
             f'p{q:g} {over["added_ms"][f"p{q:g}"]:.3f} ms ({over["ratio"][f"p{q:g}"]:.1f} x)'
@@ -613,7 +615,7 @@ def summarize(results: dict) -> dict:
                 'lost': sum(run['lost'] for run in results[case]),
                 'sent': sum(run['sent'] for run in results[case])}
     return {**{case: over(case) for case in CASES[1:]},
-            'over_floor_in_tick': {case: over(case, 'floor_in_tick') for case in TICKED},
+            'over_floor_in_tick': {case: over(case, 'floor_in_tick') for case in IN_PROCESS},
             'gateway_cpu_pct': {name: median('gateways', lambda run, n=name: run['cpu_pct'][n])
                                 for name in results['gateways'][0]['cpu_pct']
                                 if name.endswith('gateway')},
