@@ -110,6 +110,15 @@ def udp_socket() -> socket.socket:
     return udp
 
 
+def datagrams(udp: socket.socket):
+    """Yield (bytes, sender) of each datagram a non-blocking ``udp`` holds now: a tick's take."""
+    while True:
+        try:
+            yield udp.recvfrom(65536)
+        except BlockingIOError:
+            return
+
+
 def direct_session(role: str, certs: pathlib.Path, endpoint: str) -> tuple:
     """Return ``role``'s Zenoh configuration in the direct case, its key to put, its key to take.
 
@@ -191,11 +200,7 @@ class SiteEcho(Node):
 
     def _tick(self) -> None:
         self._take()
-        while True:
-            try:
-                data, sender = self._socket.recvfrom(65536)
-            except BlockingIOError:
-                return
+        for data, sender in datagrams(self._socket):
             if answered_bytes(data, self._every):
                 self._socket.sendto(data, sender)
 
@@ -306,11 +311,8 @@ class UdpTickEnd(TickingEnd):
         self._pinger = pinger
 
     def _take(self) -> None:
-        while True:
-            try:
-                self._pinger.on_pong(self.socket.recv(65536))
-            except BlockingIOError:
-                return
+        for data, _ in datagrams(self.socket):
+            self._pinger.on_pong(data)
 
     def close(self) -> None:
         self.socket.close()
