@@ -136,6 +136,41 @@ def test_a_subscription_taken_in_its_tick_is_polled_and_only_it_is_taken(context
         pushed.take()
 
 
+@pytest.mark.parametrize('in_process', [True, False], ids=['in_process', 'over_dds'])
+def test_a_polled_reader_leaves_the_graph_with_its_subscription(context, in_process):
+    """Its node of its own goes then, not when the process closes, and no reader is left."""
+    if in_process:
+        intra_process.enable()
+    try:
+        follower = node(context, 'follower')
+        commands = stream_subscription(follower, POSE, 'teleop/command', print,
+                                       refused=Tally(), max_rate=4000.0, in_tick=True)
+        assert sorted(follower.get_node_names()) == ['_follower_intake', 'follower']
+        commands.destroy()
+        assert follower.get_node_names() == ['follower']
+        assert follower.count_subscribers('teleop/command') == 0
+    finally:
+        intra_process.close()
+
+
+def test_when_the_subscription_whose_node_reads_a_topic_goes_the_next_one_s_node_reads_it(
+        context, bus):
+    follower, recorder = node(context, 'follower'), node(context, 'recorder')
+    commands = stream_subscription(follower, POSE, 'teleop/command', print, refused=Tally(),
+                                   max_rate=4000.0, in_tick=True)
+    got = []
+    stream_subscription(recorder, POSE, 'teleop/command', got.append, refused=Tally(),
+                        max_rate=4000.0)
+    assert list(recorder.timers) == []  # one reader for the process: the follower's
+    commands.destroy()
+    assert sorted(recorder.get_node_names()) == ['_recorder_intake', 'follower', 'recorder']
+    operator = node(context, 'operator')
+    publisher = operator.create_publisher(PoseStamped, 'teleop/command', HAPTIC_STREAM_QOS)
+    assert spin_until([recorder, operator],
+                      lambda: publisher.publish(POSE.encode(VALUES)) or bool(got))
+    assert got[0] == list(VALUES)
+
+
 def test_messages_are_delivered_in_the_order_they_were_published(context, bus):
     seen = []
     pose_out = stream_publisher(node(context, 'driver'), POSE, 'wand/pose')

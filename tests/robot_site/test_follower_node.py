@@ -5,6 +5,7 @@ import time
 import pytest
 import rclpy
 from rclpy.context import Context
+from rclpy.node import Node
 
 from haptic_contract.teleop_fields import impedance_message
 from haptic_util.diagnostics import ERROR, WARN
@@ -30,6 +31,19 @@ def follower():
     yield node
     node.destroy_node()
     rclpy.try_shutdown(context=context)
+
+
+def test_the_commands_reader_leaves_the_graph_with_the_follower():
+    """It reads on a node of its own, which must not outlive the follower, still matched."""
+    context = Context()
+    rclpy.init(context=context, domain_id=97)
+    try:
+        probe = Node('probe', context=context)
+        FollowerNode(context=context, parameter_overrides=[
+            rclpy.parameter.Parameter('scene_file', value='')]).destroy_node()
+        assert probe.get_node_names() == ['probe']
+    finally:
+        rclpy.try_shutdown(context=context)
 
 
 def test_it_commands_nothing_until_the_robot_says_what_it_is(follower):

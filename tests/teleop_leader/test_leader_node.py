@@ -17,7 +17,6 @@ from rclpy.node import Node
 from haptic_contract.graph import TELEOP_FEEDBACK
 from haptic_contract.teleop import Feedback
 from haptic_contract.teleop_fields import FEEDBACK, feedback_fields
-from haptic_util import intra_process
 from haptic_util.diagnostics import WARN
 from haptic_util.qos import LINK_QOS
 from teleop_leader.leader_node import LeaderNode
@@ -66,8 +65,19 @@ def leader(request):
     node._command_pub = Sent()
     yield node
     node.destroy_node()
-    intra_process.close()  # its polled feedback reader, which outlives the node till then
     rclpy.try_shutdown(context=context)
+
+
+def test_the_feedback_s_reader_leaves_the_graph_with_the_leader():
+    """It reads on a node of its own, which must not outlive the leader, still matched."""
+    context = Context()
+    rclpy.init(context=context, domain_id=97)
+    try:
+        probe = Node('probe', context=context)
+        LeaderNode(context=context).destroy_node()
+        assert probe.get_node_names() == ['probe']
+    finally:
+        rclpy.try_shutdown(context=context)
 
 
 @pytest.mark.parametrize('order', ['pose first', 'twist first'])

@@ -32,6 +32,10 @@ class ProcessRecorder(Recorder):
     ``name`` is the node's, which its parameters are given under (one per site).
     """
 
+    def __init__(self, name: str, **kwargs):
+        self._streams = []  # its stream subscriptions, made as the base class records
+        super().__init__(name, **kwargs)
+
     def record(self, topic: str, name: str) -> None:
         if topic not in STREAMS:
             super().record(topic, name)
@@ -40,4 +44,12 @@ class ProcessRecorder(Recorder):
         self.bag.add_topic(name, TOPIC_TYPES[topic], encode=codec.encode)
         subscribe = link_subscription if topic == absolute(TELEOP_COMMAND) else \
             stream_subscription
-        subscribe(self, codec, topic, lambda values: self.put(name, values), refused=self.refused)
+        self._streams.append(subscribe(self, codec, topic, lambda values: self.put(name, values),
+                                       refused=self.refused))
+
+    def destroy_node(self) -> bool:
+        """Close the bag, then stop taking the streams (a polled reader's node goes with them)."""
+        destroyed = super().destroy_node()
+        for subscription in self._streams:
+            subscription.destroy()
+        return destroyed

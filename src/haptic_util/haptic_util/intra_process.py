@@ -36,6 +36,7 @@ by asking DDS on every message (about 1.3 µs a call, six streams a tick): like 
 node, it must be spun.
 """
 from collections import deque
+import functools
 from typing import Callable, Sequence
 
 from rclpy.event_handler import PublisherEventCallbacks
@@ -55,7 +56,6 @@ _state = {'enabled': False}
 _topics: dict = {}  # resolved topic -> _Topic, while enabled
 _pending: deque = deque()  # (subscription, leaf values) to deliver, in publishing order
 _draining = [False]
-_polled: list = []  # every PolledReader made, destroyed by ``close``
 
 
 def enable() -> None:
@@ -69,13 +69,15 @@ def enabled() -> bool:
 
 
 def close() -> None:
-    """Stop delivering in the process and forget its topics: its nodes are being destroyed."""
+    """Stop delivering in the process and forget its topics: its nodes are being destroyed.
+
+    A subscription's DDS reader goes with the subscription (``StreamSubscription.destroy``),
+    which its node's ``destroy_node`` calls.
+    """
     for record in _topics.values():
         record.subscriptions.clear()  # the publishers hold these lists
     _topics.clear()
     _pending.clear()
-    while _polled:
-        _polled.pop().destroy()
     _state['enabled'] = False
 
 
@@ -86,19 +88,28 @@ class _Topic:
         self.msg_type = msg_type
         self.publishers: list = []
         self.subscriptions: list = []
-        self.reader = None  # (its DDS reader, what destroys it) while nobody here publishes
+        # (its DDS reader, what destroys it, the subscription whose node reads) while nobody
+        # here publishes
+        self.reader = None
         self.source = None  # what publishes what came from outside, when a tick takes it
 
-    def take_over_dds(self, node: Node, codec: MessageCodec, topic: str, *, refused: Tally,
-                      qos: QoSProfile, max_rate: float | None, timed: bool) -> None:
+    def take_over_dds(self) -> None:
         """Take the topic over DDS for every subscription of the process, unless it does.
 
         The first subscription's node reads it, with that subscription's QoS and rate (and,
-        polled, by its own timer or in its tick), and counts what is malformed in ``refused``.
+        polled, by its own timer or in its tick), and counts what is malformed in its tally.
         """
-        if self.reader is None and not self.publishers:
-            self.reader = _dds_reader(node, codec, topic, self.deliver, refused=refused,
-                                      qos=qos, max_rate=max_rate, timed=timed)
+        if self.reader is None and not self.publishers and self.subscriptions:
+            reading = self.subscriptions[0]
+            self.reader = (*reading.open_reader(self.deliver), reading)
+
+    def remove(self, subscription: 'StreamSubscription') -> None:
+        """Forget a destroyed subscription; if its node read the topic, the next one's does."""
+        if subscription in self.subscriptions:  # not if ``close`` forgot them all
+            self.subscriptions.remove(subscription)
+        if self.reader is not None and self.reader[2] is subscription:
+            self.drop_reader()
+            self.take_over_dds()
 
     @property
     def taken_in_tick(self) -> bool:
@@ -116,11 +127,10 @@ class _Topic:
         _pending.extend((subscription, values) for subscription in self.subscriptions)
         _drain()
 
-    def served_locally(self) -> None:
-        """Stop taking the topic over DDS: a node of this process publishes it."""
+    def drop_reader(self) -> None:
+        """Stop taking the topic over DDS: a node here publishes it, or none reads it so."""
         if self.reader is not None:
-            _, destroy = self.reader
-            destroy()
+            self.reader[1]()
             self.reader = None
 
     def dds_publisher_count(self) -> int:
@@ -152,7 +162,7 @@ class StreamPublisher:
         self._local = self._topic.subscriptions if self._topic is not None else []
         if self._topic is not None:
             self._topic.publishers.append(self)
-            self._topic.served_locally()
+            self._topic.drop_reader()
 
     @property
     def topic_name(self) -> str:
@@ -201,6 +211,9 @@ class StreamSubscription:
 
     Made ``in_tick`` (polled: ``max_rate`` given), it takes nothing by itself: its node calls
     ``take`` in its own tick.
+
+    Its node's ``destroy_node`` calls ``destroy``: a polled reader lives on a node of its own,
+    which would otherwise outlive its owner, matched to the topic's publishers.
     """
 
     def __init__(self, node: Node, codec: MessageCodec, topic: str,
@@ -211,15 +224,15 @@ class StreamSubscription:
             raise ValueError(f'{topic}: a subscription taken in its tick is polled: give max_rate')
         self.callback = callback
         self.in_tick = in_tick
+        self.open_reader = functools.partial(_dds_reader, node, codec, topic, refused=refused,
+                                             qos=qos, max_rate=max_rate, timed=not in_tick)
         self._topic = _topic(node, codec.message_class, topic)
-        self._dds = None  # its own DDS reader, while intra-process delivery is off
+        self._dds = None  # (its own DDS reader, what destroys it), while intra-process is off
         if self._topic is not None:
             self._topic.subscriptions.append(self)
-            self._topic.take_over_dds(node, codec, topic, refused=refused, qos=qos,
-                                      max_rate=max_rate, timed=not in_tick)
+            self._topic.take_over_dds()
         else:
-            self._dds, _ = _dds_reader(node, codec, topic, callback, refused=refused, qos=qos,
-                                       max_rate=max_rate, timed=not in_tick)
+            self._dds = self.open_reader(callback)
 
     def take(self) -> None:
         """Take what came from outside the process since the last tick (made ``in_tick``)."""
@@ -229,13 +242,21 @@ class StreamSubscription:
         if self._topic is not None:
             self._topic.take()
         else:
-            self._dds.take()
+            self._dds[0].take()
 
     def get_publisher_count(self) -> int:
         """Return how many publishers match: of this process, and over DDS."""
         if self._topic is None:
-            return self._dds.get_publisher_count()
+            return self._dds[0].get_publisher_count()
         return len(self._topic.publishers) + self._topic.dds_publisher_count()
+
+    def destroy(self) -> None:
+        """Stop taking the topic, and destroy the DDS reader this subscription's node holds."""
+        if self._topic is not None:
+            self._topic.remove(self)
+        elif self._dds is not None:
+            self._dds[1]()
+        self._topic = self._dds = None
 
 
 def _dds_reader(node: Node, codec: MessageCodec, topic: str,
@@ -247,12 +268,7 @@ def _dds_reader(node: Node, codec: MessageCodec, topic: str,
         subscription = node.create_subscription(codec.message_class, topic, take, qos, raw=True)
         return subscription, lambda: node.destroy_subscription(subscription)
     reader = PolledReader(node, codec.message_class, topic, take, qos, max_rate, timed=timed)
-    _polled.append(reader)
-
-    def destroy() -> None:
-        _polled.remove(reader)
-        reader.destroy()
-    return reader, destroy
+    return reader, reader.destroy
 
 
 def _decoding(codec: MessageCodec, topic: str, refused: Tally,

@@ -210,6 +210,7 @@ class FollowerNode(Node):
 
     def destroy_node(self) -> bool:
         self.diagnostics.final()
+        self._commands.destroy()
         return super().destroy_node()
 
 

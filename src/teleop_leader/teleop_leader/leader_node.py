@@ -226,6 +226,7 @@ class LeaderNode(Node):
 
     def destroy_node(self) -> bool:
         self.diagnostics.final()
+        self._feedback.destroy()
         return super().destroy_node()
 
 
