@@ -231,6 +231,7 @@ class GatewayNode(Node):
             self._take(crossing, functools.partial(on_message, index),
                        in_process and crossing.kind == STREAM)
         self._into_dds, self._handovers, self._listeners = {}, [], []
+        self._untaken = None  # the handovers no node takes in its tick: known at the first tick
         for index, crossing in enumerate(routes.incoming):
             self._hand_on(index, crossing, in_process and crossing.kind == STREAM)
         self._handover_timer = self.create_timer(TICK, self._hand_over_untaken) \
@@ -286,10 +287,12 @@ class GatewayNode(Node):
 
         Which are taken is known once the process's nodes are made, before its first tick.
         """
-        untaken = [handover for handover in self._handovers if not handover[2].taken_in_tick]
-        if not untaken:
-            self._handover_timer.cancel()
-        for handover in untaken:
+        if self._untaken is None:
+            self._untaken = [handover for handover in self._handovers
+                             if not handover[2].taken_in_tick]
+            if not self._untaken:
+                self._handover_timer.cancel()
+        for handover in self._untaken:
             self._hand_over(handover)
 
     def _hand_over(self, handover: tuple) -> None:
