@@ -2,6 +2,7 @@
 import math
 import time
 
+from domains import session_domain_id
 import pytest
 import rclpy
 from rclpy.context import Context
@@ -36,7 +37,7 @@ def follower():
 def test_the_commands_reader_leaves_the_graph_with_the_follower():
     """It reads on a node of its own, which must not outlive the follower, still matched."""
     context = Context()
-    rclpy.init(context=context, domain_id=97)
+    rclpy.init(context=context, domain_id=session_domain_id())  # none else sees it
     try:
         probe = Node('probe', context=context)
         FollowerNode(context=context, parameter_overrides=[

@@ -7,6 +7,7 @@ before the robot is found, so the driver's probe of the loop waits for it.
 import dataclasses
 import time
 
+from domains import session_domain_id
 import numpy as np
 import pytest
 import rclpy
@@ -71,7 +72,7 @@ def leader(request):
 def test_the_feedback_s_reader_leaves_the_graph_with_the_leader():
     """It reads on a node of its own, which must not outlive the leader, still matched."""
     context = Context()
-    rclpy.init(context=context, domain_id=97)
+    rclpy.init(context=context, domain_id=session_domain_id())  # none else sees it
     try:
         probe = Node('probe', context=context)
         LeaderNode(context=context).destroy_node()
