@@ -83,6 +83,9 @@ CONNECT_LIMIT = 60.0  # [s] for the path to carry a first pong, on a busy machin
 PERCENTILES = (50.0, 99.0, 99.9)
 PHASE_SEED = 20261129  # the pings' phases against the echoes' ticks, the same each invocation
 SOCKET_BUFFER = 4 << 20  # [bytes] seconds of pings, for a receiver descheduled on a busy machine
+# Issue 27's targets for the deployed path: the round trip's p99 added over the floor, and each
+# gateway's share of a core in its site's process.
+TARGETS = {'added_p99_ms': 2.0, 'gateway_cpu_pct': 10.0}
 
 
 def ping(sequence: int) -> bytes:
@@ -589,6 +592,8 @@ def main(argv=None) -> int:
           '(median of rounds): ' + ', '.join(
               f'{cpu:.1f} % ({case})' for case, cpu in
               summary['operator_in_process_gateway_cpu_pct'].items()))
+    print('targets of the deployed path: ' + '; '.join(
+        f'{what}: {"held" if holds else "MISSED"}' for what, holds in verdicts(summary)))
     result_files.write(args.json, {'rate_hz': args.rate, 'seconds': args.seconds,
                                    'answer_every': args.answer_every,
                                    'runs': results, 'summary': summary})
@@ -632,6 +637,22 @@ def summarize(results: dict) -> dict:
                     for run, floor in zip(results[case], results['floor_in_tick'])]))
                 for case in IN_PROCESS},
             'floor_lost': sum(run['lost'] for run in results['floor'])}
+
+
+def verdicts(summary: dict) -> list:
+    """Return issue 27's targets for the deployed path, as (what, holds) pairs."""
+    deployed = summary['in_process']
+    added = deployed['added_ms']['p99']
+    checks = [(f'round trip p99 {added:+.2f} ms over the floor (target <= '
+               f'+{TARGETS["added_p99_ms"]:g} ms)', added <= TARGETS['added_p99_ms']),
+              (f'{deployed["lost"]} of {deployed["sent"]} lost (target none)',
+               deployed['lost'] == 0)]
+    for role, key in (('remote', 'in_process_gateway_cpu_pct'),
+                      ('operator', 'operator_in_process_gateway_cpu_pct')):
+        cpu = summary[key]['in_process']
+        checks.append((f'the {role} gateway {cpu:.1f} % of a core (target <= '
+                       f'{TARGETS["gateway_cpu_pct"]:g} %)', cpu <= TARGETS['gateway_cpu_pct']))
+    return checks
 
 
 if __name__ == '__main__':

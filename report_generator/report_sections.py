@@ -452,6 +452,8 @@ def gateway_session_section(stored: dict) -> str:
 
 def link_section(stored: dict) -> str:
     """Tabulate the round trip over UDP, Zenoh alone and both gateway layouts, loss and CPU."""
+    from bench import bench_link
+
     def median(case: str, key: str) -> float:
         return float(np.median([run[key] for run in stored['runs'][case]]))
     summary = stored['summary']
@@ -485,4 +487,6 @@ def link_section(stored: dict) -> str:
             + f'\n\nCPU over the window, in % of one core: {cpu}; the echo {echo}. Each gateway '
             f'in its site\'s process, over the same site ticking without it (the remote one: the '
             f'ticking echo alone, in the same window; the operator\'s: the ping end in the floor '
-            f'in ticks, in the same round): {in_site}.')
+            f'in ticks, in the same round): {in_site}.\n\nTargets of the deployed path '
+            f'(issue 27): ' + '; '.join(f'{what}: {"held" if holds else "**missed**"}'
+                                        for what, holds in bench_link.verdicts(summary)) + '.')
